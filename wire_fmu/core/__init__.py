@@ -1,0 +1,1 @@
+"""Physics core: components, units and their integrators (no FMI here)."""

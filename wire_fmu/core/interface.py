@@ -1,0 +1,294 @@
+"""How a core unit declares itself: variables, feedthrough, state and energy.
+
+A *unit* is one piece of equipment (block train, winch, hydraulics) that
+advances in time with its inputs held over a communication step. It knows
+nothing of FMI: the export layer maps these declarations onto an FMU, and the
+same unit can be stepped directly from Python.
+
+Sign convention, stated once for every unit
+-------------------------------------------
+* A mechanical *port* is one end of a power bond: one unit outputs a flow
+  (velocity or angular velocity, plus its integral, the position), the
+  partner outputs the matching effort (force or torque). Each unit counts
+  the power that flows *into it* through each port as positive; across a
+  bond the two sides' port powers add to zero up to coupling error (the
+  bond's energy residual).
+* Each unit reports ``stored_energy`` (J) and ``dissipated_energy`` (J,
+  integral of loss power, never decreasing) and ``external_work`` (J,
+  integral of the power delivered into the unit through its ports). The
+  ledger ``stored(t) - stored(0) + dissipated - external_work`` is zero up
+  to integration error.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any, ClassVar
+
+__all__ = [
+    "Causality",
+    "Variability",
+    "Variable",
+    "StepResult",
+    "Unit",
+    "parameter",
+    "input_",
+    "output",
+]
+
+
+class Causality(str, Enum):
+    """Role of a variable at the unit boundary (FMI 2.0 names)."""
+
+    parameter = "parameter"
+    input = "input"
+    output = "output"
+
+
+class Variability(str, Enum):
+    """How a variable may change (FMI 2.0 names)."""
+
+    fixed = "fixed"
+    tunable = "tunable"
+    discrete = "discrete"
+    continuous = "continuous"
+
+
+_TYPES = (float, int, bool, str)
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One declared variable of a unit.
+
+    Parameters
+    ----------
+    name : str
+        Dotted name, e.g. ``"line_a.tension"``; unique within the unit.
+    causality : Causality
+        Parameter, input or output.
+    type : type
+        ``float``, ``int``, ``bool`` or ``str``.
+    start : Any
+        Start value (parameters and inputs; outputs before initialisation).
+    unit : str
+        Unit symbol in FMI form (``"N"``, ``"m/s"``, ``"N.m"``, ``"1"``);
+        empty for non-Real variables.
+    description : str
+        One sentence, for humans.
+    variability : Variability
+        ``fixed`` parameters may be set only before initialisation.
+    depends_on : tuple of str
+        For outputs: the inputs this output depends on *directly* within
+        one step (direct feedthrough). An output of a state of an inertia
+        depends on no input. Ignored for non-outputs.
+    min, max, nominal : float or None
+        Optional bounds and scale for Reals.
+    """
+
+    name: str
+    causality: Causality
+    type: type = float
+    start: Any = 0.0
+    unit: str = ""
+    description: str = ""
+    variability: Variability = Variability.continuous
+    depends_on: tuple[str, ...] = ()
+    min: float | None = None
+    max: float | None = None
+    nominal: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.type not in _TYPES:
+            raise TypeError(f"variable {self.name!r}: type must be one of {_TYPES}")
+        if not self.description:
+            raise ValueError(f"variable {self.name!r}: a description is required")
+        if self.type is float and not self.unit:
+            raise ValueError(f"variable {self.name!r}: a Real needs a unit ('1' if none)")
+
+
+def parameter(
+    name: str,
+    start: Any,
+    unit: str,
+    description: str,
+    *,
+    type: type = float,  # noqa: A002 - mirrors the FMI attribute name
+    fixed: bool = True,
+    min: float | None = None,  # noqa: A002
+    max: float | None = None,  # noqa: A002
+) -> Variable:
+    """Declare a parameter (``fixed`` unless ``fixed=False``)."""
+    return Variable(
+        name,
+        Causality.parameter,
+        type=type,
+        start=start,
+        unit=unit if type is float else "",
+        description=description,
+        variability=Variability.fixed if fixed else Variability.tunable,
+        min=min,
+        max=max,
+    )
+
+
+def input_(
+    name: str, start: Any, unit: str, description: str, *, type: type = float  # noqa: A002
+) -> Variable:
+    """Declare an input."""
+    variability = Variability.continuous if type is float else Variability.discrete
+    return Variable(
+        name,
+        Causality.input,
+        type=type,
+        start=start,
+        unit=unit if type is float else "",
+        description=description,
+        variability=variability,
+    )
+
+
+def output(
+    name: str,
+    unit: str,
+    description: str,
+    *,
+    depends_on: tuple[str, ...] = (),
+    type: type = float,  # noqa: A002
+    start: Any = None,
+) -> Variable:
+    """Declare an output and the inputs it depends on directly."""
+    variability = Variability.continuous if type is float else Variability.discrete
+    if start is None:
+        start = type()
+    return Variable(
+        name,
+        Causality.output,
+        type=type,
+        start=start,
+        unit=unit if type is float else "",
+        description=description,
+        variability=variability,
+        depends_on=tuple(depends_on),
+    )
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """Outcome of :meth:`Unit.advance`.
+
+    A refused step (``success`` False) is a physical or numerical stop the
+    unit could not step through; ``message`` says why, naming the unit and
+    the quantity. The unit's state is then that at the start of the step.
+    """
+
+    success: bool
+    message: str = ""
+    events: tuple[str, ...] = field(default=())
+
+
+class Unit(ABC):
+    """Base class of every core unit.
+
+    Subclasses declare ``VARIABLES`` (a tuple of :class:`Variable`) and
+    implement :meth:`configure`, :meth:`initialize`, :meth:`advance`,
+    :meth:`get_state` and :meth:`set_state`. Values of all declared
+    variables live in :attr:`values`, a plain dict keyed by name, which the
+    FMI facade reads and writes.
+
+    Call order: construct -> set parameters and inputs in ``values`` ->
+    :meth:`configure` -> :meth:`initialize` -> (set inputs, :meth:`advance`,
+    read outputs) ...
+    """
+
+    NAME: ClassVar[str] = "Unit"
+    DESCRIPTION: ClassVar[str] = ""
+    VARIABLES: ClassVar[tuple[Variable, ...]] = ()
+
+    def __init__(self, instance_name: str = "unit") -> None:
+        self.instance_name = instance_name
+        self.values: dict[str, Any] = {v.name: v.start for v in self.VARIABLES}
+
+    # -- declarations -------------------------------------------------------
+    @classmethod
+    def variables(cls) -> tuple[Variable, ...]:
+        """All declared variables, in declaration order."""
+        return cls.VARIABLES
+
+    @classmethod
+    def variable(cls, name: str) -> Variable:
+        """The declared variable called ``name``."""
+        for var in cls.VARIABLES:
+            if var.name == name:
+                return var
+        known = ", ".join(v.name for v in cls.VARIABLES)
+        raise KeyError(f"{cls.NAME} has no variable {name!r}; known: {known}")
+
+    @classmethod
+    def check_declarations(cls) -> list[str]:
+        """Problems with the declarations themselves (empty when sound)."""
+        problems: list[str] = []
+        names = [v.name for v in cls.VARIABLES]
+        inputs = {v.name for v in cls.VARIABLES if v.causality is Causality.input}
+        for name in sorted({n for n in names if names.count(n) > 1}):
+            problems.append(f"{cls.NAME}: variable {name!r} declared twice")
+        for var in cls.VARIABLES:
+            unknown = [d for d in var.depends_on if d not in inputs]
+            if unknown:
+                problems.append(
+                    f"{cls.NAME}.{var.name}: depends_on names {unknown}, which are not inputs"
+                )
+        return problems
+
+    # -- life cycle ---------------------------------------------------------
+    @abstractmethod
+    def configure(self) -> None:
+        """Build the model from the parameters in :attr:`values`.
+
+        Raises
+        ------
+        wire_fmu.core.errors.ConfigurationError
+            Listing every problem found in the parameters.
+        """
+
+    @abstractmethod
+    def initialize(self, start_time: float) -> None:
+        """Set the initial state from parameters and inputs; fill outputs."""
+
+    @abstractmethod
+    def advance(self, time: float, step: float) -> StepResult:
+        """Advance from ``time`` by ``step`` (s) with the inputs held."""
+
+    @abstractmethod
+    def get_state(self) -> dict[str, Any]:
+        """Complete internal state as JSON-compatible data (a deep copy)."""
+
+    @abstractmethod
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state returned by :meth:`get_state`."""
+
+    # -- helpers --------------------------------------------------------------
+    def parameters(self) -> dict[str, Any]:
+        """Current parameter values by name."""
+        return {
+            v.name: self.values[v.name]
+            for v in self.VARIABLES
+            if v.causality is Causality.parameter
+        }
+
+    def outputs(self) -> dict[str, Any]:
+        """Current output values by name."""
+        return {
+            v.name: self.values[v.name]
+            for v in self.VARIABLES
+            if v.causality is Causality.output
+        }
+
+
+def is_finite(value: float) -> bool:
+    """True for a finite float (helper for output checks)."""
+    return math.isfinite(value)
