@@ -26,7 +26,7 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 from typing import Any, ClassVar
 
 __all__ = [
@@ -41,7 +41,7 @@ __all__ = [
 ]
 
 
-class Causality(str, Enum):
+class Causality(StrEnum):
     """Role of a variable at the unit boundary (FMI 2.0 names)."""
 
     parameter = "parameter"
@@ -49,7 +49,7 @@ class Causality(str, Enum):
     output = "output"
 
 
-class Variability(str, Enum):
+class Variability(StrEnum):
     """How a variable may change (FMI 2.0 names)."""
 
     fixed = "fixed"

@@ -1,0 +1,56 @@
+"""Small helpers shared by the block-train tests: make a unit, run it."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+import numpy as np
+
+from wire_fmu.core.block_train_unit import BlockTrainUnit
+
+
+def make_unit(reeving: dict, effects: str = "", **params) -> BlockTrainUnit:
+    """A configured, initialised block-train unit."""
+    unit = BlockTrainUnit("test")
+    unit.values["reeving"] = json.dumps(reeving)
+    unit.values["effects"] = effects
+    for name, value in params.items():
+        unit.values[name] = value
+    unit.configure()
+    unit.initialize(0.0)
+    return unit
+
+
+def run(
+    unit: BlockTrainUnit,
+    duration: float,
+    step: float,
+    drive: Callable[[float, BlockTrainUnit], None] | None = None,
+    record: tuple[str, ...] = ("block_a.position",),
+) -> dict[str, np.ndarray]:
+    """Step ``unit`` for ``duration`` seconds; ``drive(t, unit)`` sets inputs.
+
+    Payout inputs are advanced with their rates so that position and rate
+    stay consistent, as a master connecting a winch would do.
+    """
+    n = int(round(duration / step))
+    out = {name: np.empty(n + 1) for name in ("time", *record)}
+    out["time"][0] = 0.0
+    for name in record:
+        out[name][0] = unit.values[name]
+    t = 0.0
+    for i in range(n):
+        if drive is not None:
+            drive(t, unit)
+        result = unit.advance(t, step)
+        assert result.success, result.message
+        for port in ("line_a", "line_b"):
+            unit.values[f"{port}.payout"] += unit.values[f"{port}.payout_rate"] * step
+        for port in ("mover_a", "mover_b"):
+            unit.values[f"{port}.position"] += unit.values[f"{port}.velocity"] * step
+        t = (i + 1) * step
+        out["time"][i + 1] = t
+        for name in record:
+            out[name][i + 1] = unit.values[name]
+    return out

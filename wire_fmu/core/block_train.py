@@ -1,0 +1,659 @@
+"""The block train: rope reeved over sheaves between anchors and line ends.
+
+Assembled from the parts in :mod:`rope`, :mod:`geometry`, :mod:`friction`
+(SPEC sections 2-6, paper 000). Which effects are included decides the
+model's states:
+
+========================  ===================================================
+always                    rope springs with slack; blocks (mass, gravity,
+                          floor); rope break; energy bookkeeping
+``rope_damping``          Kelvin-Voigt term in every rope spring
+``sheave_inertia``        each sheave a rotating mass: one coordinate per
+                          sheave, rope spans no longer merge across it
+``bearing_friction``      dry bearing friction per sheave (needs inertia)
+``rope_slip``             rope on the groove is its own mass, gripping or
+                          slipping by the capstan law (needs inertia)
+``moving_geometry``       tangent points recomputed as bodies move
+``spatial_geometry``      non-planar reevings, with fleet angles
+========================  ===================================================
+
+Coordinates and signs
+---------------------
+Along the path, node ``k`` joins segment ``k-1`` to segment ``k``. The rope
+coordinate ``s_k`` counts unstretched rope that has passed node ``k``
+forwards (from segment ``k-1`` into segment ``k``). Segment ``k`` then has
+unstretched length ``l_k = l_k(0) + s_k - s_{k+1}``. A line end at the
+start of the path has ``s = payout`` (rope paid in); at the end,
+``s = -payout``. An anchor has ``s = 0``. A massless frictionless sheave
+has no coordinate: the segments on both sides form one *span* (one spring).
+Bodies move along their unit direction by a displacement ``y``.
+
+The equations of motion are Lagrange's with the rope strain energy of
+:mod:`rope`, so the energy ledger closes to integration error.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ConfigurationError
+from .friction import GROUND, FrictionLink, StickSlip
+from .geometry import Circle, PathNode, path_geometry
+from .hybrid import SolverSettings, make_solver
+from .reeving import Reeving
+from .rope import rope_forces
+
+__all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
+
+from .effects import Effect, EffectCatalogue
+
+BLOCK_TRAIN_EFFECTS = EffectCatalogue(
+    "block train",
+    (
+        Effect("rope_damping", "Hooke rope (eq. 3)", "Kelvin-Voigt rope (eq. 5)"),
+        Effect("sheave_inertia", "massless sheaves, merged springs", "sheave inertia (eq. 11)"),
+        Effect(
+            "bearing_friction",
+            "frictionless bearings",
+            "dry bearing friction with stick",
+            requires=("sheave_inertia",),
+        ),
+        Effect(
+            "rope_slip",
+            "rope grips the groove",
+            "capstan slip (eq. 9-12)",
+            requires=("sheave_inertia",),
+        ),
+        Effect("moving_geometry", "fixed line directions", "tangent points recomputed (eq. 16-31)"),
+        Effect("spatial_geometry", "planar reeving", "3-D reeving with fleet angles"),
+    ),
+)
+
+
+@dataclass
+class BlockTrainInputs:
+    """Inputs held over one step (positions advance with their rates).
+
+    Attributes
+    ----------
+    payout : dict of str to float
+        Rope paid in through each line end, m (unstretched length).
+    payout_rate : dict of str to float
+        Its rate, m/s.
+    mover_position, mover_velocity : dict of str to float
+        Displacement (m) and velocity (m/s) of each driven body's port.
+    """
+
+    payout: dict[str, float]
+    payout_rate: dict[str, float]
+    mover_position: dict[str, float]
+    mover_velocity: dict[str, float]
+
+
+@dataclass(frozen=True)
+class _Span:
+    """Consecutive segments between two nodes that carry rope coordinates."""
+
+    segments: tuple[int, ...]
+    start_node: int
+    end_node: int
+
+
+class BlockTrainModel:
+    """Hybrid ODE of a block train; see the module docstring.
+
+    Parameters
+    ----------
+    reeving : Reeving
+        Validated reeving.
+    effects : frozenset of str
+        Effects to include (validated by :data:`BLOCK_TRAIN_EFFECTS`).
+    solver : SolverSettings
+        Internal solver for :meth:`advance`.
+    """
+
+    GEOMETRY_STEP = 1e-6  # m, central differences of lengths w.r.t. body motion
+
+    def __init__(self, reeving: Reeving, effects: frozenset[str], solver: SolverSettings) -> None:
+        self.reeving = reeving
+        self.effects = effects
+        self.settings = solver
+        self.rope = reeving.rope
+        if "rope_slip" in effects and not self.rope.linear_mass > 0.0:
+            raise ConfigurationError(
+                "block train",
+                ["effect 'rope_slip' needs rope 'linear_mass' > 0 kg/m (the rope on a groove "
+                 "is the mass that slips)"],
+            )
+        if "rope_damping" not in effects:
+            from dataclasses import replace
+
+            self.rope = replace(self.rope, damping=0.0)
+        self._build_nodes()
+        self._build_coordinates()
+        self._build_spans()
+        self._build_geometry()
+        self._build_friction()
+        self._guard_dirs = self._guard_directions()
+        self.solver = make_solver(solver)
+        self.broken = [False] * len(self.spans)
+        self.offsets = np.zeros(len(self.spans))  # l_span(0) - s(start) + s(end)
+        self.state = np.zeros(2 * self.n_coords + 2)
+        self.inputs = BlockTrainInputs({}, {}, {}, {})
+        self._t_step = 0.0
+        self.mode_changes = 0
+        self.last_events: list[str] = []
+        self._held_positions = np.zeros(self.n_coords)
+
+    # ------------------------------------------------------------------ build
+    def _build_nodes(self) -> None:
+        r = self.reeving
+        self.nodes = r.path
+        self.n_nodes = len(r.path)
+        self.n_segments = self.n_nodes - 1
+
+    def _build_coordinates(self) -> None:
+        """Coordinates: blocks, then sheave rims, then rope on grooves (slip)."""
+        r, fx = self.reeving, self.effects
+        self.blocks = r.bodies_of_kind("block")
+        self.drivers = r.bodies_of_kind("driven")
+        masses = [b.mass for b in self.blocks]
+        self.block_index = {b.name: i for i, b in enumerate(self.blocks)}
+        self.rim_index: dict[int, int] = {}
+        self.rope_index: dict[int, int] = {}  # node -> coordinate carrying its rope
+        inertia = "sheave_inertia" in fx
+        slip = "rope_slip" in fx
+        for k, node in enumerate(self.nodes):
+            if node.kind != "sheave" or not inertia:
+                continue
+            sheave = r.sheaves[node.name]
+            self.rim_index[k] = len(masses)
+            masses.append(sheave.inertia / sheave.radius**2)
+        if slip:
+            for k in list(self.rim_index):
+                self.rope_index[k] = len(masses)
+                masses.append(math.nan)  # set once wrap angles are known
+        else:
+            self.rope_index = dict(self.rim_index)
+        self.masses = np.array(masses, dtype=float)
+        self.n_coords = len(masses)
+        self.body_dof = [b.name for b in self.blocks] + [b.name for b in self.drivers]
+
+    def _build_spans(self) -> None:
+        flow_nodes = [k for k, n in enumerate(self.nodes) if n.kind != "sheave"] + list(
+            self.rope_index
+        )
+        flow_nodes = sorted(set(flow_nodes))
+        spans = []
+        for a, b in zip(flow_nodes[:-1], flow_nodes[1:], strict=True):
+            spans.append(_Span(tuple(range(a, b)), a, b))
+        self.spans = tuple(spans)
+        self.span_of_segment = {}
+        for i, sp in enumerate(self.spans):
+            for k in sp.segments:
+                self.span_of_segment[k] = i
+
+    def _node_circle(self, k: int, displacement: dict[str, float]) -> tuple[Circle, int]:
+        r = self.reeving
+        node = self.nodes[k]
+        body = r.bodies[r.node_body(node)]
+        shift = np.array(body.direction) * displacement.get(body.name, 0.0)
+        if node.kind == "sheave":
+            s = r.sheaves[node.name]
+            centre = tuple(np.array(s.centre) + shift)
+            return Circle(s.name, centre, s.axis, s.radius), node.sense
+        point = r.anchors[node.name].point if node.kind == "anchor" else node.point
+        axis = (0.0, 0.0, 1.0)
+        return Circle(f"{node.kind} {node.name!r}", tuple(np.array(point) + shift), axis, 0.0), 0
+
+    def path_nodes(self, displacement: dict[str, float]) -> list[PathNode]:
+        """Geometric path nodes for given body displacements (m)."""
+        return [PathNode(*self._node_circle(k, displacement)) for k in range(self.n_nodes)]
+
+    def _segment_lengths(self, displacement: dict[str, float], validate: bool = False):
+        geo = path_geometry(
+            self.path_nodes(displacement),
+            max_fleet_angle=self.reeving.max_fleet_angle,
+            validate=validate,
+        )
+        half_arcs = np.zeros(self.n_segments)
+        for j, arc in enumerate(geo.arc_lengths):  # interior node j + 1
+            half_arcs[j] += 0.5 * arc
+            half_arcs[j + 1] += 0.5 * arc
+        return np.asarray(geo.lengths) + half_arcs, geo
+
+    def _build_geometry(self) -> None:
+        """Initial geometry; the linear length model for fixed line directions."""
+        try:
+            lengths, geo = self._segment_lengths({}, validate=True)
+        except ConfigurationError as err:
+            raise ConfigurationError("block train reeving geometry", err.problems) from None
+        self.geometry0 = geo
+        if "spatial_geometry" not in self.effects:
+            self._require_planar(geo)
+        self.wrap_angles = np.zeros(self.n_nodes)
+        self.wrap_angles[1:-1] = geo.wrap_angles
+        self.segment_length0 = lengths
+        n_dof = len(self.body_dof)
+        jac = np.zeros((self.n_segments, n_dof))
+        dirs = np.asarray(geo.directions)
+        for b, name in enumerate(self.body_dof):
+            d = np.array(self.reeving.bodies[name].direction)
+            for k in range(self.n_segments):
+                if self.reeving.node_body(self.nodes[k + 1]) == name:
+                    jac[k, b] += dirs[k] @ d
+                if self.reeving.node_body(self.nodes[k]) == name:
+                    jac[k, b] -= dirs[k] @ d
+        self.length_jacobian0 = jac
+        self.span_matrix = np.zeros((len(self.spans), self.n_segments))
+        for i, sp in enumerate(self.spans):
+            self.span_matrix[i, list(sp.segments)] = 1.0
+        self.moving = "moving_geometry" in self.effects
+        for k, idx in self.rope_index.items():
+            if idx != self.rim_index[k]:
+                s = self.reeving.sheaves[self.nodes[k].name]
+                self.masses[idx] = self.rope.linear_mass * s.radius * self.wrap_angles[k]
+
+    def _require_planar(self, geo) -> None:
+        fleet = np.asarray(geo.fleet_angles)
+        axes = {tuple(np.round(self.reeving.sheaves[n.name].axis, 9))
+                for n in self.nodes if n.kind == "sheave"}
+        problems = []
+        if fleet.size and np.max(np.abs(fleet)) > 1e-9:
+            k = int(np.argmax(np.max(np.abs(fleet), axis=1)))
+            problems.append(
+                f"segment {k} (between {self._node_label(k)} and {self._node_label(k + 1)}) "
+                f"leaves the plane (fleet angle {math.degrees(np.max(np.abs(fleet[k]))):.3f} deg); "
+                "add the effect 'spatial_geometry' for a non-planar reeving"
+            )
+        if len({tuple(abs(c) for c in a) for a in axes}) > 1:
+            problems.append(
+                "sheave axes are not all parallel; add the effect 'spatial_geometry'"
+            )
+        if problems:
+            raise ConfigurationError("block train", problems)
+
+    def _node_label(self, k: int) -> str:
+        node = self.nodes[k]
+        return f"{node.kind} {node.name!r}"
+
+    def _build_friction(self) -> None:
+        links = []
+        self.link_kind: list[tuple[str, int]] = []
+        if "bearing_friction" in self.effects:
+            for k, idx in self.rim_index.items():
+                links.append(FrictionLink(f"sheave {self.nodes[k].name!r} bearing", idx, GROUND))
+                self.link_kind.append(("bearing", k))
+        if "rope_slip" in self.effects:
+            for k, idx in self.rope_index.items():
+                name = f"rope on sheave {self.nodes[k].name!r}"
+                links.append(FrictionLink(name, idx, self.rim_index[k]))
+                self.link_kind.append(("groove", k))
+        self.friction = StickSlip(self.masses, tuple(links))
+        sheaves = self.reeving.sheaves
+        self._bearing_c = np.zeros(len(links))
+        self._bearing_m0 = np.zeros(len(links))
+        self._capstan = np.zeros(len(links))
+        for i, (kind, k) in enumerate(self.link_kind):
+            s = sheaves[self.nodes[k].name]
+            if kind == "bearing":
+                self._bearing_m0[i] = s.bearing_torque / s.radius
+                self._bearing_c[i] = (1.0 - s.efficiency) / (1.0 + s.efficiency)
+            else:
+                self._capstan[i] = math.expm1(s.groove_friction * self.wrap_angles[k])
+
+    # ---------------------------------------------------------- state layout
+    @property
+    def q(self) -> np.ndarray:
+        """Coordinates (m): blocks, rims, rope on grooves."""
+        return self.state[: self.n_coords]
+
+    @property
+    def v(self) -> np.ndarray:
+        """Velocities (m/s), same order as :attr:`q`."""
+        return self.state[self.n_coords : 2 * self.n_coords]
+
+    # ------------------------------------------------------------ kinematics
+    def _inputs_at(self, t: float):
+        dt = t - self._t_step
+        inp = self.inputs
+        pay = {p: inp.payout.get(p, 0.0) + inp.payout_rate.get(p, 0.0) * dt for p in inp.payout}
+        mov = {
+            p: inp.mover_position.get(p, 0.0) + inp.mover_velocity.get(p, 0.0) * dt
+            for p in inp.mover_position
+        }
+        return pay, mov
+
+    def _node_flow(self, k: int, q, v, pay, rate):
+        """Rope coordinate s_k and its rate at node k."""
+        node = self.nodes[k]
+        if k in self.rope_index:
+            i = self.rope_index[k]
+            return q[i], v[i]
+        if node.kind == "line_end":
+            sign = 1.0 if k == 0 else -1.0
+            return sign * pay.get(node.name, 0.0), sign * rate.get(node.name, 0.0)
+        return 0.0, 0.0
+
+    def _body_motion(self, q, v, mov):
+        """Displacement and velocity of every body degree of freedom."""
+        y = np.zeros(len(self.body_dof))
+        ydot = np.zeros(len(self.body_dof))
+        nb = len(self.blocks)
+        y[:nb], ydot[:nb] = q[:nb], v[:nb]
+        for j, body in enumerate(self.drivers):
+            y[nb + j] = mov.get(body.port, 0.0)
+            ydot[nb + j] = self.inputs.mover_velocity.get(body.port, 0.0)
+        return y, ydot
+
+    def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Geometric span lengths (m) and their Jacobian w.r.t. body motion."""
+        if not self.moving:
+            seg = self.segment_length0 + self.length_jacobian0 @ y
+            return self.span_matrix @ seg, self.span_matrix @ self.length_jacobian0
+        disp = dict(zip(self.body_dof, y, strict=True))
+        seg, _ = self._segment_lengths(disp)
+        jac = np.zeros((self.n_segments, len(y)))
+        for b, name in enumerate(self.body_dof):
+            h = self.GEOMETRY_STEP
+            plus, _ = self._segment_lengths({**disp, name: disp[name] + h})
+            minus, _ = self._segment_lengths({**disp, name: disp[name] - h})
+            jac[:, b] = (plus - minus) / (2 * h)
+        return self.span_matrix @ seg, self.span_matrix @ jac
+
+    # -------------------------------------------------------------- physics
+    def evaluate(self, t: float, x: np.ndarray) -> dict:
+        """Everything the model knows at (t, x): forces, tensions, energies."""
+        n = self.n_coords
+        q, v = x[:n], x[n : 2 * n]
+        pay, mov = self._inputs_at(t)
+        rate = self.inputs.payout_rate
+        y, ydot = self._body_motion(q, v, mov)
+        big_l, dl_dy = self.span_lengths(y)
+        big_l_rate = dl_dy @ ydot
+        forces = np.zeros(n)
+        body_force = np.zeros(len(self.body_dof))
+        tension = np.zeros(len(self.spans))
+        stretch = np.zeros(len(self.spans))
+        g_l = np.zeros(len(self.spans))
+        span_energy = np.zeros(len(self.spans))
+        loss = 0.0
+        for i, sp in enumerate(self.spans):
+            s0, s0dot = self._node_flow(sp.start_node, q, v, pay, rate)
+            s1, s1dot = self._node_flow(sp.end_node, q, v, pay, rate)
+            small_l = self.offsets[i] + s0 - s1
+            stretch[i] = big_l[i] - small_l
+            if self.broken[i]:
+                continue
+            if small_l <= 0.0:
+                raise FloatingPointError(f"rope span {i} has no unstretched rope left")
+            rf = rope_forces(self.rope, big_l[i], small_l, big_l_rate[i], s0dot - s1dot)
+            tension[i] = rf.tension
+            g_l[i] = rf.force_on_unstretched
+            span_energy[i] = rf.energy
+            loss += rf.loss_power
+            body_force -= rf.force_on_length * dl_dy[i]
+            if sp.start_node in self.rope_index:
+                forces[self.rope_index[sp.start_node]] += rf.force_on_unstretched
+            if sp.end_node in self.rope_index:
+                forces[self.rope_index[sp.end_node]] -= rf.force_on_unstretched
+        nb = len(self.blocks)
+        gravity = np.array(self.reeving.gravity)
+        potential = 0.0
+        contact = np.zeros(nb)
+        for j, block in enumerate(self.blocks):
+            weight = block.mass * float(gravity @ np.array(block.direction))
+            forces[j] += body_force[j] + weight
+            potential -= weight * q[j]
+            if block.floor is not None:
+                f, e, p_loss = _floor_contact(block.floor, block.position + q[j], v[j])
+                forces[j] += f
+                contact[j] = f
+                potential += e
+                loss += p_loss
+        return {
+            "forces": forces,
+            "tension": tension,
+            "stretch": stretch,
+            "force_on_unstretched": g_l,
+            "body_force": body_force,
+            "contact": contact,
+            "rope_energy": float(span_energy.sum()),
+            "span_energy": span_energy,
+            "potential": potential,
+            "loss": loss,
+            "y": y,
+            "ydot": ydot,
+        }
+
+    def _capacities(self, tension: np.ndarray) -> np.ndarray:
+        caps = np.zeros(len(self.link_kind))
+        for i, (kind, k) in enumerate(self.link_kind):
+            t_in = tension[self.span_of_segment[k - 1]]
+            t_out = tension[self.span_of_segment[k]]
+            if kind == "bearing":
+                caps[i] = self._bearing_m0[i] + self._bearing_c[i] * (t_in + t_out)
+            else:
+                caps[i] = self._capstan[i] * min(t_in, t_out)
+        return caps
+
+    def _external_power(self, ev: dict) -> float:
+        """Power delivered into the block train through its ports, W."""
+        power = 0.0
+        rate = self.inputs.payout_rate
+        for k in (0, self.n_nodes - 1):
+            node = self.nodes[k]
+            if node.kind != "line_end":
+                continue
+            span = 0 if k == 0 else len(self.spans) - 1
+            power -= ev["force_on_unstretched"][span] * rate.get(node.name, 0.0)
+        nb = len(self.blocks)
+        for j in range(len(self.drivers)):
+            power -= ev["body_force"][nb + j] * ev["ydot"][nb + j]
+        return power
+
+    # ------------------------------------------------ HybridSystem protocol
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """State derivative: [q', v', dissipated', external work']."""
+        n = self.n_coords
+        ev = self.evaluate(t, x)
+        v = x[n : 2 * n]
+        out = np.empty_like(x)
+        out[:n] = v
+        caps = self._capacities(ev["tension"])
+        acc, link_force = self.friction.accelerations(ev["forces"], caps)
+        out[n : 2 * n] = acc
+        friction_loss = 0.0
+        for k, _link in enumerate(self.friction.links):
+            if self.friction.mode[k] != 0:
+                friction_loss -= link_force[k] * self.friction.relative_velocity(v, k)
+        if self.friction.links:
+            held = self.friction.stuck_to_ground()
+            out[held] = 0.0
+        out[2 * n] = ev["loss"] + friction_loss
+        out[2 * n + 1] = self._external_power(ev)
+        return out
+
+    def _guard_directions(self) -> np.ndarray:
+        n_links = len(self.friction.links)
+        dirs = [-1] * n_links + [0] * len(self.spans) + [0] * len(self.blocks)
+        dirs += [-1] * len(self.spans)
+        return np.array(dirs, dtype=float)
+
+    def guard_directions(self) -> np.ndarray:
+        """See :class:`~wire_fmu.core.hybrid.HybridSystem`."""
+        return self._guard_dirs
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """Friction links, slack kinks, floor contact and rope break."""
+        n = self.n_coords
+        ev = self.evaluate(t, x)
+        caps = self._capacities(ev["tension"])
+        _, link_force = self.friction.accelerations(ev["forces"], caps)
+        g_links = self.friction.guards(x[n : 2 * n], link_force, caps)
+        floor = np.array([
+            (b.position + x[j] - b.floor.position) if b.floor else 1.0
+            for j, b in enumerate(self.blocks)
+        ])
+        slack = np.where(self.broken, 1.0, ev["stretch"])
+        breaking = self.rope.breaking_load - ev["tension"]
+        breaking = np.where(np.isfinite(breaking), breaking, 1.0)
+        return np.concatenate([g_links, slack, floor, breaking])
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """Switch friction modes, break ropes, note kinks."""
+        n_links = len(self.friction.links)
+        n_spans = len(self.spans)
+        x = np.array(x, dtype=float)
+        link_fired = [i for i in fired if i < n_links]
+        first_break = n_links + n_spans + len(self.blocks)
+        for i in fired:
+            if i >= first_break:
+                self._break_span(i - first_break, x, t)
+            elif i >= n_links + n_spans:
+                block = self.blocks[i - n_links - n_spans]
+                self.last_events.append(f"floor contact of {block.name}")
+            elif i >= n_links:
+                self.last_events.append(f"rope span {i - n_links} slack/taut")
+        if link_fired or any(i >= first_break for i in fired):
+            x = self._settle_modes(t, x, link_fired)
+        self.mode_changes += 1
+        return self.project(x)
+
+    def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
+        """Make the friction modes consistent with the forces at (t, x)."""
+        if not self.friction.links:
+            return x
+        n = self.n_coords
+        x = np.array(x, dtype=float)
+        ev = self.evaluate(t, x)
+        caps = self._capacities(ev["tension"])
+        before = self.friction.get_mode()
+        x[n : 2 * n] = self.friction.switch(x[n : 2 * n], ev["forces"], caps, fired or [])
+        changed = False
+        for k, (old, new) in enumerate(zip(before, self.friction.get_mode(), strict=True)):
+            if old != new:
+                changed = True
+                state = "stuck" if new == 0 else "sliding"
+                self.last_events.append(f"{self.friction.links[k].name} {state}")
+        if changed and fired is None:
+            self.mode_changes += 1
+        self._held_positions = x[:n].copy()
+        return self.project(x)
+
+    def _break_span(self, i: int, x: np.ndarray, t: float) -> None:
+        if self.broken[i]:
+            return
+        released = self.evaluate(t, x)["span_energy"][i]
+        self.broken[i] = True
+        x[2 * self.n_coords] += released  # the strain energy is released and lost
+        self.last_events.append(f"rope span {i} broke")
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """Hold coordinates stuck to the ground exactly where they stuck, at rest."""
+        if self.friction.links:
+            held = self.friction.stuck_to_ground()
+            if held.size:
+                x[held] = self._held_positions[held]
+                x[self.n_coords + held] = 0.0
+        return x
+
+    # -------------------------------------------------------- initial state
+    def initialize(
+        self, t0: float, inputs: BlockTrainInputs, *, equilibrium: bool, pretension: float
+    ) -> float:
+        """Set the rope's unstretched lengths and the state at rest.
+
+        With ``equilibrium`` and at least one block, the rope is stretched so
+        that every block hangs at rest where the reeving puts it; otherwise
+        every span starts at ``pretension`` (N). Returns the initial tension.
+
+        Raises
+        ------
+        ConfigurationError
+            If no single rope tension holds every block at rest.
+        """
+        self.inputs, self._t_step = inputs, t0
+        self.state = np.zeros(2 * self.n_coords + 2)
+        self.broken = [False] * len(self.spans)
+        pay, mov = self._inputs_at(t0)
+        y, _ = self._body_motion(self.q, self.v, mov)
+        big_l, dl_dy = self.span_lengths(y)
+        tension = pretension
+        if equilibrium and self.blocks:
+            tension = self._equilibrium_tension(dl_dy)
+        ea = self.rope.axial_stiffness
+        rate = inputs.payout_rate
+        for i, sp in enumerate(self.spans):
+            s0, _ = self._node_flow(sp.start_node, self.q, self.v, pay, rate)
+            s1, _ = self._node_flow(sp.end_node, self.q, self.v, pay, rate)
+            self.offsets[i] = big_l[i] * ea / (ea + tension) - s0 + s1
+        self.friction.set_mode([0] * len(self.friction.links))
+        self.state = self._settle_modes(t0, self.state, [])
+        return tension
+
+    def _equilibrium_tension(self, dl_dy: np.ndarray) -> float:
+        gravity = np.array(self.reeving.gravity)
+        needed = []
+        for j, block in enumerate(self.blocks):
+            lift = -float(dl_dy[:, j].sum())  # rope force on the block per newton of tension
+            weight = block.mass * float(gravity @ np.array(block.direction))
+            if lift <= 0.0:
+                raise ConfigurationError(
+                    "block train",
+                    [f"block {block.name!r} hangs on no rope: it cannot start in equilibrium"],
+                )
+            needed.append((block.name, -weight / lift))
+        tensions = [t for _, t in needed]
+        if max(tensions) - min(tensions) > 1e-9 * max(1.0, max(abs(t) for t in tensions)):
+            listed = ", ".join(f"{n!r} needs {t:.6g} N" for n, t in needed)
+            raise ConfigurationError(
+                "block train",
+                [f"initial_equilibrium: no single rope tension holds every block ({listed}); "
+                 "set initial_equilibrium false or change the masses"],
+            )
+        if tensions[0] < 0.0:
+            raise ConfigurationError(
+                "block train",
+                [f"initial_equilibrium: block {needed[0][0]!r} would need the rope to push "
+                 f"({tensions[0]:.6g} N)"],
+            )
+        return tensions[0]
+
+    # -------------------------------------------------------------- stepping
+    def advance(self, t: float, h: float, inputs: BlockTrainInputs) -> int:
+        """Advance the state from ``t`` by ``h`` with ``inputs`` held; return events."""
+        self.inputs = inputs
+        self._t_step = t
+        self.last_events = []
+        self.state = self._settle_modes(t, self.state)  # new inputs may break a stuck link
+        x, events = self.solver.advance(self, t, self.state, t + h)
+        self.state = x
+        return events
+
+    def break_segment(self, segment: int) -> None:
+        """Break the span containing ``segment`` (0-based) now."""
+        self._break_span(self.span_of_segment[segment], self.state, self._t_step)
+
+    # ----------------------------------------------------------- energy
+    def stored_energy(self, t: float | None = None) -> float:
+        """Kinetic + strain + gravitational + contact energy, J."""
+        t = self._t_step if t is None else t
+        ev = self.evaluate(t, self.state)
+        kinetic = 0.5 * float(self.masses @ self.v**2)
+        return kinetic + ev["rope_energy"] + ev["potential"]
+
+
+def _floor_contact(floor, position: float, velocity: float) -> tuple[float, float, float]:
+    """Force (along the body direction), energy and loss of a floor contact."""
+    depth = floor.position - position
+    if depth <= 0.0:
+        return 0.0, 0.0, 0.0
+    elastic = floor.stiffness * depth
+    damping = -floor.damping * velocity
+    if elastic + damping < 0.0:  # a support never pulls
+        damping = -elastic
+    return elastic + damping, 0.5 * elastic * depth, -damping * velocity

@@ -1,0 +1,256 @@
+"""The block train as a co-simulation unit: ports, parameters, outputs.
+
+Ports (power bonds)
+-------------------
+``line_a``, ``line_b``
+    Rope ends through which rope is paid in (e.g. by a winch drum). Inputs
+    ``payout`` (m, unstretched rope paid in since the start) and
+    ``payout_rate`` (m/s); output ``tension`` (N). Power into the block
+    train is ``-tension * payout_rate``.
+``mover_a``, ``mover_b``
+    Driven bodies (a cylinder rod, a heaving deck). Inputs ``position`` (m,
+    displacement along the body's direction) and ``velocity`` (m/s);
+    output ``force`` (N, the rope's force on the body along its
+    direction). Power into the block train is ``-force * velocity``.
+
+Within a step a position input advances with its rate input, so a master
+that holds a (position, velocity) pair gets kinematically consistent motion.
+The rope's compliance lives here, so tensions and forces depend directly on
+those inputs; block positions and velocities are states and depend on none.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
+from .errors import ConfigurationError
+from .hybrid import IntegrationError, SolverSettings
+from .interface import StepResult, Unit, input_, output, parameter
+from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
+from .reevings import drilling_block_train
+
+__all__ = ["BlockTrainUnit"]
+
+_KINEMATIC_INPUTS = tuple(
+    [f"{p}.payout" for p in LINE_PORTS]
+    + [f"{p}.payout_rate" for p in LINE_PORTS]
+    + [f"{p}.position" for p in MOVER_PORTS]
+    + [f"{p}.velocity" for p in MOVER_PORTS]
+)
+
+
+def _variables():
+    params = (
+        parameter("reeving", json.dumps(drilling_block_train(4)), "",
+                  "Reeving as JSON text: bodies, sheaves, anchors, rope path", type=str),
+        parameter("effects", "", "",
+                  "Effects to include, comma separated: " + ", ".join(BLOCK_TRAIN_EFFECTS.names),
+                  type=str),
+        parameter("solver", "ros2", "", "Internal solver: rk4, ros2, radau, bdf, lsoda, rk45, "
+                  "dop853", type=str),
+        parameter("solver_max_step", 1e-3, "s", "Largest internal step", min=0.0),
+        parameter("solver_rtol", 1e-6, "1", "Relative tolerance of adaptive solvers", min=0.0),
+        parameter("solver_atol", 1e-9, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        parameter("initial_equilibrium", True, "",
+                  "Start with every block hanging at rest where the reeving puts it", type=bool),
+        parameter("pretension", 1.0e3, "N",
+                  "Initial rope tension when not set by block equilibrium", min=0.0),
+    )
+    inputs = []
+    for port in LINE_PORTS:
+        inputs += [
+            input_(f"{port}.payout", 0.0, "m", f"Rope paid in through {port} since the start"),
+            input_(f"{port}.payout_rate", 0.0, "m/s", f"Rate of rope paid in through {port}"),
+        ]
+    for port in MOVER_PORTS:
+        inputs += [
+            input_(f"{port}.position", 0.0, "m", f"Displacement of driven body {port}"),
+            input_(f"{port}.velocity", 0.0, "m/s", f"Velocity of driven body {port}"),
+        ]
+    inputs.append(input_("break_segment", 0, "", "Break this rope segment (1-based) now; 0: none",
+                         type=int))
+    deps = _KINEMATIC_INPUTS
+    outputs = [output(f"{p}.tension", "N", f"Rope tension at line end {p}", depends_on=deps)
+               for p in LINE_PORTS]
+    outputs += [output(f"{p}.force", "N", f"Rope force on driven body {p} along its direction",
+                       depends_on=deps) for p in MOVER_PORTS]
+    for p in BLOCK_PORTS:
+        outputs += [
+            output(f"{p}.position", "m", f"Position of block {p} along its direction"),
+            output(f"{p}.velocity", "m/s", f"Velocity of block {p} along its direction"),
+        ]
+    outputs += [
+        output("tension_max", "N", "Largest rope tension in any span", depends_on=deps),
+        output("slack_spans", "", "Number of slack rope spans", type=int, depends_on=deps),
+        output("broken", "", "Whether any rope span has broken", type=bool),
+        output("stored_energy", "J", "Kinetic, strain, gravitational and contact energy",
+               depends_on=deps),
+        output("dissipated_energy", "J", "Energy dissipated since the start"),
+        output("external_work", "J", "Work done on the block train through its ports"),
+        output("energy_balance", "J",
+               "Ledger residual: stored change + dissipated - external work", depends_on=deps),
+        output("mode_changes", "", "Number of mode events so far (stick/slip, slack, break)",
+               type=int),
+    ]
+    return params + tuple(inputs) + tuple(outputs)
+
+
+class BlockTrainUnit(Unit):
+    """Rope reeved over sheaves on fixed and moving blocks (SPEC sections 2-6)."""
+
+    NAME = "BlockTrain"
+    DESCRIPTION = "Rope reeved over sheaves and anchors (block train), wire_fmu"
+    VARIABLES = _variables()
+
+    def __init__(self, instance_name: str = "block_train") -> None:
+        super().__init__(instance_name)
+        self.model: BlockTrainModel | None = None
+        self.initial_energy = 0.0
+
+    # ------------------------------------------------------------ life cycle
+    def configure(self) -> None:
+        """Parse reeving, effects and solver; build the model."""
+        v = self.values
+        problems: list[str] = []
+        effects, effect_problems = BLOCK_TRAIN_EFFECTS.parse(v["effects"])
+        problems += [f"parameter 'effects': {p}" for p in effect_problems]
+        settings = SolverSettings(
+            str(v["solver"]), float(v["solver_max_step"]), float(v["solver_rtol"]),
+            float(v["solver_atol"]),
+        )
+        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
+                     for p in settings.problems()]
+        if not (float(v["pretension"]) >= 0.0):
+            problems.append(f"parameter 'pretension' must be >= 0 N, got {v['pretension']}")
+        reeving = None
+        try:
+            data = json.loads(v["reeving"])
+        except (TypeError, ValueError) as err:
+            problems.append(f"parameter 'reeving' is not valid JSON: {err}")
+        else:
+            try:
+                reeving = parse_reeving(data)
+            except ConfigurationError as err:
+                problems += [f"parameter 'reeving': {p}" for p in err.problems]
+        if problems:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
+        try:
+            self.model = BlockTrainModel(reeving, effects, settings)
+        except ConfigurationError as err:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
+
+    def initialize(self, start_time: float) -> None:
+        """Rope stretched for equilibrium (or pretension); outputs filled."""
+        model = self._require_model()
+        try:
+            model.initialize(start_time, self._inputs(), equilibrium=bool(
+                self.values["initial_equilibrium"]), pretension=float(self.values["pretension"]))
+        except ConfigurationError as err:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
+        self.time = start_time
+        self.initial_energy = model.stored_energy(start_time)
+        self._update_outputs()
+
+    def advance(self, time: float, step: float) -> StepResult:
+        """Advance by ``step`` seconds with the inputs held."""
+        model = self._require_model()
+        saved = self.get_state()
+        inputs = self._inputs()
+        segment = int(self.values["break_segment"])
+        try:
+            if segment > 0:
+                if segment > model.n_segments:
+                    return StepResult(False, f"{self.instance_name}: break_segment {segment} "
+                                      f"does not exist (1..{model.n_segments})")
+                model.inputs, model._t_step = inputs, time
+                model.break_segment(segment - 1)
+            model.advance(time, step, inputs)
+        except (IntegrationError, FloatingPointError, ValueError) as err:
+            self.set_state(saved)
+            return StepResult(False, f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s: "
+                              f"step of {step:.3g} s refused: {err}")
+        self.time = time + step
+        self._update_outputs()
+        return StepResult(True, events=tuple(model.last_events))
+
+    # ---------------------------------------------------------------- state
+    def get_state(self) -> dict[str, Any]:
+        """Complete state: continuous state, modes, broken spans, offsets."""
+        m = self._require_model()
+        return {
+            "x": [float(c) for c in m.state],
+            "offsets": [float(c) for c in m.offsets],
+            "broken": list(m.broken),
+            "friction_mode": m.friction.get_mode(),
+            "mode_changes": m.mode_changes,
+            "time": float(getattr(self, "time", 0.0)),
+            "initial_energy": float(self.initial_energy),
+            "solver": {"rhs_calls": m.solver.rhs_calls, "steps": m.solver.steps},
+        }
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`."""
+        import numpy as np
+
+        m = self._require_model()
+        m.state = np.array(state["x"], dtype=float)
+        m.offsets = np.array(state["offsets"], dtype=float)
+        m.broken = list(state["broken"])
+        m.friction.set_mode(list(state["friction_mode"]))
+        m.mode_changes = int(state["mode_changes"])
+        m._held_positions = m.q.copy()
+        self.time = float(state["time"])
+        self.initial_energy = float(state["initial_energy"])
+        self._update_outputs()
+
+    # -------------------------------------------------------------- helpers
+    def _require_model(self) -> BlockTrainModel:
+        if self.model is None:
+            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
+        return self.model
+
+    def _inputs(self) -> BlockTrainInputs:
+        v = self.values
+        return BlockTrainInputs(
+            payout={p: float(v[f"{p}.payout"]) for p in LINE_PORTS},
+            payout_rate={p: float(v[f"{p}.payout_rate"]) for p in LINE_PORTS},
+            mover_position={p: float(v[f"{p}.position"]) for p in MOVER_PORTS},
+            mover_velocity={p: float(v[f"{p}.velocity"]) for p in MOVER_PORTS},
+        )
+
+    def _update_outputs(self) -> None:
+        m = self._require_model()
+        ev = m.evaluate(self.time, m.state)  # inputs as they evolved over the last step
+        out = self.values
+        tension = ev["tension"]
+        for k, _port in ((0, None), (m.n_nodes - 1, None)):
+            node = m.nodes[k]
+            if node.kind == "line_end":
+                span = 0 if k == 0 else len(m.spans) - 1
+                out[f"{node.name}.tension"] = float(tension[span])
+        nb = len(m.blocks)
+        for j, body in enumerate(m.drivers):
+            out[f"{body.port}.force"] = float(ev["body_force"][nb + j])
+        for j, body in enumerate(m.blocks):
+            if body.port:
+                out[f"{body.port}.position"] = float(body.position + m.q[j])
+                out[f"{body.port}.velocity"] = float(m.v[j])
+        out["tension_max"] = float(tension.max()) if tension.size else 0.0
+        out["slack_spans"] = int(sum(1 for i, s in enumerate(ev["stretch"])
+                                     if s <= 0.0 and not m.broken[i]))
+        out["broken"] = any(m.broken)
+        kinetic = 0.5 * float(m.masses @ m.v**2)
+        stored = kinetic + ev["rope_energy"] + ev["potential"]
+        n = m.n_coords
+        out["stored_energy"] = float(stored)
+        out["dissipated_energy"] = float(m.state[2 * n])
+        out["external_work"] = float(m.state[2 * n + 1])
+        out["energy_balance"] = float(stored - self.initial_energy + out["dissipated_energy"]
+                                 - out["external_work"])
+        out["mode_changes"] = int(m.mode_changes)
+        if not all(math.isfinite(out[k]) for k in ("stored_energy", "tension_max")):
+            raise FloatingPointError(f"{self.instance_name}: non-finite outputs")

@@ -1,0 +1,248 @@
+"""Dry friction that really sticks, for 1-D coordinates with lumped masses.
+
+Bearing friction of a sheave, rope slip on a groove, the band brake and
+cylinder seals are all *friction links* between a coordinate and the ground
+or between two coordinates. Each link is either *stuck* (no relative
+motion; the link carries whatever force holds it, up to its capacity) or
+*sliding* in a direction ``+1``/``-1`` (it carries its capacity against the
+motion). This is the Karnopp idea made exact with modes: while stuck, the
+relative velocity is not merely small, it is zero, and a stuck coordinate
+does not creep.
+
+The force a stuck link must carry is computed from the known net forces,
+which is what makes holding exact and breakaway happen exactly at capacity.
+Transitions are guards for :mod:`wire_fmu.core.hybrid`:
+
+* stuck link: ``capacity - |holding force|`` goes negative -> breakaway;
+* sliding link: ``direction * relative velocity`` goes negative -> the
+  motion stops; the link sticks if its capacity can hold, else it slides on
+  the other way.
+
+Sign convention: a link force is the force *on* ``body`` (its partner
+``other`` receives the opposite); relative velocity is
+``v[body] - v[other]`` (``other = -1`` is the ground).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["FrictionLink", "StickSlip"]
+
+GROUND = -1
+
+
+@dataclass(frozen=True)
+class FrictionLink:
+    """A dry-friction contact between coordinate ``body`` and ``other``.
+
+    Parameters
+    ----------
+    name : str
+        Human-readable name used in messages, e.g. ``"sheave 'crown_1' bearing"``.
+    body : int
+        Index of the coordinate the link force acts on.
+    other : int
+        Index of the partner coordinate, or -1 for the ground.
+    """
+
+    name: str
+    body: int
+    other: int = GROUND
+
+
+class StickSlip:
+    """Mode bookkeeping and accelerations for a set of friction links.
+
+    Parameters
+    ----------
+    masses : array_like, shape (n,)
+        Mass (or rotational inertia) of each coordinate, kg (kg m^2).
+    links : sequence of FrictionLink
+        The friction links; stuck links must never form a cycle.
+    """
+
+    def __init__(self, masses: np.ndarray, links: tuple[FrictionLink, ...]) -> None:
+        self.masses = np.asarray(masses, dtype=float)
+        self.links = tuple(links)
+        self.mode = np.zeros(len(self.links), dtype=int)  # all stuck at rest
+        self._plan = None
+
+    # -- state ---------------------------------------------------------------
+    def get_mode(self) -> list[int]:
+        """The modes as plain ints (0 stuck, +1/-1 sliding direction)."""
+        return [int(m) for m in self.mode]
+
+    def set_mode(self, mode: list[int]) -> None:
+        """Restore modes saved by :meth:`get_mode`."""
+        self.mode = np.array(mode, dtype=int)
+        self._plan = None
+
+    # -- dynamics --------------------------------------------------------------
+    def relative_velocity(self, v: np.ndarray, k: int) -> float:
+        """Relative velocity of link ``k``, m/s (or rad/s)."""
+        link = self.links[k]
+        rel = v[link.body]
+        if link.other != GROUND:
+            rel -= v[link.other]
+        return rel
+
+    def accelerations(
+        self, forces: np.ndarray, capacities: np.ndarray, mode: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Accelerations and link forces in the current mode.
+
+        Parameters
+        ----------
+        forces : ndarray, shape (n,)
+            All non-friction forces on each coordinate, N (or N m).
+        capacities : ndarray, shape (n_links,)
+            Friction capacity of each link (>= 0), N (or N m).
+
+        Returns
+        -------
+        acc : ndarray, shape (n,)
+            Accelerations, m/s^2 (or rad/s^2).
+        link_force : ndarray, shape (n_links,)
+            Force each link exerts on its ``body``: the holding force of a
+            stuck link, ``-direction * capacity`` of a sliding one.
+        """
+        mode = self.mode if mode is None else mode
+        total = np.array(forces, dtype=float)
+        link_force = np.zeros(len(self.links))
+        for k, link in enumerate(self.links):
+            if mode[k] != 0:
+                f = -mode[k] * capacities[k]
+                link_force[k] = f
+                total[link.body] += f
+                if link.other != GROUND:
+                    total[link.other] -= f
+        acc = total / self.masses
+        plan = self._plan_for(mode)
+        for members, grounded, edges in plan:
+            a = 0.0 if grounded else total[members].sum() / self.masses[members].sum()
+            acc[members] = a
+            required = {i: self.masses[i] * a - total[i] for i in members}
+            for k, child, parent in edges:  # leaves first
+                carried = required[child]
+                link_force[k] = carried if self.links[k].body == child else -carried
+                if parent != GROUND:
+                    required[parent] += carried
+        return acc, link_force
+
+    def loss_power(self, v: np.ndarray, capacities: np.ndarray) -> float:
+        """Power dissipated by the sliding links, W (>= 0)."""
+        total = 0.0
+        for k in range(len(self.links)):
+            if self.mode[k] != 0:
+                total += capacities[k] * abs(self.relative_velocity(v, k))
+        return total
+
+    def guards(self, v: np.ndarray, link_force: np.ndarray, capacities: np.ndarray) -> np.ndarray:
+        """Guard values per link (see module docstring); all >= 0 inside the mode."""
+        g = np.empty(len(self.links))
+        for k in range(len(self.links)):
+            if self.mode[k] == 0:
+                g[k] = capacities[k] - abs(link_force[k])
+            else:
+                g[k] = self.mode[k] * self.relative_velocity(v, k)
+        return g
+
+    def switch(
+        self,
+        v: np.ndarray,
+        forces: np.ndarray,
+        capacities: np.ndarray,
+        fired: list[int],
+    ) -> np.ndarray:
+        """Change the modes of the links in ``fired``; return projected velocities.
+
+        A sliding link whose motion stopped is set to zero relative velocity
+        (momentum conserving) and sticks if it can hold; a stuck link that
+        cannot hold starts sliding in the direction the net force drives it.
+        The modes of all links are then made consistent with each other.
+        """
+        v = np.array(v, dtype=float)
+        for k in fired:
+            if self.mode[k] != 0:
+                v = self._stop(v, k)
+                self.mode[k] = 0
+        self._plan = None
+        for _ in range(2 * len(self.links) + 1):
+            _, link_force = self.accelerations(forces, capacities)
+            over = [
+                k
+                for k in range(len(self.links))
+                if self.mode[k] == 0 and abs(link_force[k]) > capacities[k]
+            ]
+            if not over:
+                break
+            worst = max(over, key=lambda k: abs(link_force[k]) - capacities[k])
+            self.mode[worst] = -1 if link_force[worst] > 0 else 1
+            self._plan = None
+        return v
+
+    def _stop(self, v: np.ndarray, k: int) -> np.ndarray:
+        link = self.links[k]
+        if link.other == GROUND:
+            v[link.body] = 0.0
+        else:
+            m1, m2 = self.masses[link.body], self.masses[link.other]
+            common = (m1 * v[link.body] + m2 * v[link.other]) / (m1 + m2)
+            v[link.body] = v[link.other] = common
+        return v
+
+    def stuck_to_ground(self) -> np.ndarray:
+        """Indices of coordinates held by stuck links to the ground."""
+        held = []
+        for members, grounded, _ in self._plan_for(self.mode):
+            if grounded:
+                held.extend(members)
+        return np.array(sorted(held), dtype=int)
+
+    # -- structure of the stuck links -----------------------------------------
+    def _plan_for(self, mode: np.ndarray):
+        if self._plan is not None and mode is self.mode:
+            return self._plan
+        plan = _stuck_clusters(self.links, mode)
+        if mode is self.mode:
+            self._plan = plan
+        return plan
+
+
+def _stuck_clusters(links: tuple[FrictionLink, ...], mode: np.ndarray):
+    """Group coordinates joined by stuck links into trees.
+
+    Returns a list of ``(members, grounded, edges)``; ``edges`` lists
+    ``(link index, child, parent)`` from the leaves towards the root
+    (the ground when the cluster is grounded).
+    """
+    adjacency: dict[int, list[tuple[int, int]]] = {}
+    for k, link in enumerate(links):
+        if mode[k] == 0:
+            adjacency.setdefault(link.body, []).append((k, link.other))
+            adjacency.setdefault(link.other, []).append((k, link.body))
+    seen: set[int] = set()
+    clusters = []
+    roots = ([GROUND] if GROUND in adjacency else []) + sorted(n for n in adjacency if n != GROUND)
+    for root in roots:
+        if root in seen:
+            continue
+        order: list[tuple[int, int, int]] = []
+        stack = [(root, None)]
+        seen.add(root)
+        while stack:
+            node, via = stack.pop()
+            for k, nxt in adjacency.get(node, []):
+                if k == via:
+                    continue
+                if nxt in seen:
+                    raise ValueError("stuck friction links form a cycle")
+                seen.add(nxt)
+                order.append((k, nxt, node))
+                stack.append((nxt, k))
+        members = sorted({c for _, c, _ in order} | ({root} - {GROUND}))
+        clusters.append((np.array(members, dtype=int), root == GROUND, list(reversed(order))))
+    return clusters

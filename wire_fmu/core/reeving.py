@@ -1,0 +1,423 @@
+"""A reeving: bodies, sheaves, anchors and the ordered rope path over them.
+
+The description is plain data (JSON-compatible dicts), so a scene file or an
+FMU string parameter can carry it. :func:`parse_reeving` checks it whole and
+raises one :class:`~wire_fmu.core.errors.ConfigurationError` that lists
+every problem, each naming the element at fault.
+
+Format (all lengths m, masses kg, forces N, angles in degrees where named)::
+
+    {
+      "rope": {"axial_stiffness": 5.8e7, "damping": 1.2e5,
+               "breaking_load": 1.0e6, "linear_mass": 6.2},
+      "gravity": [0, -9.81, 0],
+      "bodies": {
+        "travelling_block": {"kind": "block", "mass": 2.2e5,
+                             "direction": [0, 1, 0], "position": 15.0,
+                             "port": "block_a",
+                             "floor": {"position": 2.0, "stiffness": 5e8,
+                                       "damping": 2e6}},
+        "rod": {"kind": "driven", "direction": [1, 0, 0], "port": "mover_a"}
+      },
+      "sheaves": {
+        "crown_0": {"body": "ground", "centre": [0, 45, 0], "radius": 0.76,
+                    "axis": [0, 0, 1], "inertia": 180.0,
+                    "bearing_torque": 0.0, "efficiency": 0.9615,
+                    "groove_friction": 0.1}
+      },
+      "anchors": {"deadline": {"body": "ground", "point": [9.9, 0, 0]}},
+      "path": [
+        {"line_end": "line_a", "point": [-0.76, 0, 0]},
+        {"sheave": "crown_0", "wrap": "cw"},
+        ...,
+        {"anchor": "deadline"}
+      ],
+      "max_fleet_angle_deg": 2.5
+    }
+
+Bodies move in translation only, each along its unit ``direction``; the
+``ground`` body always exists. A ``block`` has mass and is a state of the
+block train (its sheaves' translational mass is part of ``mass``); a
+``driven`` body's motion is an input at its port (``mover_a`` or
+``mover_b``) and the rope's force on it is an output. A rope end is either
+an anchor on a body or a *line end* (port ``line_a`` or ``line_b``) through
+which rope is paid out, e.g. by a winch. Centres and points are given at
+zero body displacement. Wrap ``ccw``/``cw`` is the sense in which the rope,
+followed along the path, goes round the sheave about its axis.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from .errors import ConfigurationError
+from .rope import RopeProperties
+
+__all__ = [
+    "Body",
+    "Floor",
+    "SheaveSpec",
+    "AnchorSpec",
+    "PathElement",
+    "Reeving",
+    "parse_reeving",
+    "LINE_PORTS",
+    "MOVER_PORTS",
+    "BLOCK_PORTS",
+]
+
+LINE_PORTS = ("line_a", "line_b")
+MOVER_PORTS = ("mover_a", "mover_b")
+BLOCK_PORTS = ("block_a", "block_b")
+_WRAPS = {"ccw": 1, "cw": -1}
+
+Vector = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Floor:
+    """A support a block lands on: it only pushes.
+
+    Parameters
+    ----------
+    position : float
+        Body coordinate (along its direction) at which contact begins, m.
+    stiffness : float
+        Contact stiffness, N/m.
+    damping : float
+        Contact damping, N s/m.
+    """
+
+    position: float
+    stiffness: float
+    damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body that carries sheaves or anchors (translation only)."""
+
+    name: str
+    kind: str  # "ground", "block" or "driven"
+    direction: Vector = (0.0, 1.0, 0.0)
+    mass: float = 0.0
+    position: float = 0.0
+    port: str | None = None
+    floor: Floor | None = None
+
+
+@dataclass(frozen=True)
+class SheaveSpec:
+    """A sheave on a body (a fork's axle is the body; several may share it)."""
+
+    name: str
+    body: str
+    centre: Vector
+    radius: float
+    axis: Vector = (0.0, 0.0, 1.0)
+    inertia: float = 0.0
+    bearing_torque: float = 0.0
+    efficiency: float = 1.0
+    groove_friction: float = 0.1
+
+
+@dataclass(frozen=True)
+class AnchorSpec:
+    """A rope end clamped to a body."""
+
+    name: str
+    body: str
+    point: Vector
+
+
+@dataclass(frozen=True)
+class PathElement:
+    """One node of the rope path.
+
+    ``kind`` is ``"sheave"``, ``"anchor"`` or ``"line_end"``; ``name`` is the
+    sheave or anchor name, or the port name of a line end; ``sense`` is +1
+    (ccw) or -1 (cw) for a sheave and 0 otherwise.
+    """
+
+    kind: str
+    name: str
+    sense: int = 0
+    point: Vector | None = None
+    body: str = "ground"
+
+
+@dataclass(frozen=True)
+class Reeving:
+    """A validated reeving."""
+
+    rope: RopeProperties
+    gravity: Vector
+    bodies: dict[str, Body]
+    sheaves: dict[str, SheaveSpec]
+    anchors: dict[str, AnchorSpec]
+    path: tuple[PathElement, ...]
+    max_fleet_angle: float = math.radians(2.5)
+    source: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def node_body(self, element: PathElement) -> str:
+        """The body a path node is fixed to."""
+        if element.kind == "sheave":
+            return self.sheaves[element.name].body
+        if element.kind == "anchor":
+            return self.anchors[element.name].body
+        return element.body
+
+    def bodies_of_kind(self, kind: str) -> list[Body]:
+        """Bodies of one kind, in declaration order."""
+        return [b for b in self.bodies.values() if b.kind == kind]
+
+
+class _Problems:
+    """Collects problems while parsing, each prefixed with where it is."""
+
+    def __init__(self) -> None:
+        self.items: list[str] = []
+
+    def add(self, where: str, text: str) -> None:
+        self.items.append(f"{where}: {text}")
+
+    def number(self, data: Mapping, key: str, where: str, default: Any = None, *,
+               positive: bool = False, nonnegative: bool = False,
+               at_most: float | None = None) -> float:
+        value = data.get(key, default)
+        if value is None:
+            self.add(where, f"'{key}' is required")
+            return math.nan
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            self.add(where, f"'{key}' must be a number, got {value!r}")
+            return math.nan
+        if math.isnan(value):
+            self.add(where, f"'{key}' must be a number, got NaN")
+        elif positive and not value > 0:
+            self.add(where, f"'{key}' must be > 0, got {value:g}")
+        elif nonnegative and value < 0:
+            self.add(where, f"'{key}' must be >= 0, got {value:g}")
+        elif at_most is not None and value > at_most:
+            self.add(where, f"'{key}' must be <= {at_most:g}, got {value:g}")
+        return value
+
+    def vector(self, data: Mapping, key: str, where: str, default: Any = None, *,
+               unit: bool = False) -> Vector:
+        value = data.get(key, default)
+        try:
+            vec = tuple(float(c) for c in value)
+            if len(vec) != 3 or not all(math.isfinite(c) for c in vec):
+                raise ValueError
+        except (TypeError, ValueError):
+            self.add(where, f"'{key}' must be three finite numbers [x, y, z] (m), got {value!r}")
+            return (math.nan, math.nan, math.nan)
+        if unit:
+            norm = math.sqrt(sum(c * c for c in vec))
+            if norm == 0.0:
+                self.add(where, f"'{key}' must not be the zero vector")
+                return vec
+            vec = tuple(c / norm for c in vec)
+        return vec
+
+
+def parse_reeving(data: Mapping[str, Any]) -> Reeving:
+    """Validate a reeving description and build a :class:`Reeving`.
+
+    Raises
+    ------
+    ConfigurationError
+        Listing every problem found, each naming the element at fault.
+    """
+    p = _Problems()
+    if not isinstance(data, Mapping):
+        raise ConfigurationError("reeving", [f"must be a mapping, got {type(data).__name__}"])
+    known = {"rope", "gravity", "bodies", "sheaves", "anchors", "path", "max_fleet_angle_deg",
+             "name", "description"}
+    for key in data:
+        if key not in known:
+            p.add("reeving", f"unknown key {key!r}; known keys: {', '.join(sorted(known))}")
+    rope = _parse_rope(data.get("rope", {}), p)
+    gravity = p.vector(data, "gravity", "reeving", (0.0, -9.81, 0.0))
+    bodies = _parse_bodies(data.get("bodies", {}), p)
+    sheaves = _parse_sheaves(data.get("sheaves", {}), bodies, p)
+    anchors = _parse_anchors(data.get("anchors", {}), bodies, p)
+    path = _parse_path(data.get("path", []), sheaves, anchors, bodies, p)
+    fleet = p.number(data, "max_fleet_angle_deg", "reeving", 2.5, positive=True, at_most=45.0)
+    _check_ports(bodies, path, p)
+    if p.items:
+        raise ConfigurationError("reeving", p.items)
+    return Reeving(rope, gravity, bodies, sheaves, anchors, path, math.radians(fleet), dict(data))
+
+
+def _parse_rope(data: Mapping, p: _Problems) -> RopeProperties:
+    where = "rope"
+    if not isinstance(data, Mapping):
+        p.add(where, "must be a mapping")
+        return RopeProperties(1.0)
+    if "axial_stiffness" in data:
+        ea = p.number(data, "axial_stiffness", where, positive=True)
+        damping = p.number(data, "damping", where, 0.0, nonnegative=True)
+    else:
+        area = p.number(data, "metallic_area", where, positive=True)
+        modulus = p.number(data, "modulus", where, positive=True)
+        fill = p.number(data, "fill_factor", where, 1.0, positive=True, at_most=1.0)
+        viscosity = p.number(data, "viscosity", where, 0.0, nonnegative=True)
+        ea, damping = area * fill * modulus, area * fill * viscosity
+    breaking = p.number(data, "breaking_load", where, math.inf, positive=True)
+    linear_mass = p.number(data, "linear_mass", where, 0.0, nonnegative=True)
+    return RopeProperties(ea, damping, breaking, linear_mass)
+
+
+def _parse_bodies(data: Mapping, p: _Problems) -> dict[str, Body]:
+    bodies = {"ground": Body("ground", "ground")}
+    if not isinstance(data, Mapping):
+        p.add("bodies", "must be a mapping of name -> body")
+        return bodies
+    for name, spec in data.items():
+        where = f"body {name!r}"
+        if name == "ground":
+            p.add(where, "'ground' is built in and cannot be redefined")
+            continue
+        kind = spec.get("kind") if isinstance(spec, Mapping) else None
+        if kind not in ("block", "driven"):
+            p.add(where, f"'kind' must be 'block' or 'driven', got {kind!r}")
+            continue
+        direction = p.vector(spec, "direction", where, (0.0, 1.0, 0.0), unit=True)
+        port = spec.get("port")
+        if kind == "block":
+            mass = p.number(spec, "mass", where, positive=True)
+            position = p.number(spec, "position", where, 0.0)
+            floor = _parse_floor(spec.get("floor"), where, p)
+            if port is not None and port not in BLOCK_PORTS:
+                p.add(where, f"'port' of a block must be one of {BLOCK_PORTS}, got {port!r}")
+            bodies[name] = Body(name, kind, direction, mass, position, port, floor)
+        else:
+            if port not in MOVER_PORTS:
+                p.add(where, f"'port' of a driven body must be one of {MOVER_PORTS}, got {port!r}")
+            bodies[name] = Body(name, kind, direction, 0.0, 0.0, port)
+    return bodies
+
+
+def _parse_floor(data: Any, where: str, p: _Problems) -> Floor | None:
+    if data is None:
+        return None
+    if not isinstance(data, Mapping):
+        p.add(where, "'floor' must be a mapping with position, stiffness, damping")
+        return None
+    where = f"{where} floor"
+    return Floor(
+        p.number(data, "position", where),
+        p.number(data, "stiffness", where, positive=True),
+        p.number(data, "damping", where, 0.0, nonnegative=True),
+    )
+
+
+def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, SheaveSpec]:
+    sheaves: dict[str, SheaveSpec] = {}
+    if not isinstance(data, Mapping):
+        p.add("sheaves", "must be a mapping of name -> sheave")
+        return sheaves
+    for name, spec in data.items():
+        where = f"sheave {name!r}"
+        if not isinstance(spec, Mapping):
+            p.add(where, "must be a mapping")
+            continue
+        body = spec.get("body", "ground")
+        if body not in bodies:
+            p.add(where, f"'body' {body!r} is not a body; bodies: {', '.join(bodies)}")
+        sheaves[name] = SheaveSpec(
+            name,
+            body,
+            p.vector(spec, "centre", where),
+            p.number(spec, "radius", where, positive=True),
+            p.vector(spec, "axis", where, (0.0, 0.0, 1.0), unit=True),
+            p.number(spec, "inertia", where, 0.0, nonnegative=True),
+            p.number(spec, "bearing_torque", where, 0.0, nonnegative=True),
+            _efficiency(spec, where, p),
+            p.number(spec, "groove_friction", where, 0.1, nonnegative=True),
+        )
+    return sheaves
+
+
+def _efficiency(spec: Mapping, where: str, p: _Problems) -> float:
+    value = p.number(spec, "efficiency", where, 1.0, positive=True, at_most=1.0)
+    return value
+
+
+def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, AnchorSpec]:
+    anchors: dict[str, AnchorSpec] = {}
+    if not isinstance(data, Mapping):
+        p.add("anchors", "must be a mapping of name -> anchor")
+        return anchors
+    for name, spec in data.items():
+        where = f"anchor {name!r}"
+        if not isinstance(spec, Mapping):
+            p.add(where, "must be a mapping")
+            continue
+        body = spec.get("body", "ground")
+        if body not in bodies:
+            p.add(where, f"'body' {body!r} is not a body; bodies: {', '.join(bodies)}")
+        anchors[name] = AnchorSpec(name, body, p.vector(spec, "point", where))
+    return anchors
+
+
+def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[PathElement, ...]:
+    if not isinstance(data, list | tuple) or len(data) < 2:
+        p.add("path", "must be a list of at least two nodes (two rope ends)")
+        return ()
+    out = []
+    last = len(data) - 1
+    for i, node in enumerate(data):
+        where = f"path node {i}"
+        if not isinstance(node, Mapping):
+            p.add(where, f"must be a mapping, got {node!r}")
+            continue
+        if "sheave" in node:
+            name = node["sheave"]
+            wrap = node.get("wrap")
+            if name not in sheaves:
+                p.add(where, f"sheave {name!r} is not defined; sheaves: {', '.join(sheaves)}")
+            if wrap not in _WRAPS:
+                p.add(where, f"sheave {name!r}: 'wrap' must be 'ccw' or 'cw', got {wrap!r}")
+            out.append(PathElement("sheave", str(name), _WRAPS.get(wrap, 1)))
+        elif "anchor" in node:
+            name = node["anchor"]
+            if name not in anchors:
+                p.add(where, f"anchor {name!r} is not defined; anchors: {', '.join(anchors)}")
+            if 0 < i < last:
+                p.add(where, f"anchor {name!r} must be at an end of the path")
+            out.append(PathElement("anchor", str(name)))
+        elif "line_end" in node:
+            port = node["line_end"]
+            body = node.get("body", "ground")
+            if port not in LINE_PORTS:
+                p.add(where, f"'line_end' must be one of {LINE_PORTS}, got {port!r}")
+            if 0 < i < last:
+                p.add(where, f"line end {port!r} must be at an end of the path")
+            if body not in bodies:
+                p.add(where, f"'body' {body!r} is not a body")
+            point = p.vector(node, "point", where)
+            out.append(PathElement("line_end", str(port), 0, point, body))
+        else:
+            p.add(where, "must name a 'sheave', an 'anchor' or a 'line_end'")
+    for end in (0, last):
+        if end < len(out) and out[end].kind == "sheave":
+            p.add(f"path node {end}", "a rope end must be an anchor or a line end, not a sheave")
+    return tuple(out)
+
+
+def _check_ports(bodies: dict[str, Body], path, p: _Problems) -> None:
+    used: dict[str, str] = {}
+    owners = [(b.port, f"body {b.name!r}") for b in bodies.values() if b.port]
+    owners += [(e.name, f"path line end {e.name!r}") for e in path if e.kind == "line_end"]
+    for port, owner in owners:
+        if port in used:
+            p.add("ports", f"port {port!r} is used by both {used[port]} and {owner}")
+        used[port] = owner
+    if not any(e.kind in ("anchor", "line_end") for e in path[:1] + path[-1:]):
+        return

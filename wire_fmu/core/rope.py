@@ -1,0 +1,162 @@
+"""Rope segments: Hooke and Kelvin-Voigt, variable unstretched length, slack.
+
+SPEC section 3 (paper 000, eq. 1-8). A segment (or a chain of segments
+joined over massless frictionless sheaves, which act as one spring) has
+geometric length ``L`` between its end points and unstretched length
+``l``, which changes as rope flows in or out through its ends (eq. 6).
+
+Constitutive law, with engineering strain ``eps = (L - l) / l``::
+
+    T = max(0, EA * eps + c * deps/dt)   if eps > 0      (eq. 3-5)
+    T = 0                                 otherwise      (a rope never pushes)
+
+``EA = A_w * E_w * k_f`` (eq. 4 with k = 1/EA) and ``c = eta * A_w * k_f``
+(eq. 5). The clamp at zero means damping can neither push nor pull a slack
+rope taut; a slack rope that is re-tensioned picks its load up again
+through the elastic term, which is what produces a snap load.
+
+Energy: the strain energy ``U = EA (L - l)^2 / (2 l)`` (for ``L > l``). Its
+partial derivatives give the generalised forces on everything the rope is
+attached to::
+
+    dU/dL = T_el                    dU/dl = -T_el (1 + eps/2)
+
+The second is larger than the tension by the strain energy carried by the
+rope that flows through an end (``EA eps^2 / 2`` per metre of unstretched
+rope). The damper's force follows from the dissipation function
+``D = c l deps^2 / 2``: generalised force ``-T_d (dL/dq - (1 + eps) dl/dq)``,
+loss power ``T_d l deps/dt`` (>= 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["RopeProperties", "RopeForces", "rope_forces", "snap_load"]
+
+
+@dataclass(frozen=True)
+class RopeProperties:
+    """Material and section of a wire rope.
+
+    Parameters
+    ----------
+    axial_stiffness : float
+        ``EA = A_w E_w k_f``, N (force per unit strain).
+    damping : float
+        Kelvin-Voigt coefficient ``c = eta A_w k_f``, N s (force per unit
+        strain rate); 0 for a pure Hooke rope.
+    breaking_load : float
+        Tension at which the rope breaks, N (``inf``: never).
+    linear_mass : float
+        Mass per metre, kg/m (used for rope on a sheave groove when the
+        rope may slip).
+    """
+
+    axial_stiffness: float
+    damping: float = 0.0
+    breaking_load: float = math.inf
+    linear_mass: float = 0.0
+
+    @classmethod
+    def from_section(
+        cls,
+        metallic_area: float,
+        modulus: float,
+        fill_factor: float = 1.0,
+        viscosity: float = 0.0,
+        breaking_load: float = math.inf,
+        linear_mass: float = 0.0,
+    ) -> RopeProperties:
+        """Build from the paper's parameters (eq. 4, 5).
+
+        Parameters
+        ----------
+        metallic_area : float
+            Cross-section ``A_w``, m^2.
+        modulus : float
+            Young's modulus of the rope ``E_w``, Pa.
+        fill_factor : float
+            ``k_f``, metal area over section area, 1.
+        viscosity : float
+            Kelvin-Voigt coefficient ``eta``, Pa s.
+        """
+        area = metallic_area * fill_factor
+        return cls(area * modulus, area * viscosity, breaking_load, linear_mass)
+
+
+@dataclass(frozen=True)
+class RopeForces:
+    """Forces of one rope spring at one instant.
+
+    Attributes
+    ----------
+    tension : float
+        Physical tension ``T`` (>= 0), N.
+    force_on_length : float
+        ``dU/dL`` plus damping: the generalised force conjugate to ``L``, N.
+    force_on_unstretched : float
+        Minus the generalised force conjugate to ``l``, N (see module doc).
+    energy : float
+        Strain energy, J.
+    loss_power : float
+        Power dissipated by the damper, W (>= 0).
+    """
+
+    tension: float
+    force_on_length: float
+    force_on_unstretched: float
+    energy: float
+    loss_power: float
+
+
+_SLACK = RopeForces(0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def rope_forces(
+    props: RopeProperties, length: float, unstretched: float, length_rate: float,
+    unstretched_rate: float,
+) -> RopeForces:
+    """Tension, generalised forces, energy and loss of one rope spring.
+
+    Parameters
+    ----------
+    props : RopeProperties
+        The rope.
+    length, unstretched : float
+        Geometric length ``L`` and unstretched length ``l``, m (``l > 0``).
+    length_rate, unstretched_rate : float
+        Their time derivatives, m/s.
+    """
+    stretch = length - unstretched
+    if stretch <= 0.0:
+        return _SLACK
+    ea = props.axial_stiffness
+    eps = stretch / unstretched
+    t_el = ea * eps
+    energy = 0.5 * t_el * stretch
+    if props.damping == 0.0:
+        return RopeForces(t_el, t_el, t_el * (1.0 + 0.5 * eps), energy, 0.0)
+    eps_rate = (length_rate - (1.0 + eps) * unstretched_rate) / unstretched
+    t_d = props.damping * eps_rate
+    if t_el + t_d < 0.0:  # the damper may not push: clamp the total at zero
+        t_d = -t_el
+    loss = t_d * unstretched * eps_rate
+    return RopeForces(
+        t_el + t_d,
+        t_el + t_d,
+        t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps),
+        energy,
+        loss,
+    )
+
+
+def snap_load(mass: float, stiffness: float, speed: float, gravity: float = 9.81) -> float:
+    """Peak tension when a mass falling at ``speed`` engages a slack rope.
+
+    Closed form ``T_max = m g (1 + sqrt(1 + k v0^2 / (m g^2)))`` (SPEC section 17)
+    for a linear spring of stiffness ``k`` (N/m) engaged at zero stretch.
+    """
+    weight = mass * gravity
+    return weight * (1.0 + math.sqrt(1.0 + stiffness * speed**2 / (mass * gravity**2)))
