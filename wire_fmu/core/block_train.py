@@ -43,7 +43,7 @@ from .errors import ConfigurationError
 from .friction import GROUND, FrictionLink, StickSlip
 from .geometry import Circle, PathNode, path_geometry
 from .hybrid import SolverSettings, make_solver
-from .reeving import Reeving
+from .reeving import LINE_PORTS, Reeving
 from .rope import rope_forces
 
 __all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
@@ -137,13 +137,14 @@ class BlockTrainModel:
         self._build_spans()
         self._build_geometry()
         self._build_friction()
+        self._build_flow_map()
+        self._floored = [j for j, b in enumerate(self.blocks) if b.floor is not None]
         self._guard_dirs = self._guard_directions()
         self.solver = make_solver(solver)
         self.broken = [False] * len(self.spans)
         self.offsets = np.zeros(len(self.spans))  # l_span(0) - s(start) + s(end)
         self.state = np.zeros(2 * self.n_coords + 2)
-        self.inputs = BlockTrainInputs({}, {}, {}, {})
-        self._t_step = 0.0
+        self.set_inputs(0.0, BlockTrainInputs({}, {}, {}, {}))
         self.mode_changes = 0
         self.last_events: list[str] = []
         self._held_positions = np.zeros(self.n_coords)
@@ -304,6 +305,19 @@ class BlockTrainModel:
                 self._bearing_c[i] = (1.0 - s.efficiency) / (1.0 + s.efficiency)
             else:
                 self._capstan[i] = math.expm1(s.groove_friction * self.wrap_angles[k])
+        self._link_span_in = np.array([self.span_of_segment[k - 1] for _, k in self.link_kind],
+                                      dtype=int)
+        self._link_span_out = np.array([self.span_of_segment[k] for _, k in self.link_kind],
+                                       dtype=int)
+
+    @property
+    def broken(self) -> list[bool]:
+        """Whether each rope span has broken."""
+        return [bool(b) for b in self.broken_mask]
+
+    @broken.setter
+    def broken(self, value: list[bool]) -> None:
+        self.broken_mask = np.array(value, dtype=bool)
 
     # ---------------------------------------------------------- state layout
     @property
@@ -317,37 +331,38 @@ class BlockTrainModel:
         return self.state[self.n_coords : 2 * self.n_coords]
 
     # ------------------------------------------------------------ kinematics
-    def _inputs_at(self, t: float):
-        dt = t - self._t_step
-        inp = self.inputs
-        pay = {p: inp.payout.get(p, 0.0) + inp.payout_rate.get(p, 0.0) * dt for p in inp.payout}
-        mov = {
-            p: inp.mover_position.get(p, 0.0) + inp.mover_velocity.get(p, 0.0) * dt
-            for p in inp.mover_position
-        }
-        return pay, mov
+    def _build_flow_map(self) -> None:
+        """Unstretched span lengths as ``l = offsets + B @ [q, s_line_a, s_line_b]``."""
+        n = self.n_coords
+        flow = np.zeros((len(self.spans), n + len(LINE_PORTS)))
+        self.line_sign = np.zeros(len(LINE_PORTS))
+        for k in (0, self.n_nodes - 1):
+            node = self.nodes[k]
+            if node.kind == "line_end":
+                self.line_sign[LINE_PORTS.index(node.name)] = 1.0 if k == 0 else -1.0
+        for i, sp in enumerate(self.spans):
+            for node, sign in ((sp.start_node, 1.0), (sp.end_node, -1.0)):
+                if node in self.rope_index:
+                    flow[i, self.rope_index[node]] += sign
+                elif self.nodes[node].kind == "line_end":
+                    flow[i, n + LINE_PORTS.index(self.nodes[node].name)] += sign
+        self.flow_matrix = flow
+        self.driver_ports = [b.port for b in self.drivers]
+        self.block_weight = np.array([
+            b.mass * float(np.array(self.reeving.gravity) @ np.array(b.direction))
+            for b in self.blocks
+        ])
 
-    def _node_flow(self, k: int, q, v, pay, rate):
-        """Rope coordinate s_k and its rate at node k."""
-        node = self.nodes[k]
-        if k in self.rope_index:
-            i = self.rope_index[k]
-            return q[i], v[i]
-        if node.kind == "line_end":
-            sign = 1.0 if k == 0 else -1.0
-            return sign * pay.get(node.name, 0.0), sign * rate.get(node.name, 0.0)
-        return 0.0, 0.0
-
-    def _body_motion(self, q, v, mov):
-        """Displacement and velocity of every body degree of freedom."""
-        y = np.zeros(len(self.body_dof))
-        ydot = np.zeros(len(self.body_dof))
-        nb = len(self.blocks)
-        y[:nb], ydot[:nb] = q[:nb], v[:nb]
-        for j, body in enumerate(self.drivers):
-            y[nb + j] = mov.get(body.port, 0.0)
-            ydot[nb + j] = self.inputs.mover_velocity.get(body.port, 0.0)
-        return y, ydot
+    def set_inputs(self, t: float, inputs: BlockTrainInputs) -> None:
+        """Hold ``inputs`` from time ``t`` on (positions advance with their rates)."""
+        self.inputs = inputs
+        self._t_step = t
+        self._line_s0 = self.line_sign * np.array([inputs.payout.get(p, 0.0) for p in LINE_PORTS])
+        self._line_rate = self.line_sign * np.array(
+            [inputs.payout_rate.get(p, 0.0) for p in LINE_PORTS]
+        )
+        self._mover_y0 = np.array([inputs.mover_position.get(p, 0.0) for p in self.driver_ports])
+        self._mover_v = np.array([inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports])
 
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Geometric span lengths (m) and their Jacobian w.r.t. body motion."""
@@ -367,58 +382,43 @@ class BlockTrainModel:
     # -------------------------------------------------------------- physics
     def evaluate(self, t: float, x: np.ndarray) -> dict:
         """Everything the model knows at (t, x): forces, tensions, energies."""
-        n = self.n_coords
+        n, nb = self.n_coords, len(self.blocks)
         q, v = x[:n], x[n : 2 * n]
-        pay, mov = self._inputs_at(t)
-        rate = self.inputs.payout_rate
-        y, ydot = self._body_motion(q, v, mov)
+        dt = t - self._t_step
+        y = np.concatenate((q[:nb], self._mover_y0 + self._mover_v * dt))
+        ydot = np.concatenate((v[:nb], self._mover_v))
         big_l, dl_dy = self.span_lengths(y)
-        big_l_rate = dl_dy @ ydot
-        forces = np.zeros(n)
-        body_force = np.zeros(len(self.body_dof))
-        tension = np.zeros(len(self.spans))
-        stretch = np.zeros(len(self.spans))
-        g_l = np.zeros(len(self.spans))
-        span_energy = np.zeros(len(self.spans))
-        loss = 0.0
-        for i, sp in enumerate(self.spans):
-            s0, s0dot = self._node_flow(sp.start_node, q, v, pay, rate)
-            s1, s1dot = self._node_flow(sp.end_node, q, v, pay, rate)
-            small_l = self.offsets[i] + s0 - s1
-            stretch[i] = big_l[i] - small_l
-            if self.broken[i]:
-                continue
-            if small_l <= 0.0:
-                raise FloatingPointError(f"rope span {i} has no unstretched rope left")
-            rf = rope_forces(self.rope, big_l[i], small_l, big_l_rate[i], s0dot - s1dot)
-            tension[i] = rf.tension
-            g_l[i] = rf.force_on_unstretched
-            span_energy[i] = rf.energy
-            loss += rf.loss_power
-            body_force -= rf.force_on_length * dl_dy[i]
-            if sp.start_node in self.rope_index:
-                forces[self.rope_index[sp.start_node]] += rf.force_on_unstretched
-            if sp.end_node in self.rope_index:
-                forces[self.rope_index[sp.end_node]] -= rf.force_on_unstretched
-        nb = len(self.blocks)
-        gravity = np.array(self.reeving.gravity)
-        potential = 0.0
+        flow = np.concatenate((q, self._line_s0 + self._line_rate * dt))
+        flow_rate = np.concatenate((v, self._line_rate))
+        small_l = self.offsets + self.flow_matrix @ flow
+        if np.any(small_l <= 0.0):
+            i = int(np.argmin(small_l))
+            raise FloatingPointError(f"rope span {i} has no unstretched rope left")
+        rf = rope_forces(self.rope, big_l, small_l, dl_dy @ ydot, self.flow_matrix @ flow_rate)
+        intact = ~self.broken_mask
+        tension = rf.tension * intact
+        g_big = rf.force_on_length * intact
+        g_small = rf.force_on_unstretched * intact
+        span_energy = rf.energy * intact
+        body_force = -(g_big @ dl_dy)
+        generalised = g_small @ self.flow_matrix  # on [q, s_line_a, s_line_b]
+        forces = generalised[:n].copy()
+        forces[:nb] += body_force[:nb] + self.block_weight
+        potential = -float(self.block_weight @ q[:nb])
+        loss = float(rf.loss_power @ intact)
         contact = np.zeros(nb)
-        for j, block in enumerate(self.blocks):
-            weight = block.mass * float(gravity @ np.array(block.direction))
-            forces[j] += body_force[j] + weight
-            potential -= weight * q[j]
-            if block.floor is not None:
-                f, e, p_loss = _floor_contact(block.floor, block.position + q[j], v[j])
-                forces[j] += f
-                contact[j] = f
-                potential += e
-                loss += p_loss
+        for j in self._floored:
+            block = self.blocks[j]
+            f, e, p_loss = _floor_contact(block.floor, block.position + q[j], v[j])
+            forces[j] += f
+            contact[j] = f
+            potential += e
+            loss += p_loss
         return {
             "forces": forces,
             "tension": tension,
-            "stretch": stretch,
-            "force_on_unstretched": g_l,
+            "stretch": big_l - small_l,
+            "line_force": generalised[n:],
             "body_force": body_force,
             "contact": contact,
             "rope_energy": float(span_energy.sum()),
@@ -430,29 +430,15 @@ class BlockTrainModel:
         }
 
     def _capacities(self, tension: np.ndarray) -> np.ndarray:
-        caps = np.zeros(len(self.link_kind))
-        for i, (kind, k) in enumerate(self.link_kind):
-            t_in = tension[self.span_of_segment[k - 1]]
-            t_out = tension[self.span_of_segment[k]]
-            if kind == "bearing":
-                caps[i] = self._bearing_m0[i] + self._bearing_c[i] * (t_in + t_out)
-            else:
-                caps[i] = self._capstan[i] * min(t_in, t_out)
-        return caps
+        t_in, t_out = tension[self._link_span_in], tension[self._link_span_out]
+        return (self._bearing_m0 + self._bearing_c * (t_in + t_out)
+                + self._capstan * np.minimum(t_in, t_out))
 
     def _external_power(self, ev: dict) -> float:
         """Power delivered into the block train through its ports, W."""
-        power = 0.0
-        rate = self.inputs.payout_rate
-        for k in (0, self.n_nodes - 1):
-            node = self.nodes[k]
-            if node.kind != "line_end":
-                continue
-            span = 0 if k == 0 else len(self.spans) - 1
-            power -= ev["force_on_unstretched"][span] * rate.get(node.name, 0.0)
         nb = len(self.blocks)
-        for j in range(len(self.drivers)):
-            power -= ev["body_force"][nb + j] * ev["ydot"][nb + j]
+        power = -float(ev["line_force"] @ self._line_rate)
+        power -= float(ev["body_force"][nb:] @ ev["ydot"][nb:])
         return power
 
     # ------------------------------------------------ HybridSystem protocol
@@ -548,7 +534,7 @@ class BlockTrainModel:
         if self.broken[i]:
             return
         released = self.evaluate(t, x)["span_energy"][i]
-        self.broken[i] = True
+        self.broken_mask[i] = True
         x[2 * self.n_coords] += released  # the strain energy is released and lost
         self.last_events.append(f"rope span {i} broke")
 
@@ -576,21 +562,18 @@ class BlockTrainModel:
         ConfigurationError
             If no single rope tension holds every block at rest.
         """
-        self.inputs, self._t_step = inputs, t0
+        self.set_inputs(t0, inputs)
         self.state = np.zeros(2 * self.n_coords + 2)
         self.broken = [False] * len(self.spans)
-        pay, mov = self._inputs_at(t0)
-        y, _ = self._body_motion(self.q, self.v, mov)
+        nb = len(self.blocks)
+        y = np.concatenate((np.zeros(nb), self._mover_y0))
         big_l, dl_dy = self.span_lengths(y)
         tension = pretension
         if equilibrium and self.blocks:
             tension = self._equilibrium_tension(dl_dy)
         ea = self.rope.axial_stiffness
-        rate = inputs.payout_rate
-        for i, sp in enumerate(self.spans):
-            s0, _ = self._node_flow(sp.start_node, self.q, self.v, pay, rate)
-            s1, _ = self._node_flow(sp.end_node, self.q, self.v, pay, rate)
-            self.offsets[i] = big_l[i] * ea / (ea + tension) - s0 + s1
+        flow = np.concatenate((self.q, self._line_s0))
+        self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
         self.friction.set_mode([0] * len(self.friction.links))
         self.state = self._settle_modes(t0, self.state, [])
         return tension
@@ -626,8 +609,7 @@ class BlockTrainModel:
     # -------------------------------------------------------------- stepping
     def advance(self, t: float, h: float, inputs: BlockTrainInputs) -> int:
         """Advance the state from ``t`` by ``h`` with ``inputs`` held; return events."""
-        self.inputs = inputs
-        self._t_step = t
+        self.set_inputs(t, inputs)
         self.last_events = []
         self.state = self._settle_modes(t, self.state)  # new inputs may break a stuck link
         x, events = self.solver.advance(self, t, self.state, t + h)

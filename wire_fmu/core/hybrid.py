@@ -152,11 +152,14 @@ class _FixedStepSolver:
         directions = system.guard_directions()
         grid = [t0 + (t1 - t0) * i / n for i in range(n + 1)]
         k = 0
+        g0 = system.guards(t, x)
         while k < n:
             t_next = grid[k + 1]
-            x_next, fired_at = self._step_with_events(system, t, x, t_next - t, directions)
+            x_next, g1, fired_at = self._step_with_events(
+                system, t, x, t_next - t, directions, g0
+            )
             if fired_at is None:
-                t, x = t_next, x_next
+                t, x, g0 = t_next, x_next, g1
                 k += 1
                 continue
             t_event, fired = fired_at
@@ -170,6 +173,7 @@ class _FixedStepSolver:
             if t >= t_next - self.settings.event_time_tolerance:
                 t = t_next
                 k += 1
+            g0 = system.guards(t, x)
         return x, events
 
     def _checked_step(self, system, t, x, h):
@@ -179,17 +183,21 @@ class _FixedStepSolver:
             raise IntegrationError(f"non-finite state after a step of {h:.3g} s at t = {t:.6g} s")
         return x1
 
-    def _step_with_events(self, system, t, x, h, directions):
-        """One step; if a guard fires inside it, stop just after the first crossing."""
-        g0 = system.guards(t, x)
+    def _step_with_events(self, system, t, x, h, directions, g0):
+        """One step; if a guard fires inside it, stop just after the first crossing.
+
+        Returns the new state, the guards there and ``None``, or the state
+        just after the first crossing, ``None`` and ``(time, fired guards)``.
+        """
         x1 = self._checked_step(system, t, x, h)
         if g0.size == 0:
-            return x1, None
+            return x1, g0, None
         g1 = system.guards(t + h, x1)
         mask = _fired(g0, g1, directions)
         if not mask.any():
-            return x1, None
-        return self._locate(system, t, x, h, g0, directions, x1, mask)
+            return x1, g1, None
+        x_event, fired_at = self._locate(system, t, x, h, g0, directions, x1, mask)
+        return x_event, None, fired_at
 
     def _locate(self, system, t, x, h, g0, directions, x1, mask):
         """Illinois regula falsi on the step fraction, for the earliest crossing."""

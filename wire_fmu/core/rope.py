@@ -33,6 +33,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = ["RopeProperties", "RopeForces", "rope_forces", "snap_load"]
 
 
@@ -88,68 +90,63 @@ class RopeProperties:
 
 @dataclass(frozen=True)
 class RopeForces:
-    """Forces of one rope spring at one instant.
+    """Forces of rope springs at one instant (arrays: one entry per spring).
 
     Attributes
     ----------
-    tension : float
+    tension : ndarray
         Physical tension ``T`` (>= 0), N.
-    force_on_length : float
+    force_on_length : ndarray
         ``dU/dL`` plus damping: the generalised force conjugate to ``L``, N.
-    force_on_unstretched : float
+    force_on_unstretched : ndarray
         Minus the generalised force conjugate to ``l``, N (see module doc).
-    energy : float
+    energy : ndarray
         Strain energy, J.
-    loss_power : float
+    loss_power : ndarray
         Power dissipated by the damper, W (>= 0).
     """
 
-    tension: float
-    force_on_length: float
-    force_on_unstretched: float
-    energy: float
-    loss_power: float
-
-
-_SLACK = RopeForces(0.0, 0.0, 0.0, 0.0, 0.0)
+    tension: np.ndarray
+    force_on_length: np.ndarray
+    force_on_unstretched: np.ndarray
+    energy: np.ndarray
+    loss_power: np.ndarray
 
 
 def rope_forces(
-    props: RopeProperties, length: float, unstretched: float, length_rate: float,
-    unstretched_rate: float,
+    props: RopeProperties,
+    length: np.ndarray,
+    unstretched: np.ndarray,
+    length_rate: np.ndarray,
+    unstretched_rate: np.ndarray,
 ) -> RopeForces:
-    """Tension, generalised forces, energy and loss of one rope spring.
+    """Tension, generalised forces, energy and loss of rope springs.
 
     Parameters
     ----------
     props : RopeProperties
         The rope.
-    length, unstretched : float
-        Geometric length ``L`` and unstretched length ``l``, m (``l > 0``).
-    length_rate, unstretched_rate : float
+    length, unstretched : array_like
+        Geometric length ``L`` and unstretched length ``l`` of each spring,
+        m (``l > 0``).
+    length_rate, unstretched_rate : array_like
         Their time derivatives, m/s.
     """
-    stretch = length - unstretched
-    if stretch <= 0.0:
-        return _SLACK
-    ea = props.axial_stiffness
-    eps = stretch / unstretched
-    t_el = ea * eps
-    energy = 0.5 * t_el * stretch
+    big_l = np.asarray(length, dtype=float)
+    small_l = np.asarray(unstretched, dtype=float)
+    stretch = big_l - small_l
+    taut = stretch > 0.0
+    eps = np.where(taut, stretch / small_l, 0.0)
+    t_el = props.axial_stiffness * eps
+    energy = 0.5 * t_el * np.maximum(stretch, 0.0)
     if props.damping == 0.0:
-        return RopeForces(t_el, t_el, t_el * (1.0 + 0.5 * eps), energy, 0.0)
-    eps_rate = (length_rate - (1.0 + eps) * unstretched_rate) / unstretched
-    t_d = props.damping * eps_rate
-    if t_el + t_d < 0.0:  # the damper may not push: clamp the total at zero
-        t_d = -t_el
-    loss = t_d * unstretched * eps_rate
-    return RopeForces(
-        t_el + t_d,
-        t_el + t_d,
-        t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps),
-        energy,
-        loss,
-    )
+        return RopeForces(t_el, t_el, t_el * (1.0 + 0.5 * eps), energy, np.zeros_like(t_el))
+    eps_rate = (np.asarray(length_rate) - (1.0 + eps) * np.asarray(unstretched_rate)) / small_l
+    t_d = np.where(taut, props.damping * eps_rate, 0.0)
+    t_d = np.maximum(t_d, -t_el)  # the damper may not push: clamp the total at zero
+    loss = t_d * small_l * eps_rate
+    total = t_el + t_d
+    return RopeForces(total, total, t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps), energy, loss)
 
 
 def snap_load(mass: float, stiffness: float, speed: float, gravity: float = 9.81) -> float:
