@@ -260,3 +260,14 @@ class TestBadInput:
             unit.configure()
         assert "not valid JSON" in str(info.value) and "solver 'euler' is unknown" in str(
             info.value)
+
+
+def test_energy_ledger_books_work_done_by_position_jumps():
+    """A master that sets positions without rates still gets a closed ledger."""
+    unit = make_unit(single_fall(damping=2e4), "rope_damping", solver="rk4", solver_max_step=1e-3)
+    for i in range(100):
+        unit.values["line_a.payout"] = 0.01 * math.sin(0.3 * i)  # jumps, rate left at 0
+        assert unit.advance(i * 1e-2, 1e-2).success
+    v = unit.values
+    assert abs(v["external_work"]) > 10.0
+    assert abs(v["energy_balance"]) < 1e-5 * abs(v["external_work"])

@@ -44,7 +44,7 @@ from .friction import GROUND, FrictionLink, StickSlip
 from .geometry import Circle, PathNode, path_geometry
 from .hybrid import SolverSettings, make_solver
 from .reeving import LINE_PORTS, Reeving
-from .rope import rope_forces
+from .rope import rope_forces, slack_guard, taut_guard
 
 __all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
 
@@ -148,6 +148,8 @@ class BlockTrainModel:
         self.mode_changes = 0
         self.last_events: list[str] = []
         self._held_positions = np.zeros(self.n_coords)
+        self.taut_mask = np.ones(len(self.spans), dtype=bool)
+        self.contact_mask = np.zeros(len(self.blocks), dtype=bool)
 
     # ------------------------------------------------------------------ build
     def _build_nodes(self) -> None:
@@ -394,8 +396,9 @@ class BlockTrainModel:
         if np.any(small_l <= 0.0):
             i = int(np.argmin(small_l))
             raise FloatingPointError(f"rope span {i} has no unstretched rope left")
-        rf = rope_forces(self.rope, big_l, small_l, dl_dy @ ydot, self.flow_matrix @ flow_rate)
         intact = ~self.broken_mask
+        rf = rope_forces(self.rope, big_l, small_l, dl_dy @ ydot, self.flow_matrix @ flow_rate,
+                         self.taut_mask & intact)
         tension = rf.tension * intact
         g_big = rf.force_on_length * intact
         g_small = rf.force_on_unstretched * intact
@@ -407,18 +410,29 @@ class BlockTrainModel:
         potential = -float(self.block_weight @ q[:nb])
         loss = float(rf.loss_power @ intact)
         contact = np.zeros(nb)
+        trial_contact = np.zeros(nb)
+        depth = np.zeros(nb)
         for j in self._floored:
             block = self.blocks[j]
-            f, e, p_loss = _floor_contact(block.floor, block.position + q[j], v[j])
-            forces[j] += f
-            contact[j] = f
-            potential += e
-            loss += p_loss
+            depth[j], trial_contact[j], e, p_loss = _floor_contact(
+                block.floor, block.position + q[j], v[j]
+            )
+            if self.contact_mask[j]:
+                contact[j] = trial_contact[j]
+                forces[j] += contact[j]
+                potential += e
+                loss += p_loss
+            elif depth[j] > 0.0:  # lifting off faster than the pad recovers: it drains
+                potential += e
+                loss += block.floor.stiffness * depth[j] * v[j]
         return {
             "forces": forces,
             "tension": tension,
             "stretch": big_l - small_l,
             "line_force": generalised[n:],
+            "rope": rf,
+            "depth": depth,
+            "trial_contact": trial_contact,
             "body_force": body_force,
             "contact": contact,
             "rope_energy": float(span_energy.sum()),
@@ -474,23 +488,28 @@ class BlockTrainModel:
         return self._guard_dirs
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Friction links, slack kinks, floor contact and rope break."""
+        """Friction links, slack/taut ropes, floor contact, rope break (all fire below 0)."""
         n = self.n_coords
         ev = self.evaluate(t, x)
         caps = self._capacities(ev["tension"])
         _, link_force = self.friction.accelerations(ev["forces"], caps)
         g_links = self.friction.guards(x[n : 2 * n], link_force, caps)
-        floor = np.array([
-            (b.position + x[j] - b.floor.position) if b.floor else 1.0
-            for j, b in enumerate(self.blocks)
-        ])
-        slack = np.where(self.broken, 1.0, ev["stretch"])
+        rf = ev["rope"]
+        g_rope = np.where(self.taut_mask, taut_guard(rf), slack_guard(rf))
+        g_rope = np.where(self.broken_mask, 1.0, g_rope)
+        stiffness = np.array([b.floor.stiffness if b.floor else 0.0 for b in self.blocks])
+        g_floor = np.where(
+            self.contact_mask,
+            ev["trial_contact"],
+            np.maximum(-stiffness * ev["depth"], -ev["trial_contact"]),
+        )
+        g_floor = np.where(stiffness > 0.0, g_floor, 1.0)
         breaking = self.rope.breaking_load - ev["tension"]
         breaking = np.where(np.isfinite(breaking), breaking, 1.0)
-        return np.concatenate([g_links, slack, floor, breaking])
+        return np.concatenate([g_links, g_rope, g_floor, breaking])
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Switch friction modes, break ropes, note kinks."""
+        """Switch friction, slack/taut and contact modes; break ropes."""
         n_links = len(self.friction.links)
         n_spans = len(self.spans)
         x = np.array(x, dtype=float)
@@ -500,14 +519,33 @@ class BlockTrainModel:
             if i >= first_break:
                 self._break_span(i - first_break, x, t)
             elif i >= n_links + n_spans:
-                block = self.blocks[i - n_links - n_spans]
-                self.last_events.append(f"floor contact of {block.name}")
+                j = i - n_links - n_spans
+                self.contact_mask[j] = not self.contact_mask[j]
+                what = "lands on" if self.contact_mask[j] else "lifts off"
+                self.last_events.append(f"block {self.blocks[j].name!r} {what} its floor")
             elif i >= n_links:
-                self.last_events.append(f"rope span {i - n_links} slack/taut")
-        if link_fired or any(i >= first_break for i in fired):
-            x = self._settle_modes(t, x, link_fired)
+                k = i - n_links
+                self.taut_mask[k] = not self.taut_mask[k]
+                what = "taut" if self.taut_mask[k] else "slack"
+                self.last_events.append(f"rope span {k} {what}")
+        x = self._settle_modes(t, x, link_fired)
         self.mode_changes += 1
         return self.project(x)
+
+    def _settle_contact_modes(self, t: float, x: np.ndarray) -> bool:
+        """After inputs jump: make slack/taut and floor modes fit (t, x); True if any changed."""
+        changed = False
+        for _ in range(len(self.spans) + len(self.blocks) + 1):
+            g = self.guards(t, x)
+            n_links = len(self.friction.links)
+            g_modes = g[n_links : n_links + len(self.spans) + len(self.blocks)]
+            wrong = np.flatnonzero(g_modes < 0.0)
+            if wrong.size == 0:
+                break
+            self.handle_events(t, x, [int(i) + n_links for i in wrong[:1]])
+            self.mode_changes -= 1  # counted once by the caller
+            changed = True
+        return changed
 
     def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
         """Make the friction modes consistent with the forces at (t, x)."""
@@ -574,6 +612,11 @@ class BlockTrainModel:
         ea = self.rope.axial_stiffness
         flow = np.concatenate((self.q, self._line_s0))
         self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
+        self.taut_mask = np.full(len(self.spans), tension > 0.0)
+        self.contact_mask = np.array([
+            b.floor is not None and b.position < b.floor.position
+            for b in self.blocks
+        ], dtype=bool)
         self.friction.set_mode([0] * len(self.friction.links))
         self.state = self._settle_modes(t0, self.state, [])
         return tension
@@ -607,18 +650,51 @@ class BlockTrainModel:
         return tensions[0]
 
     # -------------------------------------------------------------- stepping
-    def advance(self, t: float, h: float, inputs: BlockTrainInputs) -> int:
-        """Advance the state from ``t`` by ``h`` with ``inputs`` held; return events."""
-        self.set_inputs(t, inputs)
+    def advance(
+        self, t: float, h: float, inputs: BlockTrainInputs, break_segment: int | None = None
+    ) -> int:
+        """Advance the state from ``t`` by ``h`` with ``inputs`` held; return events.
+
+        ``break_segment`` (0-based), if given, breaks that segment's span at ``t``.
+        """
         self.last_events = []
+        before = self._input_energy(t)
+        self.set_inputs(t, inputs)
+        changed = self._settle_contact_modes(t, self.state)
+        # a jump of a position input does work on the rope at once: book it
+        self.state[2 * self.n_coords + 1] += self._input_energy(t) - before
+        self.mode_changes += int(changed)
+        if break_segment is not None:
+            self._break_span(self.span_of_segment[break_segment], self.state, t)
         self.state = self._settle_modes(t, self.state)  # new inputs may break a stuck link
         x, events = self.solver.advance(self, t, self.state, t + h)
         self.state = x
         return events
 
-    def break_segment(self, segment: int) -> None:
-        """Break the span containing ``segment`` (0-based) now."""
-        self._break_span(self.span_of_segment[segment], self.state, self._t_step)
+    def _input_energy(self, t: float) -> float:
+        """The part of the stored energy that inputs can change at once (rope strain), J."""
+        return self.evaluate(t, self.state)["rope_energy"]
+
+    def held_inputs(self) -> dict:
+        """The inputs held since the last step started, as plain data."""
+        inp = self.inputs
+        return {
+            "time": self._t_step,
+            "payout": dict(inp.payout),
+            "payout_rate": dict(inp.payout_rate),
+            "mover_position": dict(inp.mover_position),
+            "mover_velocity": dict(inp.mover_velocity),
+        }
+
+    def restore_held_inputs(self, data: dict) -> None:
+        """Restore inputs saved by :meth:`held_inputs`."""
+        inputs = BlockTrainInputs(
+            {k: float(v) for k, v in data["payout"].items()},
+            {k: float(v) for k, v in data["payout_rate"].items()},
+            {k: float(v) for k, v in data["mover_position"].items()},
+            {k: float(v) for k, v in data["mover_velocity"].items()},
+        )
+        self.set_inputs(float(data["time"]), inputs)
 
     # ----------------------------------------------------------- energy
     def stored_energy(self, t: float | None = None) -> float:
@@ -629,13 +705,13 @@ class BlockTrainModel:
         return kinetic + ev["rope_energy"] + ev["potential"]
 
 
-def _floor_contact(floor, position: float, velocity: float) -> tuple[float, float, float]:
-    """Force (along the body direction), energy and loss of a floor contact."""
+def _floor_contact(floor, position: float, velocity: float):
+    """Depth, trial force (along the body direction), energy and loss of a floor contact.
+
+    The force is that of a spring-damper while in contact; contact is a
+    mode switched by the caller, so a support never pulls.
+    """
     depth = floor.position - position
-    if depth <= 0.0:
-        return 0.0, 0.0, 0.0
     elastic = floor.stiffness * depth
     damping = -floor.damping * velocity
-    if elastic + damping < 0.0:  # a support never pulls
-        damping = -elastic
-    return elastic + damping, 0.5 * elastic * depth, -damping * velocity
+    return depth, elastic + damping, 0.5 * elastic * depth, -damping * velocity

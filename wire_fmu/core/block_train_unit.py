@@ -26,6 +26,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
 from .errors import ConfigurationError
 from .hybrid import IntegrationError, SolverSettings
@@ -161,14 +163,11 @@ class BlockTrainUnit(Unit):
         saved = self.get_state()
         inputs = self._inputs()
         segment = int(self.values["break_segment"])
+        if not 0 <= segment <= model.n_segments:
+            return StepResult(False, f"{self.NAME} {self.instance_name!r}: break_segment "
+                              f"{segment} does not exist (0 for none, 1..{model.n_segments})")
         try:
-            if segment > 0:
-                if segment > model.n_segments:
-                    return StepResult(False, f"{self.instance_name}: break_segment {segment} "
-                                      f"does not exist (1..{model.n_segments})")
-                model.inputs, model._t_step = inputs, time
-                model.break_segment(segment - 1)
-            model.advance(time, step, inputs)
+            model.advance(time, step, inputs, segment - 1 if segment else None)
         except (IntegrationError, FloatingPointError, ValueError) as err:
             self.set_state(saved)
             return StepResult(False, f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s: "
@@ -185,23 +184,27 @@ class BlockTrainUnit(Unit):
             "x": [float(c) for c in m.state],
             "offsets": [float(c) for c in m.offsets],
             "broken": list(m.broken),
+            "taut": [bool(b) for b in m.taut_mask],
+            "contact": [bool(b) for b in m.contact_mask],
             "friction_mode": m.friction.get_mode(),
             "mode_changes": m.mode_changes,
             "time": float(getattr(self, "time", 0.0)),
             "initial_energy": float(self.initial_energy),
+            "held_inputs": m.held_inputs(),
             "solver": {"rhs_calls": m.solver.rhs_calls, "steps": m.solver.steps},
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`."""
-        import numpy as np
-
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.offsets = np.array(state["offsets"], dtype=float)
         m.broken = list(state["broken"])
+        m.taut_mask = np.array(state["taut"], dtype=bool)
+        m.contact_mask = np.array(state["contact"], dtype=bool)
         m.friction.set_mode(list(state["friction_mode"]))
         m.mode_changes = int(state["mode_changes"])
+        m.restore_held_inputs(state["held_inputs"])
         m._held_positions = m.q.copy()
         self.time = float(state["time"])
         self.initial_energy = float(state["initial_energy"])
@@ -240,8 +243,7 @@ class BlockTrainUnit(Unit):
                 out[f"{body.port}.position"] = float(body.position + m.q[j])
                 out[f"{body.port}.velocity"] = float(m.v[j])
         out["tension_max"] = float(tension.max()) if tension.size else 0.0
-        out["slack_spans"] = int(sum(1 for i, s in enumerate(ev["stretch"])
-                                     if s <= 0.0 and not m.broken[i]))
+        out["slack_spans"] = int(np.count_nonzero(~m.taut_mask & ~m.broken_mask))
         out["broken"] = any(m.broken)
         kinetic = 0.5 * float(m.masses @ m.v**2)
         stored = kinetic + ev["rope_energy"] + ev["potential"]

@@ -7,8 +7,13 @@ geometric length ``L`` between its end points and unstretched length
 
 Constitutive law, with engineering strain ``eps = (L - l) / l``::
 
-    T = max(0, EA * eps + c * deps/dt)   if eps > 0      (eq. 3-5)
-    T = 0                                 otherwise      (a rope never pushes)
+    T = EA * eps + c * deps/dt      while taut                (eq. 3-5)
+    T = 0                           while slack (a rope never pushes)
+
+A taut spring goes slack when ``T`` would turn negative; a slack one
+engages when it is stretched and ``T`` would be positive. Treating the two
+as modes (rather than clamping with ``max``) keeps the force smooth inside
+each mode, which implicit integrators and their Jacobians need.
 
 ``EA = A_w * E_w * k_f`` (eq. 4 with k = 1/EA) and ``c = eta * A_w * k_f``
 (eq. 5). The clamp at zero means damping can neither push nor pull a slack
@@ -35,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RopeProperties", "RopeForces", "rope_forces", "snap_load"]
+__all__ = ["RopeProperties", "RopeForces", "rope_forces", "slack_guard", "taut_guard", "snap_load"]
 
 
 @dataclass(frozen=True)
@@ -95,7 +100,7 @@ class RopeForces:
     Attributes
     ----------
     tension : ndarray
-        Physical tension ``T`` (>= 0), N.
+        Physical tension ``T``, N (0 for a slack spring).
     force_on_length : ndarray
         ``dU/dL`` plus damping: the generalised force conjugate to ``L``, N.
     force_on_unstretched : ndarray
@@ -104,6 +109,11 @@ class RopeForces:
         Strain energy, J.
     loss_power : ndarray
         Power dissipated by the damper, W (>= 0).
+    trial_tension : ndarray
+        ``EA eps + c deps/dt`` whether taut or not, N: the tension the
+        spring would carry if it were taut (used to switch modes).
+    elastic_tension : ndarray
+        ``EA eps``, N.
     """
 
     tension: np.ndarray
@@ -111,6 +121,8 @@ class RopeForces:
     force_on_unstretched: np.ndarray
     energy: np.ndarray
     loss_power: np.ndarray
+    trial_tension: np.ndarray
+    elastic_tension: np.ndarray
 
 
 def rope_forces(
@@ -119,8 +131,13 @@ def rope_forces(
     unstretched: np.ndarray,
     length_rate: np.ndarray,
     unstretched_rate: np.ndarray,
+    taut: np.ndarray,
 ) -> RopeForces:
     """Tension, generalised forces, energy and loss of rope springs.
+
+    Whether each spring is taut is a *mode*, switched by the caller where
+    :func:`slack_guard` or :func:`taut_guard` crosses zero; inside a mode the
+    forces are smooth, which is what implicit integrators need.
 
     Parameters
     ----------
@@ -131,22 +148,55 @@ def rope_forces(
         m (``l > 0``).
     length_rate, unstretched_rate : array_like
         Their time derivatives, m/s.
+    taut : array_like of bool
+        Mode of each spring.
     """
     big_l = np.asarray(length, dtype=float)
     small_l = np.asarray(unstretched, dtype=float)
     stretch = big_l - small_l
-    taut = stretch > 0.0
-    eps = np.where(taut, stretch / small_l, 0.0)
+    eps = stretch / small_l
     t_el = props.axial_stiffness * eps
-    energy = 0.5 * t_el * np.maximum(stretch, 0.0)
     if props.damping == 0.0:
-        return RopeForces(t_el, t_el, t_el * (1.0 + 0.5 * eps), energy, np.zeros_like(t_el))
-    eps_rate = (np.asarray(length_rate) - (1.0 + eps) * np.asarray(unstretched_rate)) / small_l
-    t_d = np.where(taut, props.damping * eps_rate, 0.0)
-    t_d = np.maximum(t_d, -t_el)  # the damper may not push: clamp the total at zero
-    loss = t_d * small_l * eps_rate
-    total = t_el + t_d
-    return RopeForces(total, total, t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps), energy, loss)
+        t_d = np.zeros_like(t_el)
+        eps_rate = t_d
+    else:
+        eps_rate = (np.asarray(length_rate) - (1.0 + eps) * np.asarray(unstretched_rate)) / small_l
+        t_d = props.damping * eps_rate
+    trial = t_el + t_d
+    on = np.asarray(taut, dtype=bool)
+    tension = np.where(on, trial, 0.0)
+    # A slack spring may still be stretched while its damper unloads it (zero
+    # total force): its strain energy is still there and drains through the
+    # damper, at the rate the stretch falls.
+    relaxing = ~on & (stretch > 0.0)
+    energy = np.where(on | relaxing, 0.5 * t_el * stretch, 0.0)
+    strain_rate = t_el * np.asarray(length_rate) - t_el * (1.0 + 0.5 * eps) * np.asarray(
+        unstretched_rate
+    )
+    loss = np.where(on, t_d * small_l * eps_rate, np.where(relaxing, -strain_rate, 0.0))
+    return RopeForces(
+        tension,
+        tension,
+        np.where(on, t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps), 0.0),
+        energy,
+        loss,
+        trial,
+        t_el,
+    )
+
+
+def taut_guard(forces: RopeForces) -> np.ndarray:
+    """Positive while a taut spring stays taut; crosses zero when it goes slack, N."""
+    return forces.trial_tension
+
+
+def slack_guard(forces: RopeForces) -> np.ndarray:
+    """Positive while a slack spring stays slack; crosses zero when it engages, N.
+
+    A spring engages when it is stretched *and* the damper would not pull it
+    apart, i.e. when both ``EA eps`` and the trial tension are positive.
+    """
+    return np.maximum(-forces.elastic_tension, -forces.trial_tension)
 
 
 def snap_load(mass: float, stiffness: float, speed: float, gravity: float = 9.81) -> float:
