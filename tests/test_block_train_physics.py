@@ -271,3 +271,16 @@ def test_energy_ledger_books_work_done_by_position_jumps():
     v = unit.values
     assert abs(v["external_work"]) > 10.0
     assert abs(v["energy_balance"]) < 1e-5 * abs(v["external_work"])
+
+
+def test_moving_geometry_fast_planar_path_matches_full_geometry():
+    unit = make_unit(drilling_block_train(4), "moving_geometry")
+    model = unit.model
+    for y in (np.array([0.0]), np.array([3.7]), np.array([-5.2])):
+        np.testing.assert_allclose(model._planar_segment_lengths(y),
+                                   model._spatial_segment_lengths(y), rtol=0, atol=1e-12)
+    # lines stay vertical as the block moves: each line shortens by the block's rise
+    rise = model._planar_segment_lengths(np.array([0.0])) - model._planar_segment_lengths(
+        np.array([1.0]))
+    np.testing.assert_allclose(rise[1:5], 1.0, atol=1e-12)
+    np.testing.assert_allclose(rise[[0, 5]], 0.0, atol=1e-12)

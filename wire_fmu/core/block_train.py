@@ -41,7 +41,7 @@ import numpy as np
 
 from .errors import ConfigurationError
 from .friction import GROUND, FrictionLink, StickSlip
-from .geometry import Circle, PathNode, path_geometry
+from .geometry import Circle, PathNode, path_geometry, planar_frame, planar_path_lengths
 from .hybrid import SolverSettings, make_solver
 from .reeving import LINE_PORTS, Reeving
 from .rope import rope_forces, slack_guard, taut_guard
@@ -255,10 +255,43 @@ class BlockTrainModel:
         for i, sp in enumerate(self.spans):
             self.span_matrix[i, list(sp.segments)] = 1.0
         self.moving = "moving_geometry" in self.effects
+        self._planar = None
+        if self.moving and "spatial_geometry" not in self.effects:
+            self._build_planar_fast_path()
         for k, idx in self.rope_index.items():
             if idx != self.rim_index[k]:
                 s = self.reeving.sheaves[self.nodes[k].name]
                 self.masses[idx] = self.rope.linear_mass * s.radius * self.wrap_angles[k]
+
+    def _build_planar_fast_path(self) -> None:
+        """2-D coordinates for recomputing a planar path cheaply as bodies move."""
+        nodes = self.path_nodes({})
+        frame = planar_frame(nodes, max_fleet_angle=self.reeving.max_fleet_angle)
+        xy0 = [frame.project(n.circle.centre) for n in nodes]
+        dof_of_node, dirs = [], []
+        for b, name in enumerate(self.body_dof):
+            d = self.reeving.bodies[name].direction
+            dirs.append((sum(a * c for a, c in zip(d, frame.u, strict=True)),
+                         sum(a * c for a, c in zip(d, frame.v, strict=True))))
+            del b
+        for k in range(self.n_nodes):
+            body = self.reeving.node_body(self.nodes[k])
+            dof_of_node.append(self.body_dof.index(body) if body in self.body_dof else -1)
+        self._planar = (xy0, np.array(frame.signed_radii), dof_of_node, dirs,
+                        tuple(n.circle.name for n in nodes))
+
+    def _planar_segment_lengths(self, y) -> np.ndarray:
+        xy0, radii, dof_of_node, dirs, names = self._planar
+        xy = [
+            (x, z) if b < 0 else (x + y[b] * dirs[b][0], z + y[b] * dirs[b][1])
+            for (x, z), b in zip(xy0, dof_of_node, strict=True)
+        ]
+        lengths, wraps = planar_path_lengths(xy, radii, names=names)
+        seg = np.array(lengths)
+        half_arcs = 0.5 * np.abs(radii[1:-1]) * np.array(wraps)
+        seg[:-1] += half_arcs
+        seg[1:] += half_arcs
+        return seg
 
     def _require_planar(self, geo) -> None:
         fleet = np.asarray(geo.fleet_angles)
@@ -371,15 +404,18 @@ class BlockTrainModel:
         if not self.moving:
             seg = self.segment_length0 + self.length_jacobian0 @ y
             return self.span_matrix @ seg, self.span_matrix @ self.length_jacobian0
-        disp = dict(zip(self.body_dof, y, strict=True))
-        seg, _ = self._segment_lengths(disp)
+        lengths = self._planar_segment_lengths if self._planar else self._spatial_segment_lengths
+        seg = lengths(y)
         jac = np.zeros((self.n_segments, len(y)))
-        for b, name in enumerate(self.body_dof):
-            h = self.GEOMETRY_STEP
-            plus, _ = self._segment_lengths({**disp, name: disp[name] + h})
-            minus, _ = self._segment_lengths({**disp, name: disp[name] - h})
-            jac[:, b] = (plus - minus) / (2 * h)
+        h = self.GEOMETRY_STEP
+        for b in range(len(y)):
+            step = np.zeros(len(y))
+            step[b] = h
+            jac[:, b] = (lengths(y + step) - lengths(y - step)) / (2 * h)
         return self.span_matrix @ seg, self.span_matrix @ jac
+
+    def _spatial_segment_lengths(self, y: np.ndarray) -> np.ndarray:
+        return self._segment_lengths(dict(zip(self.body_dof, y, strict=True)))[0]
 
     # -------------------------------------------------------------- physics
     def evaluate(self, t: float, x: np.ndarray) -> dict:
