@@ -1,0 +1,412 @@
+"""The generic pythonfmu facade: one FMI variable per declared core variable.
+
+A facade script only names the core unit::
+
+    from wire_fmu.core.block_train import BlockTrainUnit
+    from wire_fmu.export.facade import CoreFacade
+
+    class BlockTrain(CoreFacade):
+        unit_class = BlockTrainUnit
+
+What the facade does at each FMI call
+-------------------------------------
+``fmi2Instantiate``
+    Checks that the imported ``wire_fmu`` is the bundled one
+    (:mod:`wire_fmu.export.guard`), creates the unit, registers its variables.
+``fmi2SetupExperiment``
+    Remembers the start time.
+``fmi2EnterInitializationMode``
+    ``unit.configure()``; a :class:`~wire_fmu.core.errors.ConfigurationError`
+    is logged (status Error, every problem) and fails the call.
+``fmi2ExitInitializationMode``
+    Rebuilds the unit if a parameter was set in initialisation mode, then
+    ``unit.initialize(start_time)``.
+``fmi2DoStep``
+    ``unit.advance(t, h)``; a refused step is logged (status Discard, with the
+    unit's message) before returning ``False`` (pythonfmu: ``fmi2Discard``).
+``fmi2Get/SetFMUstate``
+    The unit's full ``get_state()`` plus every variable value, as JSON data.
+
+Errors
+------
+pythonfmu turns any exception into ``fmi2Fatal`` and reports only
+"unknown error" or the exception's repr, and only if the master switched
+logging on. So every entry point logs first: a deliberate
+:class:`~wire_fmu.core.errors.WireFmuError` with its message (status Error),
+anything else with its full traceback (status Fatal), then re-raises. Every
+message of status Warning or worse is also sent to the Python logger
+``wire_fmu.export.facade``, which reaches the master's process when
+pythonfmu drops the FMI message (``loggingOn`` false).
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import json
+import logging
+import traceback
+from collections.abc import Callable, Mapping
+from enum import StrEnum
+from typing import Any, ClassVar, TypeVar
+
+from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+import wire_fmu
+from wire_fmu.core.errors import WireFmuError
+from wire_fmu.core.interface import Causality, Unit, Variability, Variable
+from wire_fmu.export.guard import check_core
+from wire_fmu.export.pythonfmu_compat import pin_for_fatal
+from wire_fmu.export.state import json_copy
+
+__all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
+
+logger = logging.getLogger(__name__)
+
+STATE_FORMAT = "wire_fmu.fmu_state/1"
+"""Tag of the FMU state layout written by :meth:`CoreFacade._get_fmu_state`."""
+
+_SCALAR = {float: Real, int: Integer, bool: Boolean, str: String}
+_CAUSALITY = {
+    Causality.parameter: Fmi2Causality.parameter,
+    Causality.input: Fmi2Causality.input,
+    Causality.output: Fmi2Causality.output,
+}
+_VARIABILITY = {v: Fmi2Variability[v.value] for v in Variability}
+_INITIAL = {
+    Causality.parameter: Fmi2Initial.exact,
+    Causality.input: None,  # FMI 2.0 forbids `initial` on inputs
+    Causality.output: Fmi2Initial.calculated,
+}
+_PY_LEVEL = {
+    Fmi2Status.ok: logging.DEBUG,
+    Fmi2Status.warning: logging.WARNING,
+    Fmi2Status.discard: logging.WARNING,
+    Fmi2Status.error: logging.ERROR,
+    Fmi2Status.fatal: logging.CRITICAL,
+}
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+class FacadeError(WireFmuError, RuntimeError):
+    """An FMI call the facade cannot honour (wrong phase, bad state, ...)."""
+
+
+class Phase(StrEnum):
+    """Life-cycle phase of a facade (FMI 2.0 co-simulation states)."""
+
+    instantiated = "instantiated"
+    initialization = "initialization"
+    step = "step"
+    terminated = "terminated"
+
+
+def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
+    """Decorate a method that pythonfmu calls: log why it fails, then re-raise.
+
+    Parameters
+    ----------
+    fmi_name : str
+        The FMI function, for the message (e.g. ``"fmi2DoStep"``).
+    """
+
+    def decorate(method: _F) -> _F:
+        @functools.wraps(method)
+        def guarded(self: CoreFacade, *args: Any, **kwargs: Any) -> Any:
+            try:
+                return method(self, *args, **kwargs)
+            except WireFmuError as exc:
+                self._report(f"{fmi_name} failed: {exc}", Fmi2Status.error)
+                pin_for_fatal(self)
+                raise
+            except Exception:
+                detail = traceback.format_exc()
+                self._report(f"{fmi_name} failed unexpectedly:\n{detail}", Fmi2Status.fatal)
+                pin_for_fatal(self)
+                raise
+
+        return guarded  # type: ignore[return-value]
+
+    return decorate
+
+
+class CoreFacade(Fmi2Slave):
+    """pythonfmu slave that exposes one core :class:`~wire_fmu.core.interface.Unit`.
+
+    Subclasses set :attr:`unit_class` and nothing else.
+
+    Parameters
+    ----------
+    **kwargs
+        As passed by pythonfmu: ``instance_name``, ``resources`` (the FMU's
+        resources folder; ``None`` when the facade is used directly from
+        Python, which skips the core-version guard), ``visible``, ``logger``.
+
+    Attributes
+    ----------
+    unit : Unit
+        The core unit; FMI variables read and write ``unit.values``.
+    """
+
+    unit_class: ClassVar[type[Unit] | None] = None
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        unit_class = self._unit_class()
+        if self.resources is not None:
+            self._guard_core(unit_class)
+        self.modelName = unit_class.NAME
+        self.description = unit_class.DESCRIPTION or None
+        self.version = wire_fmu.__version__
+        self.unit: Unit = unit_class(instance_name=self.instance_name)
+        self._phase = Phase.instantiated
+        self._start_time = 0.0
+        self._reconfigure = False
+        self._inputs_changed = False
+        for var in unit_class.variables():
+            self._register(var)
+
+    # -- construction -----------------------------------------------------------
+    @classmethod
+    def _unit_class(cls) -> type[Unit]:
+        unit_class = cls.unit_class
+        if not (isinstance(unit_class, type) and issubclass(unit_class, Unit)):
+            raise TypeError(
+                f"{cls.__name__}.unit_class must be a wire_fmu.core.interface.Unit subclass, "
+                f"got {unit_class!r}"
+            )
+        return unit_class
+
+    def _guard_core(self, unit_class: type[Unit]) -> None:
+        try:
+            check_core(self.resources, unit_class.NAME, self.instance_name)
+        except WireFmuError as exc:
+            # The instance does not exist yet, so its log queue never reaches
+            # the master: pythonfmu logs the exception's repr as fmi2Fatal, and
+            # the Python logger reaches the master's process.
+            logger.error("%s", exc)
+            raise
+
+    def _register(self, var: Variable) -> None:
+        scalar = _SCALAR[var.type](
+            var.name,
+            causality=_CAUSALITY[var.causality],
+            variability=_VARIABILITY[var.variability],
+            initial=_INITIAL[var.causality],
+            description=var.description,
+            getter=functools.partial(self._get_value, var),
+            setter=functools.partial(self._set_value, var),
+        )
+        # nested=False: dotted names are plain keys of unit.values.
+        self.register_variable(scalar, nested=False)
+
+    @property
+    def phase(self) -> Phase:
+        """Current life-cycle phase."""
+        return self._phase
+
+    @property
+    def who(self) -> str:
+        """``"<NAME> '<instance>'"``, the prefix of every message."""
+        return f"{self.unit.NAME} {self.instance_name!r}"
+
+    # -- messages -----------------------------------------------------------
+    def _report(self, message: str, status: Fmi2Status) -> None:
+        """Log to the FMI logger and mirror to the Python logger."""
+        text = f"{self.who}: {message}"
+        self.log(text, status)
+        logger.log(_PY_LEVEL[status], "%s", text)
+
+    def _require(self, fmi_name: str, *phases: Phase) -> None:
+        if self._phase not in phases:
+            allowed = " or ".join(p.value for p in phases)
+            raise FacadeError(
+                f"{fmi_name} called in phase {self._phase.value!r}; allowed in {allowed}"
+            )
+
+    # -- variable access --------------------------------------------------------
+    def _get_value(self, var: Variable) -> Any:
+        if var.depends_on and self._inputs_changed and self._phase is Phase.step:
+            self._evaluate_outputs()
+        return self.unit.values[var.name]
+
+    def _evaluate_outputs(self) -> None:
+        # Optional unit hook: recompute direct-feedthrough outputs from new
+        # inputs without stepping. Without it, outputs are those of the last step.
+        hook = getattr(self.unit, "evaluate_outputs", None)
+        if callable(hook):
+            hook()
+        self._inputs_changed = False
+
+    def _set_value(self, var: Variable, value: Any) -> None:
+        if var.causality is Causality.output:
+            raise FacadeError(f"output {var.name!r} cannot be set")
+        settled = self._phase in (Phase.step, Phase.terminated)
+        if settled and var.variability is Variability.fixed:
+            raise FacadeError(
+                f"fixed parameter {var.name!r} can only be set before fmi2ExitInitializationMode"
+            )
+        self.unit.values[var.name] = var.type(value)
+        if var.causality is Causality.input:
+            self._inputs_changed = True
+        elif self._phase is Phase.initialization:
+            self._reconfigure = True
+
+    @fmi_entry("fmi2GetReal")
+    def get_real(self, vrs: list[int]) -> list[float]:  # noqa: D102
+        return super().get_real(vrs)
+
+    @fmi_entry("fmi2GetInteger")
+    def get_integer(self, vrs: list[int]) -> list[int]:  # noqa: D102
+        return super().get_integer(vrs)
+
+    @fmi_entry("fmi2GetBoolean")
+    def get_boolean(self, vrs: list[int]) -> list[bool]:  # noqa: D102
+        return super().get_boolean(vrs)
+
+    @fmi_entry("fmi2GetString")
+    def get_string(self, vrs: list[int]) -> list[str]:  # noqa: D102
+        return super().get_string(vrs)
+
+    @fmi_entry("fmi2SetReal")
+    def set_real(self, vrs: list[int], values: list[float]) -> None:  # noqa: D102
+        super().set_real(vrs, values)
+
+    @fmi_entry("fmi2SetInteger")
+    def set_integer(self, vrs: list[int], values: list[int]) -> None:  # noqa: D102
+        super().set_integer(vrs, values)
+
+    @fmi_entry("fmi2SetBoolean")
+    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:  # noqa: D102
+        super().set_boolean(vrs, values)
+
+    @fmi_entry("fmi2SetString")
+    def set_string(self, vrs: list[int], values: list[str]) -> None:  # noqa: D102
+        super().set_string(vrs, values)
+
+    # -- life cycle ---------------------------------------------------------------
+    @fmi_entry("fmi2SetupExperiment")
+    def setup_experiment(
+        self, start_time: float, stop_time: float | None = None, tolerance: float | None = None
+    ) -> None:
+        """Remember the start time (pythonfmu passes only ``start_time``)."""
+        self._start_time = float(start_time)
+
+    @fmi_entry("fmi2EnterInitializationMode")
+    def enter_initialization_mode(self) -> None:
+        """Configure the unit from its parameters."""
+        self._require("fmi2EnterInitializationMode", Phase.instantiated)
+        self.unit.configure()
+        self._phase = Phase.initialization
+        self._reconfigure = False
+
+    @fmi_entry("fmi2ExitInitializationMode")
+    def exit_initialization_mode(self) -> None:
+        """Initialise the unit at the start time."""
+        self._require("fmi2ExitInitializationMode", Phase.initialization)
+        if self._reconfigure:
+            self._rebuild_unit(self.unit.values)
+        self.unit.initialize(self._start_time)
+        self._phase = Phase.step
+        self._inputs_changed = False
+
+    @fmi_entry("fmi2DoStep")
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        """Advance the unit; log and return ``False`` if it refuses the step."""
+        self._require("fmi2DoStep", Phase.step)
+        result = self.unit.advance(current_time, step_size)
+        for event in result.events:
+            self._report(f"t = {current_time + step_size!r} s: {event}", Fmi2Status.ok)
+        if not result.success:
+            self._report(
+                f"step from t = {current_time!r} s by {step_size!r} s refused: {result.message}",
+                Fmi2Status.discard,
+            )
+            return False
+        self._inputs_changed = False
+        return True
+
+    @fmi_entry("fmi2Terminate")
+    def terminate(self) -> None:
+        """Mark the instance terminated."""
+        self._phase = Phase.terminated
+
+    def _rebuild_unit(self, values: Mapping[str, Any]) -> None:
+        """Fresh unit with ``values``, configured."""
+        unit = self._unit_class()(instance_name=self.instance_name)
+        unit.values.update(values)
+        unit.configure()
+        self.unit = unit
+
+    # -- FMU state --------------------------------------------------------------
+    @fmi_entry("fmi2GetFMUstate")
+    def _get_fmu_state(self) -> dict[str, Any]:
+        settled = self._phase in (Phase.step, Phase.terminated)
+        raw = {
+            "format": STATE_FORMAT,
+            "unit": self.unit.NAME,
+            "phase": self._phase.value,
+            "start_time": self._start_time,
+            "reconfigure": self._reconfigure,
+            "inputs_changed": self._inputs_changed,
+            "values": self.unit.values,
+            "core": self.unit.get_state() if settled else None,
+        }
+        try:
+            return json_copy(raw)
+        except (TypeError, ValueError) as exc:
+            raise FacadeError(
+                f"FMU state is not JSON-compatible ({exc}); {type(self.unit).__name__}"
+                ".get_state() and unit.values must hold JSON data"
+            ) from exc
+
+    @fmi_entry("fmi2SetFMUstate")
+    def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        self._check_state(state)
+        values = copy.deepcopy(state["values"])
+        phase = Phase(state["phase"])
+        if phase is Phase.instantiated:
+            self.unit = self._unit_class()(instance_name=self.instance_name)
+            self.unit.values.update(values)
+        elif phase is Phase.initialization:
+            self._rebuild_unit(values)
+        else:
+            if self._needs_configure(values):
+                self._rebuild_unit(values)
+            self.unit.values.update(values)
+            self.unit.set_state(copy.deepcopy(state["core"]))
+            self.unit.values.update(values)  # exactly the saved outputs
+        self._phase = phase
+        self._start_time = float(state["start_time"])
+        self._reconfigure = bool(state["reconfigure"])
+        self._inputs_changed = bool(state["inputs_changed"])
+
+    @staticmethod
+    def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:
+        # pythonfmu calls this on the class, so an exception here could not be
+        # logged for the instance: unreadable bytes become a state that
+        # _set_fmu_state refuses with a logged message.
+        try:
+            return json.loads(state.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            return {"format": None, "unreadable": f"not a serialised wire_fmu state ({exc})"}
+
+    def _needs_configure(self, values: Mapping[str, Any]) -> bool:
+        if self._phase not in (Phase.step, Phase.terminated):
+            return True
+        names = [v.name for v in self.unit.VARIABLES if v.causality is Causality.parameter]
+        return any(self.unit.values[n] != values[n] for n in names)
+
+    def _check_state(self, state: Any) -> None:
+        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
+            reason = state.get("unreadable", "") if isinstance(state, dict) else ""
+            raise FacadeError(f"not an FMU state of format {STATE_FORMAT!r} {reason}".strip())
+        if state.get("unit") != self.unit.NAME:
+            raise FacadeError(
+                f"the FMU state belongs to unit {state.get('unit')!r}, not {self.unit.NAME!r}"
+            )
+        expected = {v.name for v in self.unit.VARIABLES}
+        if set(state["values"]) != expected:
+            raise FacadeError("the FMU state's variables differ from this FMU's variables")
