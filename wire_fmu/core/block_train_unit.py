@@ -176,6 +176,16 @@ class BlockTrainUnit(Unit):
         self._update_outputs()
         return StepResult(True, events=tuple(model.last_events))
 
+    def evaluate_outputs(self) -> None:
+        """Outputs for the inputs now set, at the current time; the state is untouched."""
+        model = self._require_model()
+        held = model.held_inputs()
+        model.set_inputs(self.time, self._inputs())
+        try:
+            self._update_outputs()
+        finally:
+            model.restore_held_inputs(held)
+
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
         """Complete state: continuous state, modes, broken spans, offsets."""

@@ -271,6 +271,15 @@ class Unit(ABC):
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state returned by :meth:`get_state`."""
 
+    def evaluate_outputs(self) -> None:
+        """Recompute direct-feedthrough outputs for the inputs now in :attr:`values`.
+
+        Called when a master reads such an output after setting inputs and
+        before stepping. Must not change the unit's state. The default keeps
+        the outputs of the last step, right for units without feedthrough.
+        """
+        return None
+
     # -- helpers --------------------------------------------------------------
     def parameters(self) -> dict[str, Any]:
         """Current parameter values by name."""

@@ -233,11 +233,8 @@ class CoreFacade(Fmi2Slave):
         return self.unit.values[var.name]
 
     def _evaluate_outputs(self) -> None:
-        # Optional unit hook: recompute direct-feedthrough outputs from new
-        # inputs without stepping. Without it, outputs are those of the last step.
-        hook = getattr(self.unit, "evaluate_outputs", None)
-        if callable(hook):
-            hook()
+        # recompute direct-feedthrough outputs from the new inputs, without stepping
+        self.unit.evaluate_outputs()
         self._inputs_changed = False
 
     def _set_value(self, var: Variable, value: Any) -> None:
