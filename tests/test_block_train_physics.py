@@ -284,3 +284,31 @@ def test_moving_geometry_fast_planar_path_matches_full_geometry():
         np.array([1.0]))
     np.testing.assert_allclose(rise[1:5], 1.0, atol=1e-12)
     np.testing.assert_allclose(rise[[0, 5]], 0.0, atol=1e-12)
+
+
+class TestSpatialGeometry:
+    @staticmethod
+    def offset_pulley(offset):
+        reeving = pulley()
+        reeving["anchors"]["hook"]["point"] = [0.5, 0.0, offset]  # hangs off the sheave plane
+        return reeving
+
+    def test_a_non_planar_reeving_needs_the_effect(self):
+        with pytest.raises(ConfigurationError, match="spatial_geometry"):
+            make_unit(self.offset_pulley(0.2))
+
+    def test_fleet_angle_length_and_equilibrium(self):
+        offset = 0.2
+        unit = make_unit(self.offset_pulley(offset), "spatial_geometry")
+        fleet = unit.model.geometry0.fleet_angles[1, 0]
+        drop = 10.0  # vertical distance from the sheave's tangent height to the hook
+        assert fleet == pytest.approx(math.atan(offset / drop), rel=1e-6)
+        # the hanging line is tilted, so the rope holds the weight with T cos(fleet) ... and
+        # only the vertical motion of the block stretches it: T = m g / cos(fleet)
+        assert unit.values["line_a.tension"] == pytest.approx(1000 * G / math.cos(fleet),
+                                                              rel=1e-6)
+
+    def test_fleet_angle_above_the_limit_is_refused_naming_both_ends(self):
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(self.offset_pulley(2.0), "spatial_geometry")
+        assert "pulley" in str(info.value) and "hook" in str(info.value)

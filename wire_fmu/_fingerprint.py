@@ -13,10 +13,11 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-__all__ = ["EXCLUDED_TOP_LEVEL", "bundled_files", "fingerprint", "package_dir"]
+__all__ = ["BUNDLED_TOP_LEVEL", "bundled_files", "fingerprint", "package_dir"]
 
-EXCLUDED_TOP_LEVEL = frozenset({"master", "cli.py"})
-"""Top-level entries that import fmpy and never run inside an FMU."""
+BUNDLED_TOP_LEVEL = frozenset({"__init__.py", "_fingerprint.py", "core", "export"})
+"""What runs inside an FMU: the physics core and the facade layer. The rest
+of the package (master, command line, studies) uses fmpy and stays out."""
 
 _EXCLUDED_DIRS = frozenset({"__pycache__"})
 _EXCLUDED_SUFFIXES = (".pyc", ".pyo", ".swp", ".swo", ".orig", ".rej", "~")
@@ -29,7 +30,7 @@ def package_dir() -> Path:
 
 def _is_bundled(relative: Path) -> bool:
     parts = relative.parts
-    if parts[0] in EXCLUDED_TOP_LEVEL:
+    if parts[0] not in BUNDLED_TOP_LEVEL:
         return False
     if any(part in _EXCLUDED_DIRS or part.startswith(".") for part in parts):
         return False

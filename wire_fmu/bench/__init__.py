@@ -1,0 +1,1 @@
+"""Benchmarks: what the physics and the FMI layer cost (not run by the tests)."""
