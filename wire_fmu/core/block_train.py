@@ -502,14 +502,9 @@ class BlockTrainModel:
         caps = self._capacities(ev["tension"])
         acc, link_force = self.friction.accelerations(ev["forces"], caps)
         out[n : 2 * n] = acc
-        friction_loss = 0.0
-        for k, _link in enumerate(self.friction.links):
-            if self.friction.mode[k] != 0:
-                friction_loss -= link_force[k] * self.friction.relative_velocity(v, k)
         if self.friction.links:
-            held = self.friction.stuck_to_ground()
-            out[held] = 0.0
-        out[2 * n] = ev["loss"] + friction_loss
+            out[self.friction.stuck_to_ground()] = 0.0
+        out[2 * n] = ev["loss"] + self.friction.loss_power(v, link_force)
         out[2 * n + 1] = self._external_power(ev)
         return out
 

@@ -21,6 +21,13 @@ Transitions are guards for :mod:`wire_fmu.core.hybrid`:
 Sign convention: a link force is the force *on* ``body`` (its partner
 ``other`` receives the opposite); relative velocity is
 ``v[body] - v[other]`` (``other = -1`` is the ground).
+
+Capacities may depend on direction (a band brake is self-energising one
+way only): pass them with shape ``(n_links, 2)``, column 0 opposing
+positive relative motion and column 1 opposing negative relative motion,
+or with shape ``(n_links,)`` when both are equal. A link may also slide
+with a force other than its static capacity (Stribeck friction): pass the
+sliding magnitudes separately, in the same shape.
 """
 
 from __future__ import annotations
@@ -29,9 +36,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FrictionLink", "StickSlip"]
+__all__ = ["FrictionLink", "StickSlip", "GROUND"]
 
 GROUND = -1
+
+
+def _by_direction(capacities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(capacity against positive motion, capacity against negative motion)."""
+    caps = np.asarray(capacities, dtype=float)
+    if caps.ndim == 2:
+        return caps[:, 0], caps[:, 1]
+    return caps, caps
+
+
+def _against(caps: tuple[np.ndarray, np.ndarray], k: int, direction: float) -> float:
+    """Capacity of link ``k`` against motion in ``direction`` (+1 or -1)."""
+    return caps[0][k] if direction > 0 else caps[1][k]
 
 
 @dataclass(frozen=True)
@@ -90,7 +110,11 @@ class StickSlip:
         return rel
 
     def accelerations(
-        self, forces: np.ndarray, capacities: np.ndarray, mode: np.ndarray | None = None
+        self,
+        forces: np.ndarray,
+        capacities: np.ndarray,
+        mode: np.ndarray | None = None,
+        sliding: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Accelerations and link forces in the current mode.
 
@@ -98,8 +122,13 @@ class StickSlip:
         ----------
         forces : ndarray, shape (n,)
             All non-friction forces on each coordinate, N (or N m).
-        capacities : ndarray, shape (n_links,)
-            Friction capacity of each link (>= 0), N (or N m).
+        capacities : ndarray, shape (n_links,) or (n_links, 2)
+            Static friction capacity of each link (>= 0), N (or N m); see
+            the module docstring for direction-dependent capacities.
+        mode : ndarray, optional
+            Modes to use instead of the current ones.
+        sliding : ndarray, optional
+            Friction magnitude while sliding (default: the capacities).
 
         Returns
         -------
@@ -110,11 +139,12 @@ class StickSlip:
             stuck link, ``-direction * capacity`` of a sliding one.
         """
         mode = self.mode if mode is None else mode
+        slide = _by_direction(capacities if sliding is None else sliding)
         total = np.array(forces, dtype=float)
         link_force = np.zeros(len(self.links))
         for k, link in enumerate(self.links):
             if mode[k] != 0:
-                f = -mode[k] * capacities[k]
+                f = -mode[k] * _against(slide, k, mode[k])
                 link_force[k] = f
                 total[link.body] += f
                 if link.other != GROUND:
@@ -132,20 +162,29 @@ class StickSlip:
                     required[parent] += carried
         return acc, link_force
 
-    def loss_power(self, v: np.ndarray, capacities: np.ndarray) -> float:
-        """Power dissipated by the sliding links, W (>= 0)."""
+    def loss_power(self, v: np.ndarray, link_force: np.ndarray) -> float:
+        """Power dissipated by the sliding links, W (>= 0 while the modes hold).
+
+        Parameters
+        ----------
+        v : ndarray
+            Velocities.
+        link_force : ndarray
+            Link forces from :meth:`accelerations`.
+        """
         total = 0.0
         for k in range(len(self.links)):
             if self.mode[k] != 0:
-                total += capacities[k] * abs(self.relative_velocity(v, k))
+                total -= link_force[k] * self.relative_velocity(v, k)
         return total
 
     def guards(self, v: np.ndarray, link_force: np.ndarray, capacities: np.ndarray) -> np.ndarray:
         """Guard values per link (see module docstring); all >= 0 inside the mode."""
+        caps = _by_direction(capacities)
         g = np.empty(len(self.links))
         for k in range(len(self.links)):
             if self.mode[k] == 0:
-                g[k] = capacities[k] - abs(link_force[k])
+                g[k] = _holding_margin(caps, k, link_force[k])
             else:
                 g[k] = self.mode[k] * self.relative_velocity(v, k)
         return g
@@ -172,14 +211,16 @@ class StickSlip:
         self._plan = None
         for _ in range(2 * len(self.links) + 1):
             _, link_force = self.accelerations(forces, capacities)
-            over = [
-                k
+            caps = _by_direction(capacities)
+            margin = {
+                k: _holding_margin(caps, k, link_force[k])
                 for k in range(len(self.links))
-                if self.mode[k] == 0 and abs(link_force[k]) > capacities[k]
-            ]
+                if self.mode[k] == 0
+            }
+            over = [k for k, m in margin.items() if m < 0.0]
             if not over:
                 break
-            worst = max(over, key=lambda k: abs(link_force[k]) - capacities[k])
+            worst = min(over, key=lambda k: margin[k])
             self.mode[worst] = -1 if link_force[worst] > 0 else 1
             self._plan = None
         return v
@@ -210,6 +251,15 @@ class StickSlip:
         if mode is self.mode:
             self._plan = plan
         return plan
+
+
+def _holding_margin(caps, k: int, holding: float) -> float:
+    """Capacity left when link ``k`` holds ``holding`` (force on its body).
+
+    A negative holding force stops positive motion, so it is compared with
+    the capacity against positive motion, and vice versa.
+    """
+    return _against(caps, k, -holding if holding != 0.0 else 1.0) - abs(holding)
 
 
 def _stuck_clusters(links: tuple[FrictionLink, ...], mode: np.ndarray):
