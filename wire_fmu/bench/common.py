@@ -1,0 +1,178 @@
+"""What every unit benchmark shares: timing the core and the built FMU per step.
+
+A benchmark describes one manoeuvre as a :class:`Case`: the unit class, its
+facade script, string and real parameters, and a function giving the real
+inputs at step ``i``. :func:`measure` steps it in the core and through the
+FMU (fmpy, in this process) and returns a :class:`Row`.
+
+The FMU runs in this process and uses the ``wire_fmu`` already imported
+here, so the time spent inside the unit's ``advance`` during the FMU run is
+measured too; the FMI overhead is the rest of the FMU's time (pythonfmu's
+C++ and Python layers, the facade, fmpy's ctypes calls). Times are medians
+over the steps (wall clock, ``time.perf_counter``) after a warm-up.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from wire_fmu.core.interface import Unit
+
+__all__ = ["Case", "Row", "measure", "table", "ROOT"]
+
+ROOT = Path(__file__).resolve().parents[2]
+WARM_UP = 5
+
+
+@dataclass(frozen=True)
+class Case:
+    """One benchmark manoeuvre.
+
+    Parameters
+    ----------
+    label : str
+        Row label (usually the effect set).
+    unit_class : type of Unit
+        The core unit.
+    strings, reals, booleans : mapping
+        Parameters to set before initialisation.
+    inputs : callable
+        ``inputs(i)`` -> mapping of real input name to value at step ``i``.
+    outputs : sequence of str
+        Outputs a master would read every step.
+    step : float
+        Communication step, s.
+    """
+
+    label: str
+    unit_class: type[Unit]
+    strings: Mapping[str, str] = field(default_factory=dict)
+    reals: Mapping[str, float] = field(default_factory=dict)
+    booleans: Mapping[str, bool] = field(default_factory=dict)
+    inputs: Callable[[int], Mapping[str, float]] = lambda i: {}
+    outputs: tuple[str, ...] = ()
+    step: float = 0.01
+
+
+@dataclass(frozen=True)
+class Row:
+    """Benchmark figures of one case, ms per communication step."""
+
+    label: str
+    states: int
+    core_ms: float
+    fmu_ms: float
+    overhead_ms: float
+
+    @property
+    def overhead_share(self) -> float:
+        """Share of the FMU step spent outside the physics."""
+        return self.overhead_ms / self.fmu_ms
+
+
+def _core_unit(case: Case) -> Unit:
+    unit = case.unit_class("bench")
+    unit.values.update(case.strings)
+    unit.values.update(case.reals)
+    unit.values.update(case.booleans)
+    unit.configure()
+    unit.initialize(0.0)
+    return unit
+
+
+def time_core(case: Case, steps: int) -> tuple[float, int]:
+    """Median ms per step of the core unit, and the size of its state."""
+    unit = _core_unit(case)
+    samples = []
+    for i in range(steps):
+        unit.values.update(case.inputs(i))
+        start = time.perf_counter()
+        unit.advance(i * case.step, case.step)
+        samples.append(time.perf_counter() - start)
+    state = unit.get_state().get("x", [])
+    return statistics.median(samples[WARM_UP:]) * 1e3, len(state)
+
+
+class _AdvanceTimer:
+    """Accumulates the time spent in ``unit_class.advance`` (wraps it)."""
+
+    def __init__(self, unit_class: type[Unit]) -> None:
+        self.unit_class = unit_class
+        self.elapsed = 0.0
+        self._original = unit_class.advance
+
+    def __enter__(self) -> _AdvanceTimer:
+        original, timer = self._original, self
+
+        def timed(unit, time_, step):
+            start = time.perf_counter()
+            try:
+                return original(unit, time_, step)
+            finally:
+                timer.elapsed += time.perf_counter() - start
+
+        self.unit_class.advance = timed
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.unit_class.advance = self._original
+
+
+def time_fmu(fmu_path: Path, case: Case, steps: int) -> tuple[float, float]:
+    """Median ms per FMU step (set inputs, doStep, get outputs), and of it outside ``advance``."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu_path))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu_path)),
+                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
+    fmu.instantiate()
+    for setter, values in ((fmu.setString, case.strings), (fmu.setReal, case.reals),
+                           (fmu.setBoolean, case.booleans)):
+        if values:
+            setter([refs[k] for k in values], list(values.values()))
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    outputs = [refs[n] for n in case.outputs]
+    samples, outside = [], []
+    with _AdvanceTimer(case.unit_class) as timer:
+        for i in range(steps):
+            values = case.inputs(i)
+            refs_in, vals_in = [refs[k] for k in values], list(values.values())
+            inside = timer.elapsed
+            start = time.perf_counter()
+            if refs_in:
+                fmu.setReal(refs_in, vals_in)
+            fmu.doStep(currentCommunicationPoint=i * case.step, communicationStepSize=case.step)
+            fmu.getReal(outputs)
+            total = time.perf_counter() - start
+            samples.append(total)
+            outside.append(total - (timer.elapsed - inside))
+    fmu.terminate()
+    fmu.freeInstance()
+    return statistics.median(samples[WARM_UP:]) * 1e3, statistics.median(outside[WARM_UP:]) * 1e3
+
+
+def measure(fmu_path: Path, case: Case, steps: int) -> Row:
+    """Time ``case`` in the core and through the FMU at ``fmu_path``."""
+    core_ms, states = time_core(case, steps)
+    fmu_ms, overhead_ms = time_fmu(fmu_path, case, steps)
+    return Row(case.label, states, core_ms, fmu_ms, overhead_ms)
+
+
+def table(rows: list[Row]) -> str:
+    """Markdown table of the figures."""
+    lines = [
+        "| effects | states | core ms/step | FMU ms/step | FMI overhead ms | share |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        lines.append(f"| {r.label} | {r.states} | {r.core_ms:.3f} | {r.fmu_ms:.3f} | "
+                     f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |")
+    return "\n".join(lines)
