@@ -1,0 +1,137 @@
+"""The master against the closed-form two-mass oscillator.
+
+Unit ``a``: mass m1 on a spring k1 to the ground (the Oscillator test FMU),
+force input, position/velocity outputs without feedthrough. Unit ``b``:
+mass m2 hung from ``a`` on a spring k (the CoupledMass test FMU), the
+coupling compliance inside it. The closed form is ``expm`` of the linear
+system's matrix. Observed convergence orders must match the theory:
+1 holding inputs constant, 2 holding the linear extrapolant's midpoint.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+SUPPORT = Path(__file__).resolve().parent / "support"
+if str(SUPPORT) not in sys.path:
+    sys.path.insert(0, str(SUPPORT))
+
+from fmi_test_tools import FACADES  # noqa: E402
+
+from wire_fmu.export.builder import build_fmu  # noqa: E402
+from wire_fmu.master.observers import CsvRecorder  # noqa: E402
+from wire_fmu.master.plots import read_results  # noqa: E402
+from wire_fmu.master.scene import parse_scene  # noqa: E402
+from wire_fmu.master.simulation import Simulation  # noqa: E402
+from wire_fmu.master.validate import validate_scene  # noqa: E402
+
+pytestmark = pytest.mark.integration
+
+M1, K1, M2, K, X0 = 1.0, 40.0, 2.0, 60.0, 0.1
+STOP = 1.0
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory) -> dict[str, Path]:
+    out = tmp_path_factory.mktemp("fmus")
+    return {
+        "osc": build_fmu(FACADES / "oscillator.py", out,
+                         extra_modules=[SUPPORT / "wire_fmu_test_units.py"]),
+        "mass": build_fmu(FACADES / "coupled_mass.py", out,
+                          extra_modules=[SUPPORT / "wire_fmu_master_units.py"]),
+    }
+
+
+def scene_data(fmus, *, step, algorithm="jacobi", extrapolation="linear", **run):
+    return {
+        "name": "two_mass",
+        "run": {"stop_time": STOP, "step": step, "algorithm": algorithm,
+                "extrapolation": extrapolation, **run},
+        "units": {
+            "a": {"fmu": str(fmus["osc"]), "parameters": {
+                "mass": M1, "stiffness": K1, "damping": 0.0, "x0": X0, "substeps": 50}},
+            "b": {"fmu": str(fmus["mass"]), "parameters": {
+                "mass": M2, "stiffness": K, "damping": 0.0, "x0": 0.0, "substeps": 50}},
+        },
+        "bonds": [{
+            "name": "spring", "kind": "translational",
+            "effort": "b.force_on_flange -> a.force",
+            "flow": "a.velocity -> b.flange.velocity",
+            "position": "a.position -> b.flange.position",
+        }],
+        "outputs": {"variables": ["a.position", "b.position"]},
+    }
+
+
+def exact_positions(t: float) -> np.ndarray:
+    """x1, x2 at t from expm of [x1, x2, v1, v2]' = A [...]."""
+    stiffness = np.array([[K1 + K, -K], [-K, K]])
+    mass = np.diag([M1, M2])
+    a = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-np.linalg.solve(mass, stiffness), np.zeros((2, 2))]])
+    return (expm(a * t) @ np.array([X0, 0.0, 0.0, 0.0]))[:2]
+
+
+def run(fmus, tmp_path, **kw):
+    scene = parse_scene(scene_data(fmus, **kw), base_dir=tmp_path)
+    structure = validate_scene(scene, through_fmi=False)
+    recorder = CsvRecorder(tmp_path / f"run_{kw['step']}_{kw.get('extrapolation')}")
+    sim = Simulation(scene, structure, [recorder])
+    result = sim.run()
+    assert result.status == "finished", result.message
+    return read_results(recorder.csv_path), result
+
+
+def final_error(fmus, tmp_path, **kw) -> float:
+    """Largest deviation from the closed form over the whole run, m."""
+    columns, _ = run(fmus, tmp_path, **kw)
+    assert columns["time"][-1] == pytest.approx(STOP)
+    exact = np.array([exact_positions(t) for t in columns["time"]])
+    got = np.column_stack([columns["a.position"], columns["b.position"]])
+    return float(np.max(np.abs(got - exact)))
+
+
+@pytest.mark.parametrize("algorithm", ["jacobi", "gauss_seidel"])
+@pytest.mark.parametrize(("extrapolation", "order"), [("constant", 1), ("linear", 2)])
+def test_observed_convergence_order(fmus, tmp_path, algorithm, extrapolation, order):
+    steps = [0.01, 0.005, 0.0025]
+    errors = [final_error(fmus, tmp_path, step=h, algorithm=algorithm,
+                          extrapolation=extrapolation) for h in steps]
+    observed = [math.log2(errors[i] / errors[i + 1]) for i in range(len(errors) - 1)]
+    assert observed[-1] == pytest.approx(order, abs=0.3), (errors, observed)
+    assert errors[-1] < (5e-3 if order == 2 else 5e-2) * X0
+
+
+def test_gauss_seidel_beats_jacobi_at_the_same_order(fmus, tmp_path):
+    jacobi = final_error(fmus, tmp_path, step=0.01, algorithm="jacobi")
+    gauss_seidel = final_error(fmus, tmp_path, step=0.01, algorithm="gauss_seidel")
+    assert gauss_seidel < jacobi
+
+
+def test_constant_hold_injects_energy_linear_much_less(fmus, tmp_path):
+    """Zero-order hold creates energy at the bond (SPEC section 15); the residual shows it."""
+    _, constant = run(fmus, tmp_path, step=0.02, extrapolation="constant")
+    _, linear = run(fmus, tmp_path, step=0.02, extrapolation="linear")
+    assert abs(linear.bond_residual["spring"]) < 0.2 * abs(constant.bond_residual["spring"])
+
+
+def test_iteration_with_rollback_converges_to_a_smaller_error(fmus, tmp_path):
+    plain = final_error(fmus, tmp_path, step=0.02, algorithm="jacobi")
+    iterated = final_error(fmus, tmp_path, step=0.02, algorithm="jacobi", iterations=6,
+                           iteration_tolerance=1e-10)
+    assert iterated < 0.6 * plain
+
+
+def test_adaptive_step_keeps_the_bond_residual_per_step_below_tolerance(fmus, tmp_path):
+    columns, result = run(fmus, tmp_path, step=0.05, adaptive=True, energy_tolerance=1e-6,
+                          min_step=1e-4, max_step=0.05)
+    assert result.rejected > 0  # the first, too large steps were rejected
+    assert result.steps > STOP / 0.05
+    residual = np.diff(columns["bond.spring.energy_residual"])
+    assert np.max(np.abs(residual)) <= 1e-6 * (1 + 1e-9)

@@ -1,0 +1,85 @@
+"""Our FMUs by name, built on demand and rebuilt when the core has changed.
+
+A scene names one of our units (``fmu = "BlockTrain"``) or gives a path to
+any FMI 2.0 co-simulation FMU. Ours are built from the facade scripts in
+``models/`` into a cache folder (default ``dist/fmus`` in the source tree);
+an FMU whose recorded core fingerprint differs from the core imported here
+is rebuilt, since the version guard would refuse it anyway.
+"""
+
+from __future__ import annotations
+
+import logging
+import zipfile
+from pathlib import Path
+
+from wire_fmu._fingerprint import fingerprint, package_dir
+from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo
+
+__all__ = ["OUR_FMUS", "ROOT", "DEFAULT_FMU_DIR", "resolve_fmu", "is_ours", "ensure_built"]
+
+logger = logging.getLogger(__name__)
+
+ROOT = package_dir().parent
+DEFAULT_FMU_DIR = ROOT / "dist" / "fmus"
+OUR_FMUS = {
+    "BlockTrain": "block_train.py",
+    "Winch": "winch.py",
+    "Hydraulics": "hydraulics.py",
+}
+"""Model name -> facade script in ``models/``."""
+
+
+def is_ours(fmu: str) -> bool:
+    """Whether a scene's ``fmu`` names one of our units."""
+    return fmu in OUR_FMUS
+
+
+def resolve_fmu(fmu: str, base_dir: Path, fmu_dir: Path = DEFAULT_FMU_DIR) -> tuple[Path | None,
+                                                                                    str | None]:
+    """The FMU file for a scene's ``fmu`` entry, building ours if needed.
+
+    Returns ``(path, None)`` or ``(None, problem)``.
+    """
+    if is_ours(fmu):
+        script = ROOT / "models" / OUR_FMUS[fmu]
+        if not script.exists():
+            return None, f"our FMU {fmu!r} has no facade script {script}"
+        return ensure_built(fmu, script, fmu_dir), None
+    path = Path(fmu)
+    if not path.is_absolute():
+        path = base_dir / path
+    if path.suffix != ".fmu":
+        known = ", ".join(OUR_FMUS)
+        return None, f"{fmu!r} is neither one of our FMUs ({known}) nor a path to a .fmu file"
+    if not path.exists():
+        return None, f"FMU file {path} does not exist"
+    return path, None
+
+
+def _recorded_fingerprint(path: Path) -> str | None:
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = [n for n in archive.namelist() if n.endswith(BUILD_INFO_FILE)]
+            if not names:
+                return None
+            data = archive.read(names[0]).decode("utf-8")
+    except (OSError, zipfile.BadZipFile):
+        return None
+    import json
+
+    return BuildInfo(**{k: str(v) for k, v in json.loads(data).items()
+                        if k in BuildInfo.__dataclass_fields__}).fingerprint
+
+
+def ensure_built(name: str, script: Path, fmu_dir: Path) -> Path:
+    """Path of our FMU ``name``, (re)built from ``script`` if missing or stale."""
+    from wire_fmu.export.builder import build_fmu
+
+    path = fmu_dir / f"{name}.fmu"
+    current = fingerprint(package_dir())
+    if path.exists() and _recorded_fingerprint(path) == current:
+        return path
+    logger.info("building %s.fmu from %s", name, script.name)
+    fmu_dir.mkdir(parents=True, exist_ok=True)
+    return build_fmu(script, fmu_dir)

@@ -1,0 +1,68 @@
+"""PNG plots of a scene's key outputs, from its results file."""
+
+from __future__ import annotations
+
+import csv
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from .observers import LEDGER_CHANNEL
+from .scene import Scene
+
+__all__ = ["read_results", "plot_scene"]
+
+logger = logging.getLogger(__name__)
+
+
+def read_results(csv_path: Path) -> dict[str, np.ndarray]:
+    """Columns of a results file as float arrays, by name."""
+    with Path(csv_path).open(newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    data = np.array([[float(c) for c in row] for row in body]) if body else np.zeros((0, len(
+        header)))
+    return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def _figure(title: str, ylabel: str):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 4), dpi=100, layout="constrained")
+    ax = fig.add_subplot()
+    ax.set_title(title)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    return fig, ax
+
+
+def _slug(text: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in text.lower()).strip("_")
+
+
+def plot_scene(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
+    """One PNG per scene plot, plus the energy channels; returns the files."""
+    columns = read_results(csv_path)
+    time = columns["time"]
+    written = []
+    for spec in scene.plots:
+        fig, ax = _figure(spec.title, spec.ylabel)
+        for ref in spec.variables:
+            ax.plot(time, columns[str(ref)], label=str(ref))
+        ax.legend(loc="best", fontsize="small")
+        path = Path(directory) / f"{_slug(spec.title)}.png"
+        fig.savefig(path)
+        written.append(path)
+    energy = [c for c in columns if c.endswith(".energy_residual") or c == LEDGER_CHANNEL]
+    if energy:
+        fig, ax = _figure(f"{scene.name}: energy bookkeeping", "energy (J)")
+        for name in energy:
+            ax.plot(time, columns[name], label=name)
+        ax.legend(loc="best", fontsize="small")
+        path = Path(directory) / "energy.png"
+        fig.savefig(path)
+        written.append(path)
+    logger.info("plots: %s", ", ".join(str(p) for p in written))
+    return written

@@ -1,0 +1,105 @@
+"""Running a scene from Python in a few lines.
+
+>>> from wire_fmu.master.run import run_scene          # doctest: +SKIP
+>>> outcome = run_scene("riser_tensioner")             # doctest: +SKIP
+>>> outcome.csv_path                                   # doctest: +SKIP
+
+A scene is named (one we ship, see :func:`shipped_scenes`) or given by path.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .catalog import DEFAULT_FMU_DIR
+from .observers import CsvRecorder, Progress
+from .scene import Scene, SceneError, load_scene
+from .simulation import RunResult, Simulation
+from .validate import validate_scene
+
+__all__ = ["SCENE_DIR", "shipped_scenes", "find_scene", "run_scene", "Outcome"]
+
+logger = logging.getLogger(__name__)
+
+SCENE_DIR = Path(__file__).resolve().parents[1] / "scenes"
+
+
+def shipped_scenes() -> dict[str, Path]:
+    """Scenes we ship, by name."""
+    return {p.stem: p for p in sorted(SCENE_DIR.glob("*.toml"))}
+
+
+def find_scene(name_or_path: str | Path) -> Path:
+    """The scene file for a shipped name or a path.
+
+    Raises
+    ------
+    SceneError
+        Naming the shipped scenes when neither matches.
+    """
+    path = Path(name_or_path)
+    if path.suffix == ".toml" or path.exists():
+        if not path.exists():
+            raise SceneError(str(path), ["no such scene file"])
+        return path
+    shipped = shipped_scenes()
+    if str(name_or_path) in shipped:
+        return shipped[str(name_or_path)]
+    raise SceneError(str(name_or_path), [
+        f"not a shipped scene nor a file; shipped scenes: {', '.join(shipped) or 'none'}"])
+
+
+@dataclass
+class Outcome:
+    """What a run produced."""
+
+    scene: Scene
+    result: RunResult
+    directory: Path
+    csv_path: Path
+    plots: list[Path] = field(default_factory=list)
+    simulation: Simulation | None = None
+
+
+def run_scene(
+    scene: str | Path | Scene,
+    results: Path | None = None,
+    *,
+    progress: bool = False,
+    plots: bool = True,
+    fmu_dir: Path = DEFAULT_FMU_DIR,
+    observers=(),
+) -> Outcome:
+    """Validate and run a scene; write results (and plots) to ``results``.
+
+    Parameters
+    ----------
+    scene : str, Path or Scene
+        A shipped scene's name, a scene file, or a parsed scene.
+    results : Path, optional
+        Results folder (default ``results/<scene name>`` in the working folder).
+    progress : bool
+        Show a progress bar on stderr.
+    plots : bool
+        Draw the scene's plots as PNG files after the run.
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+    observers : sequence
+        More observers (see :class:`~wire_fmu.master.simulation.Observer`).
+    """
+    if not isinstance(scene, Scene):
+        scene = load_scene(find_scene(scene))
+    structure = validate_scene(scene, fmu_dir)
+    directory = Path(results) if results else Path("results") / scene.name
+    recorder = CsvRecorder(directory, scene.run.output_interval)
+    chain = [recorder, *observers] + ([Progress()] if progress else [])
+    sim = Simulation(scene, structure, chain)
+    result = sim.run()
+    outcome = Outcome(scene, result, directory, recorder.csv_path, simulation=sim)
+    if plots and scene.plots:
+        from .plots import plot_scene
+
+        outcome.plots = plot_scene(scene, recorder.csv_path, directory)
+    return outcome

@@ -1,0 +1,527 @@
+"""Scenes: which units, how they connect, what drives them, how to run.
+
+A scene is a TOML file (data only, nothing is executed). :func:`load_scene`
+reads it and :func:`parse_scene` turns the data into a :class:`Scene`,
+collecting every problem it can see without opening an FMU; the checks that
+need the units' model descriptions are in :mod:`wire_fmu.master.validate`.
+
+Format::
+
+    name = "riser_tensioner"
+    description = "..."
+
+    [run]
+    stop_time = 60.0          # s
+    step = 0.01               # s, macro (communication) step
+    algorithm = "gauss_seidel"        # or "jacobi"
+    extrapolation = "linear"          # "constant", "linear" or "quadratic"
+    output_interval = 0.05    # s
+    iterations = 1            # > 1: iterate each step with rollback
+    iteration_tolerance = 1e-6
+    adaptive = false          # macro step from the bonds' energy residual
+    energy_tolerance = 10.0   # J per step, with adaptive
+    min_step = 1e-4
+    max_step = 0.05
+
+    [units.rope]
+    fmu = "BlockTrain"        # one of ours by name, or a path to any FMI 2.0 CS FMU
+    effects = ["rope_damping"]
+    [units.rope.parameters]
+    pretension = 2.0e5
+    reeving = { ... }         # a table is passed to a String parameter as JSON
+
+    [[bonds]]                 # a power bond: effort one way, flow (and position) back
+    name = "rod"
+    kind = "translational"    # "translational", "rotational" or "rope"
+    effort = "rope.mover_a.force -> cylinder.rod.force"
+    flow = "cylinder.rod.velocity -> rope.mover_a.velocity"
+    position = "cylinder.rod.position -> rope.mover_a.position"
+
+    [[connections]]           # plain signals
+    from = "a.x"
+    to = "b.y"
+
+    [[drivers]]               # see wire_fmu.master.drivers
+    target = "rope.mover_b.position"
+    rate_target = "rope.mover_b.velocity"
+    kind = "sine"
+    amplitude = 1.5
+    period = 10.0
+
+    [[events]]
+    time = 30.0
+    label = "brake applied"
+    set = { "winch.brake.lever_force" = 2000.0 }
+
+    [outputs]
+    variables = ["rope.line_a.tension"]      # or "all"
+
+    [[plots]]
+    title = "Riser tension"
+    variables = ["rope.line_b.tension"]
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from wire_fmu.core.errors import ConfigurationError
+
+__all__ = [
+    "VarRef",
+    "UnitSpec",
+    "Connection",
+    "Bond",
+    "DriverSpec",
+    "EventSpec",
+    "RunSettings",
+    "PlotSpec",
+    "Scene",
+    "SceneError",
+    "load_scene",
+    "parse_scene",
+    "ALGORITHMS",
+    "EXTRAPOLATIONS",
+    "BOND_KINDS",
+]
+
+ALGORITHMS = ("jacobi", "gauss_seidel")
+EXTRAPOLATIONS = ("constant", "linear", "quadratic")
+BOND_KINDS = {
+    # kind: (effort unit, flow unit, position unit)
+    "translational": ("N", "m/s", "m"),
+    "rope": ("N", "m/s", "m"),
+    "rotational": ("N.m", "rad/s", "rad"),
+}
+
+
+class SceneError(ConfigurationError):
+    """A scene with problems; ``problems`` lists every one."""
+
+
+@dataclass(frozen=True, order=True)
+class VarRef:
+    """``unit.variable``: the first dotted component names the unit."""
+
+    unit: str
+    variable: str
+
+    def __str__(self) -> str:
+        return f"{self.unit}.{self.variable}"
+
+    @classmethod
+    def parse(cls, text: Any) -> VarRef | None:
+        """Parse ``"unit.variable.path"``; None if malformed."""
+        if not isinstance(text, str) or "." not in text.strip():
+            return None
+        unit, _, variable = text.strip().partition(".")
+        if not unit or not variable:
+            return None
+        return cls(unit, variable)
+
+
+@dataclass(frozen=True)
+class UnitSpec:
+    """One unit of the scene.
+
+    Attributes
+    ----------
+    name : str
+        Instance name used in connections.
+    fmu : str
+        Name of one of our FMUs (``"BlockTrain"``) or a path to an FMU.
+    effects : tuple of str
+        Effects to include (ours only); everything else is the simplest model.
+    parameters : dict
+        Parameter values; tables become JSON text for String parameters.
+    """
+
+    name: str
+    fmu: str
+    effects: tuple[str, ...] = ()
+    parameters: dict[str, Any] = field(default_factory=dict)
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Parameters as FMI values (tables and lists serialised to JSON)."""
+        out = {}
+        for key, value in self.parameters.items():
+            out[key] = json.dumps(value) if isinstance(value, Mapping | list) else value
+        return out
+
+
+@dataclass(frozen=True)
+class Connection:
+    """An output feeding an input.
+
+    ``role`` is ``"effort"``, ``"flow"`` or ``"position"`` inside a bond,
+    ``"signal"`` otherwise.
+    """
+
+    source: VarRef
+    target: VarRef
+    role: str = "signal"
+    bond: str | None = None
+    extrapolation: str | None = None
+
+
+@dataclass(frozen=True)
+class Bond:
+    """A power bond between two units (effort one way, flow back)."""
+
+    name: str
+    kind: str
+    effort: Connection
+    flow: Connection
+    position: Connection | None = None
+
+    @property
+    def connections(self) -> tuple[Connection, ...]:
+        """The bond's connections."""
+        return tuple(c for c in (self.effort, self.flow, self.position) if c is not None)
+
+
+@dataclass(frozen=True)
+class DriverSpec:
+    """A time signal on an input (and optionally its rate on another)."""
+
+    target: VarRef
+    spec: dict[str, Any]
+    rate_target: VarRef | None = None
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class EventSpec:
+    """Inputs set to new values at a scheduled time."""
+
+    time: float
+    values: dict[VarRef, Any]
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class PlotSpec:
+    """One figure of the scene's key outputs."""
+
+    title: str
+    variables: tuple[VarRef, ...]
+    ylabel: str = ""
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """How to run the scene (see the module docstring for the keys)."""
+
+    stop_time: float = 10.0
+    step: float = 0.01
+    algorithm: str = "gauss_seidel"
+    extrapolation: str = "linear"
+    output_interval: float | None = None
+    iterations: int = 1
+    iteration_tolerance: float = 1e-6
+    adaptive: bool = False
+    energy_tolerance: float = 10.0
+    min_step: float = 1e-5
+    max_step: float | None = None
+    order: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A parsed scene."""
+
+    name: str
+    description: str
+    units: dict[str, UnitSpec]
+    bonds: tuple[Bond, ...]
+    connections: tuple[Connection, ...]
+    drivers: tuple[DriverSpec, ...]
+    events: tuple[EventSpec, ...]
+    outputs: tuple[VarRef, ...] | None
+    plots: tuple[PlotSpec, ...]
+    run: RunSettings
+    base_dir: Path
+    source: Path | None = None
+
+    @property
+    def all_connections(self) -> tuple[Connection, ...]:
+        """Signal connections and every bond's connections."""
+        return self.connections + tuple(c for b in self.bonds for c in b.connections)
+
+
+_TOP_KEYS = {"name", "description", "run", "units", "bonds", "connections", "drivers",
+             "events", "outputs", "plots"}
+_RUN_KEYS = set(RunSettings.__dataclass_fields__)
+
+
+def load_scene(path: Path) -> Scene:
+    """Read and parse a scene file.
+
+    Raises
+    ------
+    SceneError
+        Listing every problem found.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except OSError as err:
+        raise SceneError(str(path), [f"cannot read the scene file: {err}"]) from None
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(str(path), [f"not valid TOML: {err}"]) from None
+    return parse_scene(data, base_dir=path.parent, source=path)
+
+
+def parse_scene(data: Mapping[str, Any], *, base_dir: Path, source: Path | None = None) -> Scene:
+    """Build a :class:`Scene` from plain data; raise :class:`SceneError` with every problem."""
+    problems: list[str] = []
+    for key in data:
+        if key not in _TOP_KEYS:
+            problems.append(f"unknown top-level key {key!r}; known: {', '.join(sorted(_TOP_KEYS))}")
+    name = str(data.get("name", source.stem if source else "scene"))
+    units = _parse_units(data.get("units", {}), problems)
+    bonds = _parse_bonds(data.get("bonds", []), problems)
+    connections = _parse_connections(data.get("connections", []), problems)
+    drivers = _parse_drivers(data.get("drivers", []), problems)
+    events = _parse_events(data.get("events", []), problems)
+    outputs = _parse_outputs(data.get("outputs", {}), problems)
+    plots = _parse_plots(data.get("plots", []), problems)
+    run = _parse_run(data.get("run", {}), problems)
+    if problems:
+        raise SceneError(f"scene {name!r}", problems)
+    return Scene(name, str(data.get("description", "")), units, bonds, connections, drivers,
+                 events, outputs, plots, run, Path(base_dir), source)
+
+
+def _as_list(value: Any, where: str, problems: list[str]) -> list:
+    if isinstance(value, list):
+        return value
+    problems.append(f"{where} must be a list of tables ([[{where}]])")
+    return []
+
+
+def _parse_units(data: Any, problems: list[str]) -> dict[str, UnitSpec]:
+    units: dict[str, UnitSpec] = {}
+    if not isinstance(data, Mapping) or not data:
+        problems.append("the scene needs a [units] table with at least one unit")
+        return units
+    for name, spec in data.items():
+        where = f"unit {name!r}"
+        if "." in name:
+            problems.append(f"{where}: a unit name may not contain '.'")
+        if not isinstance(spec, Mapping):
+            problems.append(f"{where}: must be a table")
+            continue
+        unknown = set(spec) - {"fmu", "effects", "parameters"}
+        if unknown:
+            problems.append(f"{where}: unknown keys {sorted(unknown)}; known: fmu, effects, "
+                            "parameters")
+        fmu = spec.get("fmu")
+        if not isinstance(fmu, str) or not fmu:
+            problems.append(f"{where}: 'fmu' must name one of our FMUs or give a path to one")
+            fmu = ""
+        effects = spec.get("effects", [])
+        if isinstance(effects, str):
+            effects = [e.strip() for e in effects.replace(",", " ").split() if e.strip()]
+        if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+            problems.append(f"{where}: 'effects' must be a list of effect names")
+            effects = []
+        params = spec.get("parameters", {})
+        if not isinstance(params, Mapping):
+            problems.append(f"{where}: 'parameters' must be a table")
+            params = {}
+        units[name] = UnitSpec(name, fmu, tuple(effects), dict(params))
+    return units
+
+
+def _parse_link(text: Any, where: str, problems: list[str]) -> tuple[VarRef, VarRef] | None:
+    if not isinstance(text, str) or "->" not in text:
+        problems.append(f"{where}: must read 'unit.output -> unit.input', got {text!r}")
+        return None
+    left, _, right = text.partition("->")
+    source, target = VarRef.parse(left), VarRef.parse(right)
+    if source is None or target is None:
+        problems.append(f"{where}: both sides must be 'unit.variable', got {text!r}")
+        return None
+    return source, target
+
+
+def _parse_bonds(data: Any, problems: list[str]) -> tuple[Bond, ...]:
+    bonds = []
+    names: set[str] = set()
+    for i, spec in enumerate(_as_list(data, "bonds", problems)):
+        if not isinstance(spec, Mapping):
+            problems.append(f"bond {i}: must be a table")
+            continue
+        name = str(spec.get("name", f"bond{i}"))
+        where = f"bond {name!r}"
+        if name in names:
+            problems.append(f"{where}: defined twice")
+        names.add(name)
+        kind = spec.get("kind")
+        if kind not in BOND_KINDS:
+            problems.append(f"{where}: 'kind' must be one of {sorted(BOND_KINDS)}, got {kind!r}")
+        extrapolation = spec.get("extrapolation")
+        if extrapolation is not None and extrapolation not in EXTRAPOLATIONS:
+            problems.append(f"{where}: 'extrapolation' must be one of {EXTRAPOLATIONS}")
+        links = {}
+        for role in ("effort", "flow", "position"):
+            if role not in spec:
+                if role != "position":
+                    problems.append(f"{where}: '{role}' is required")
+                continue
+            link = _parse_link(spec[role], f"{where} {role}", problems)
+            if link:
+                links[role] = Connection(*link, role=role, bond=name, extrapolation=extrapolation)
+        unknown = set(spec) - {"name", "kind", "effort", "flow", "position", "extrapolation"}
+        if unknown:
+            problems.append(f"{where}: unknown keys {sorted(unknown)}")
+        if "effort" in links and "flow" in links:
+            e, f = links["effort"], links["flow"]
+            if e.source.unit != f.target.unit or e.target.unit != f.source.unit:
+                problems.append(f"{where}: the effort must go from the unit the flow goes to "
+                                f"(effort {e.source.unit} -> {e.target.unit}, flow "
+                                f"{f.source.unit} -> {f.target.unit})")
+            bonds.append(Bond(name, str(kind), e, f, links.get("position")))
+    return tuple(bonds)
+
+
+def _parse_connections(data: Any, problems: list[str]) -> tuple[Connection, ...]:
+    out = []
+    for i, spec in enumerate(_as_list(data, "connections", problems)):
+        where = f"connection {i}"
+        if not isinstance(spec, Mapping):
+            problems.append(f"{where}: must be a table with 'from' and 'to'")
+            continue
+        source, target = VarRef.parse(spec.get("from")), VarRef.parse(spec.get("to"))
+        if source is None or target is None:
+            problems.append(f"{where}: 'from' and 'to' must be 'unit.variable'")
+            continue
+        extrapolation = spec.get("extrapolation")
+        if extrapolation is not None and extrapolation not in EXTRAPOLATIONS:
+            problems.append(f"{where}: 'extrapolation' must be one of {EXTRAPOLATIONS}")
+        out.append(Connection(source, target, extrapolation=extrapolation))
+    return tuple(out)
+
+
+def _parse_drivers(data: Any, problems: list[str]) -> tuple[DriverSpec, ...]:
+    out = []
+    for i, spec in enumerate(_as_list(data, "drivers", problems)):
+        if not isinstance(spec, Mapping):
+            problems.append(f"driver {i}: must be a table")
+            continue
+        target = VarRef.parse(spec.get("target"))
+        if target is None:
+            problems.append(f"driver {i}: 'target' must be 'unit.input'")
+            continue
+        rate = spec.get("rate_target")
+        rate_ref = VarRef.parse(rate) if rate is not None else None
+        if rate is not None and rate_ref is None:
+            problems.append(f"driver {i}: 'rate_target' must be 'unit.input'")
+        body = {k: v for k, v in spec.items() if k not in ("target", "rate_target", "label")}
+        out.append(DriverSpec(target, body, rate_ref, str(spec.get("label", ""))))
+    return tuple(out)
+
+
+def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
+    out = []
+    for i, spec in enumerate(_as_list(data, "events", problems)):
+        where = f"event {i}"
+        if not isinstance(spec, Mapping):
+            problems.append(f"{where}: must be a table")
+            continue
+        time = spec.get("time")
+        if not isinstance(time, int | float) or not math.isfinite(time) or time < 0:
+            problems.append(f"{where}: 'time' must be a number of seconds >= 0, got {time!r}")
+            continue
+        values = {}
+        raw = spec.get("set", {})
+        if not isinstance(raw, Mapping) or not raw:
+            problems.append(f"{where}: 'set' must be a table of 'unit.input' = value")
+            continue
+        for key, value in raw.items():
+            ref = VarRef.parse(key)
+            if ref is None:
+                problems.append(f"{where}: {key!r} is not 'unit.input'")
+            else:
+                values[ref] = value
+        out.append(EventSpec(float(time), values, str(spec.get("label", f"event {i}"))))
+    return tuple(sorted(out, key=lambda e: e.time))
+
+
+def _parse_outputs(data: Any, problems: list[str]) -> tuple[VarRef, ...] | None:
+    if not isinstance(data, Mapping):
+        problems.append("[outputs] must be a table with 'variables'")
+        return None
+    variables = data.get("variables", "all")
+    if variables == "all":
+        return None
+    if not isinstance(variables, list):
+        problems.append("outputs.variables must be \"all\" or a list of 'unit.variable'")
+        return None
+    refs = []
+    for text in variables:
+        ref = VarRef.parse(text)
+        if ref is None:
+            problems.append(f"outputs: {text!r} is not 'unit.variable'")
+        else:
+            refs.append(ref)
+    return tuple(refs)
+
+
+def _parse_plots(data: Any, problems: list[str]) -> tuple[PlotSpec, ...]:
+    out = []
+    for i, spec in enumerate(_as_list(data, "plots", problems)):
+        if not isinstance(spec, Mapping) or not isinstance(spec.get("variables"), list):
+            problems.append(f"plot {i}: needs 'title' and a list 'variables'")
+            continue
+        refs = [VarRef.parse(v) for v in spec["variables"]]
+        if any(r is None for r in refs):
+            problems.append(f"plot {i}: every variable must be 'unit.variable'")
+            continue
+        out.append(PlotSpec(str(spec.get("title", f"plot {i}")), tuple(refs),
+                            str(spec.get("ylabel", ""))))
+    return tuple(out)
+
+
+def _parse_run(data: Any, problems: list[str]) -> RunSettings:
+    if not isinstance(data, Mapping):
+        problems.append("[run] must be a table")
+        return RunSettings()
+    unknown = set(data) - _RUN_KEYS
+    if unknown:
+        problems.append(f"run: unknown keys {sorted(unknown)}; known: {sorted(_RUN_KEYS)}")
+    settings = RunSettings(**{k: (tuple(v) if k == "order" else v)
+                              for k, v in data.items() if k in _RUN_KEYS})
+    _check_run(settings, problems)
+    return settings
+
+
+def _positive(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(
+        value) and value > 0
+
+
+def _check_run(s: RunSettings, problems: list[str]) -> None:
+    for key in ("stop_time", "step", "iteration_tolerance", "energy_tolerance", "min_step"):
+        if not _positive(getattr(s, key)):
+            problems.append(f"run.{key} must be a positive number, got {getattr(s, key)!r}")
+    for key in ("output_interval", "max_step"):
+        value = getattr(s, key)
+        if value is not None and not _positive(value):
+            problems.append(f"run.{key} must be a positive number, got {value!r}")
+    if s.algorithm not in ALGORITHMS:
+        problems.append(f"run.algorithm must be one of {ALGORITHMS}, got {s.algorithm!r}")
+    if s.extrapolation not in EXTRAPOLATIONS:
+        problems.append(f"run.extrapolation must be one of {EXTRAPOLATIONS}, "
+                        f"got {s.extrapolation!r}")
+    if not isinstance(s.iterations, int) or isinstance(s.iterations, bool) or s.iterations < 1:
+        problems.append(f"run.iterations must be an integer >= 1, got {s.iterations!r}")
+    if not isinstance(s.adaptive, bool):
+        problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")

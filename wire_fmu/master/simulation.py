@@ -1,0 +1,424 @@
+"""Running a scene: units, connections, drivers, events, stepping, rollback.
+
+:class:`Simulation` owns the units (:class:`~wire_fmu.master.slave.Slave`,
+FMI only), the connections with their extrapolation histories, the
+manipulators (drivers and scheduled events, which set inputs) and the
+observers (which read: recorder, progress, energy monitor). One macro step:
+
+1. manipulators set driven inputs for ``[t, t + h]`` (a driven position
+   gets its value at ``t`` and its rate input the step's mean rate, so the
+   unit reaches the driver's value at ``t + h`` exactly);
+2. the coupling algorithm sets connected inputs and steps every unit;
+3. with ``iterations > 1`` the step is repeated from saved FMU states with
+   the sources' new values until the inputs stop changing;
+4. with ``adaptive`` the bonds' energy residual decides whether to accept
+   the step; a rejected (or refused) step is rolled back and retried shorter;
+5. accepted: histories advance (a unit whose ``mode_changes`` output moved
+   has its outgoing histories reset, so nothing extrapolates across a rope
+   break or a stick/slip switch), observers are told.
+
+Energy residual of a bond over a step (SPEC section 15): the flow side got
+``e_held * mean(flow)`` while the effort side gave ``mean(effort) * f_held``;
+their difference times ``h`` is energy the coupling created or destroyed.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections import defaultdict
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from .algorithms import make_algorithm, step_order
+from .drivers import make_driver
+from .extrapolation import History, held_value
+from .scene import Bond, Connection, Scene, VarRef
+from .slave import Slave, StepRefusedError, UnitFailedError
+from .validate import Structure, unit_start_values
+
+__all__ = ["Simulation", "Observer", "RunResult", "SimulationStoppedError"]
+
+logger = logging.getLogger(__name__)
+
+MODE_OUTPUT = "mode_changes"
+_PI = {"safety": 0.99, "k_p": 0.2, "k_i": 0.15, "shrink": 0.2, "grow": 1.5}
+
+
+class SimulationStoppedError(RuntimeError):
+    """A unit stopped the run; the message says which, when and why."""
+
+
+class Observer(Protocol):
+    """Reads the simulation; never changes it."""
+
+    def on_start(self, sim: Simulation) -> None:
+        """Called after initialisation, at the start time."""
+
+    def on_step(self, sim: Simulation) -> None:
+        """Called after every accepted macro step."""
+
+    def on_end(self, sim: Simulation, result: RunResult) -> None:
+        """Called once at the end, also after a failure or an interruption."""
+
+
+@dataclass
+class _Link:
+    connection: Connection
+    key: str  # source "unit.var"
+    target_vr: int
+    scheme: str
+
+
+@dataclass
+class _Driven:
+    driver: Any
+    target: VarRef
+    rate: VarRef | None
+
+
+@dataclass
+class _Attempt:
+    """One try at a macro step."""
+
+    accepted: bool
+    residuals: dict[str, float]
+    sweeps: int
+    new: dict[str, float] = field(default_factory=dict)
+    retry_step: float = 0.0
+    message: str = ""
+
+
+@dataclass
+class RunResult:
+    """Outcome of :meth:`Simulation.run`."""
+
+    status: str  # "finished", "stopped" (a unit refused or failed), "interrupted"
+    message: str = ""
+    end_time: float = 0.0
+    wall_time: float = 0.0
+    steps: int = 0
+    rejected: int = 0
+    iterations: int = 0
+    bond_residual: dict[str, float] = field(default_factory=dict)
+
+
+class Simulation:
+    """A scene ready to run.
+
+    Parameters
+    ----------
+    scene : Scene
+        The parsed scene.
+    structure : Structure
+        Its units' FMU paths and model descriptions (from validation).
+    observers : sequence of Observer
+        Recorders, progress displays, monitors.
+    """
+
+    def __init__(self, scene: Scene, structure: Structure, observers=()) -> None:
+        self.scene = scene
+        self.run_settings = scene.run
+        self.observers = list(observers)
+        self.slaves = {name: Slave(name, structure.paths[name]) for name in scene.units}
+        self.time = 0.0
+        self.step_size = scene.run.step
+        self._build_links()
+        self._build_drivers()
+        self.overrides: dict[VarRef, Any] = {}
+        self.pending_events = list(scene.events)
+        self.algorithm = make_algorithm(scene.run.algorithm, self._order(structure))
+        self.bond_residual = {b.name: 0.0 for b in scene.bonds}
+        self.bond_power = {b.name: 0.0 for b in scene.bonds}
+        self.held: dict[str, float] = {}
+        self.mode_counts: dict[str, int] = {}
+        self.result = RunResult("not started")
+        self._error_prev = 1.0
+
+    # -- structure -------------------------------------------------------------
+    def _build_links(self) -> None:
+        self.links_into: dict[str, list[_Link]] = defaultdict(list)
+        self.source_keys: dict[str, list[str]] = defaultdict(list)
+        for c in self.scene.all_connections:
+            slave = self.slaves[c.target.unit]
+            scheme = c.extrapolation or self.run_settings.extrapolation
+            key = str(c.source)
+            link = _Link(c, key, slave.vr(c.target.variable), scheme)
+            self.links_into[c.target.unit].append(link)
+            if key not in self.source_keys[c.source.unit]:
+                self.source_keys[c.source.unit].append(key)
+        self.source_vrs = {
+            unit: [self.slaves[unit].vr(k.split(".", 1)[1]) for k in keys]
+            for unit, keys in self.source_keys.items()
+        }
+        self.histories = {k: History() for keys in self.source_keys.values() for k in keys}
+
+    def _build_drivers(self) -> None:
+        self.driven: dict[str, list[_Driven]] = defaultdict(list)
+        for i, d in enumerate(self.scene.drivers):
+            driver, problems = make_driver(d.spec, where=f"driver {i}",
+                                           base_dir=self.scene.base_dir)
+            if problems:
+                raise ValueError("; ".join(problems))
+            self.driven[d.target.unit].append(_Driven(driver, d.target, d.rate_target))
+
+    def _order(self, structure: Structure) -> list[str]:
+        flows_to, feeds = defaultdict(set), defaultdict(set)
+        for c in self.scene.all_connections:
+            feeds[c.source.unit].add(c.target.unit)
+            if c.role != "effort":
+                flows_to[c.source.unit].add(c.target.unit)
+        return step_order(list(self.scene.units), flows_to, feeds, self.run_settings.order)
+
+    # -- initialisation ----------------------------------------------------------
+    def initialize(self) -> None:
+        """Instantiate, set parameters and start inputs, initialise in step order."""
+        start = 0.0
+        for name in self.algorithm.order:
+            slave = self.slaves[name]
+            slave.instantiate()
+            values = unit_start_values(self.scene.units[name], slave)
+            values.update(self._driven_values(name, start, None))
+            values.update(self._overrides_for(name, start))
+            slave.initialize(start, values)
+        for name in self.algorithm.order:  # sources first: their outputs feed the next
+            self._set_connected_from_latest(name)
+            self.slaves[name].exit_initialization()
+            self._push(name, start)
+        for name, slave in self.slaves.items():
+            if MODE_OUTPUT in slave.variables:
+                self.mode_counts[name] = int(slave.get([MODE_OUTPUT])[MODE_OUTPUT])
+        self.time = start
+
+    def _set_connected_from_latest(self, unit: str) -> None:
+        refs, values = [], []
+        for link in self.links_into.get(unit, ()):
+            if self.histories[link.key].points:
+                refs.append(link.target_vr)
+                values.append(self.histories[link.key].latest)
+        self.slaves[unit].set_reals(refs, values)
+
+    def _push(self, unit: str, t: float) -> None:
+        for key, value in self.read_sources(unit).items():
+            self.histories[key].push(t, value)
+
+    # -- what algorithms call ------------------------------------------------------
+    def read_sources(self, unit: str) -> dict[str, float]:
+        """Current values of ``unit``'s outputs that feed connections."""
+        keys = self.source_keys.get(unit, [])
+        return dict(zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])),
+                        strict=True))
+
+    def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
+        """Held values of every connected, driven or overridden input of ``unit``."""
+        refs, values = [], []
+        for link in self.links_into.get(unit, ()):
+            history = self.histories[link.key]
+            if link.connection.role == "position":
+                value = history.latest  # the unit advances it with the held velocity
+            else:
+                value = held_value(history, t, h, link.scheme,
+                                   None if fresh is None else fresh.get(link.key))
+            refs.append(link.target_vr)
+            values.append(value)
+            self.held[f"{link.connection.target}"] = value
+        slave = self.slaves[unit]
+        slave.set_reals(refs, values)
+        driven = self._driven_values(unit, t, h)
+        driven.update(self._overrides_for(unit, t))
+        if driven:
+            slave.set_many(driven)
+
+    def step_unit(self, unit: str, t: float, h: float) -> None:
+        """Step one unit (errors propagate as StepRefusedError / UnitFailedError)."""
+        self.slaves[unit].do_step(t, h)
+
+    # -- manipulators -------------------------------------------------------------------
+    def _driven_values(self, unit: str, t: float, h: float | None) -> dict[str, float]:
+        out = {}
+        for d in self.driven.get(unit, ()):
+            if d.rate is None:  # held at the step's midpoint: second order
+                out[d.target.variable] = d.driver.value(t if h is None else t + 0.5 * h)
+            else:  # position now, mean rate over the step: the unit lands on value(t + h)
+                out[d.target.variable] = d.driver.value(t)
+                out[d.rate.variable] = (d.driver.rate(t) if not h else
+                                        (d.driver.value(t + h) - d.driver.value(t)) / h)
+        return out
+
+    def _overrides_for(self, unit: str, t: float) -> dict[str, Any]:
+        return {ref.variable: v for ref, v in self.overrides.items() if ref.unit == unit}
+
+    def _apply_events(self, t: float) -> list[str]:
+        fired = []
+        while self.pending_events and self.pending_events[0].time <= t + 1e-12:
+            event = self.pending_events.pop(0)
+            self.overrides.update(event.values)
+            fired.append(event.label)
+            logger.info("t = %.6g s: %s", t, event.label)
+        if fired:
+            for history in self.histories.values():
+                history.reset()
+        return fired
+
+    # -- one macro step -----------------------------------------------------------------
+    def _save(self):
+        return {name: s.get_state() for name, s in self.slaves.items()}
+
+    def _restore(self, states) -> None:
+        for name, state in states.items():
+            self.slaves[name].set_state(state)
+
+    def _free(self, states) -> None:
+        for name, state in states.items():
+            self.slaves[name].free_state(state)
+
+    def _read_all(self) -> dict[str, float]:
+        new = {}
+        for unit in self.slaves:
+            new.update(self.read_sources(unit))
+        return new
+
+    def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
+        self.algorithm.sweep(self, t, h)
+        new = self._read_all()
+        sweeps = 1
+        for _ in range(self.run_settings.iterations - 1):
+            before = dict(self.held)
+            self._restore(states)
+            self.algorithm.sweep(self, t, h, fresh=new)
+            new = self._read_all()
+            sweeps += 1
+            change = max((abs(self.held[k] - before.get(k, 0.0)) /
+                          max(1.0, abs(self.held[k])) for k in self.held), default=0.0)
+            if change < self.run_settings.iteration_tolerance:
+                break
+        return new, sweeps
+
+    def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
+        """Energy each bond's coupling created over the step just taken, J."""
+        out = {}
+        for bond in self.scene.bonds:
+            out[bond.name] = self._bond_residual(bond, new, h)
+        return out
+
+    def _bond_residual(self, bond: Bond, new: dict[str, float], h: float) -> float:
+        e_key, f_key = str(bond.effort.source), str(bond.flow.source)
+        e0, f0 = self.histories[e_key].latest, self.histories[f_key].latest
+        e1, f1 = new[e_key], new[f_key]
+        e_held = self.held.get(str(bond.effort.target), e0)
+        f_held = self.held.get(str(bond.flow.target), f0)
+        self.bond_power[bond.name] = e_held * 0.5 * (f0 + f1)
+        return h * (e_held * 0.5 * (f0 + f1) - 0.5 * (e0 + e1) * f_held)
+
+    def _attempt(self, t: float, h: float) -> _Attempt:
+        """Take one macro step, rolling back when it is refused or rejected."""
+        rollback = self.run_settings.iterations > 1 or self.run_settings.adaptive
+        states = self._save() if rollback else None
+        try:
+            if states is not None:
+                new, sweeps = self._sweep_iterated(t, h, states)
+            else:
+                self.algorithm.sweep(self, t, h)
+                new, sweeps = self._read_all(), 1
+        except StepRefusedError as exc:
+            if states is None:
+                raise SimulationStoppedError(str(exc)) from None
+            self._restore(states)
+            self._free(states)
+            return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
+        residuals = self.bond_residuals(new, h)
+        if self.run_settings.adaptive:
+            error = max((abs(r) for r in residuals.values()), default=0.0)
+            error /= self.run_settings.energy_tolerance
+            if error > 1.0 and h > self.run_settings.min_step * (1 + 1e-9):
+                self._restore(states)
+                self._free(states)
+                return _Attempt(False, residuals, sweeps, retry_step=new_h(h, error),
+                                message=f"bond energy residual {error:.3g} x tolerance")
+        if states is not None:
+            self._free(states)
+        return _Attempt(True, residuals, sweeps, new)
+
+    def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
+        for key, value in new.items():
+            self.histories[key].push(t + h, value)
+        for name, r in residuals.items():
+            self.bond_residual[name] += r
+        for name, before in self.mode_counts.items():
+            now = int(self.slaves[name].get([MODE_OUTPUT])[MODE_OUTPUT])
+            if now != before:
+                self.mode_counts[name] = now
+                for key in self.source_keys.get(name, ()):
+                    self.histories[key].reset()
+        self.time = t + h
+
+    def _next_step(self, h: float, residuals) -> float:
+        s = self.run_settings
+        if not s.adaptive:
+            return s.step
+        error = max((abs(r) for r in residuals.values()), default=0.0) / s.energy_tolerance
+        error = max(error, 1e-10)
+        factor = _PI["safety"] * error ** -_PI["k_i"] * (self._error_prev / error) ** _PI["k_p"]
+        self._error_prev = error
+        factor = min(_PI["grow"], max(_PI["shrink"], factor))
+        return min(s.max_step or math.inf, max(s.min_step, h * factor))
+
+    # -- the run --------------------------------------------------------------------------
+    def run(self) -> RunResult:
+        """Initialise and run to the stop time; observers see every accepted step."""
+        wall = time.perf_counter()
+        result = RunResult("finished")
+        try:
+            self.initialize()
+            self._apply_events(self.time)
+            for obs in self.observers:
+                obs.on_start(self)
+            self._loop(result)
+        except KeyboardInterrupt:
+            result.status, result.message = "interrupted", f"interrupted at t = {self.time:.6g} s"
+        except (SimulationStoppedError, UnitFailedError, StepRefusedError) as exc:
+            result.status, result.message = "stopped", str(exc)
+            logger.error("%s", exc)
+        finally:
+            result.end_time, result.wall_time = self.time, time.perf_counter() - wall
+            result.bond_residual = dict(self.bond_residual)
+            self.result = result
+            for obs in self.observers:
+                obs.on_end(self, result)
+            for slave in self.slaves.values():
+                slave.terminate()
+        return result
+
+    def _loop(self, result: RunResult) -> None:
+        stop = self.run_settings.stop_time
+        h = self.run_settings.step
+        while self.time < stop - 1e-12:
+            t = self.time
+            h = min(h, stop - t)
+            if self.pending_events:
+                h = min(h, self.pending_events[0].time - t) if self.pending_events[0].time > t \
+                    else h
+            attempt = self._attempt(t, h)
+            result.iterations += attempt.sweeps
+            if not attempt.accepted:
+                result.rejected += 1
+                if h <= self.run_settings.min_step * (1 + 1e-9):
+                    raise SimulationStoppedError(f"step refused at the minimum step "
+                                            f"{self.run_settings.min_step:g} s: "
+                                            f"{attempt.message}")
+                h = max(self.run_settings.min_step, attempt.retry_step)
+                logger.debug("t = %.6g s: step rejected (%s), retrying with %.3g s", t,
+                             attempt.message, h)
+                continue
+            self._accept(t, h, attempt.new, attempt.residuals)
+            result.steps += 1
+            self._apply_events(self.time)
+            for obs in self.observers:
+                obs.on_step(self)
+            h = self._next_step(h, attempt.residuals)
+
+
+def new_h(h: float, error: float) -> float:
+    """A shorter step after a rejection, from the error ratio (> 1)."""
+    return h * max(_PI["shrink"], min(0.9, 0.9 * error ** -0.5))

@@ -1,0 +1,241 @@
+"""One co-simulation unit as the master sees it: an FMI 2.0 CS FMU behind fmpy.
+
+The master reaches units only through this class, so it runs any FMI 2.0
+co-simulation FMU, not only ours. It adds name-based access with cached
+value references, typed setters, FMU state save/restore, per-call counts
+and time, and routes the FMU's log messages into Python logging (and keeps
+the ones of status Warning or worse so a refused step can be explained).
+
+fmpy keeps the logger callback it is handed in one global of a native
+library for the whole process, so the callback objects are kept alive in
+:data:`_CALLBACKS_ALIVE` for as long as the process lives (the only
+module-level state of the master, and it only grows by one per process).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import time
+from collections import defaultdict
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fmpy import calloc, extract, free, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+from fmpy.logging import addLoggerProxy
+
+__all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS"]
+
+logger = logging.getLogger(__name__)
+
+FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
+_CALLBACKS_ALIVE: list[object] = []
+
+
+class StepRefusedError(RuntimeError):
+    """A unit answered a step with fmi2Discard (a physical or numerical stop)."""
+
+
+class UnitFailedError(RuntimeError):
+    """A unit answered with fmi2Error or fmi2Fatal."""
+
+
+@dataclass
+class _Messages:
+    """Log messages of one FMU instance (Warning or worse are kept)."""
+
+    name: str
+    kept: list[str] = field(default_factory=list)
+
+    def __call__(self, env, instance, status, category, message) -> None:
+        text = message.decode("utf-8", "replace") if message else ""
+        level = {0: logging.DEBUG, 1: logging.WARNING, 2: logging.WARNING}.get(status,
+                                                                                logging.ERROR)
+        logger.log(level, "%s [%s]: %s", self.name, FMI_STATUS.get(status, status), text)
+        if status >= 1:
+            self.kept.append(text)
+
+
+def _callbacks(messages: _Messages) -> fmi2CallbackFunctions:
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(messages)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    addLoggerProxy(ctypes.byref(callbacks))
+    _CALLBACKS_ALIVE.append(callbacks)
+    return callbacks
+
+
+class Slave:
+    """An instantiated FMU.
+
+    Parameters
+    ----------
+    name : str
+        Instance name (the scene's unit name).
+    path : Path
+        The ``.fmu`` file.
+    """
+
+    def __init__(self, name: str, path: Path) -> None:
+        self.name = name
+        self.path = Path(path)
+        self.model_description = read_model_description(str(self.path))
+        self.variables = {v.name: v for v in self.model_description.modelVariables}
+        self.calls: dict[str, int] = defaultdict(int)
+        self.seconds: dict[str, float] = defaultdict(float)
+        self.messages = _Messages(name)
+        self._fmu: FMU2Slave | None = None
+
+    # -- description ---------------------------------------------------------
+    @property
+    def can_save_state(self) -> bool:
+        """Whether the FMU can get and set its state (needed for rollback)."""
+        cs = self.model_description.coSimulation
+        return bool(cs and cs.canGetAndSetFMUstate)
+
+    def output_dependencies(self) -> dict[str, list[str] | None]:
+        """For each output, the inputs it depends on directly (None: all, per FMI)."""
+        out = {}
+        for unknown in self.model_description.outputs:
+            deps = unknown.dependencies
+            out[unknown.variable.name] = None if deps is None else [d.name for d in deps]
+        return out
+
+    def vr(self, name: str) -> int:
+        """Value reference of ``name``."""
+        return self.variables[name].valueReference
+
+    # -- life cycle ------------------------------------------------------------
+    def instantiate(self, unzipdir: str | None = None) -> None:
+        """Load the binary and instantiate (logging on, into Python logging)."""
+        md = self.model_description
+        self._fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir or extract(str(self.path)),
+                              modelIdentifier=md.coSimulation.modelIdentifier,
+                              instanceName=self.name)
+        self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
+
+    def initialize(self, start_time: float, values: dict[str, Any], inputs_first=None) -> None:
+        """Set ``values`` (parameters, start inputs), then enter initialisation mode."""
+        self._call("setupExperiment", startTime=start_time)
+        self.set_many(values)
+        self._call("enterInitializationMode")
+
+    def exit_initialization(self) -> None:
+        """Leave initialisation mode."""
+        self._call("exitInitializationMode")
+
+    def terminate(self) -> None:
+        """Terminate and free the instance (errors ignored: we are cleaning up)."""
+        if self._fmu is None:
+            return
+        for fn in ("terminate", "freeInstance"):
+            try:
+                getattr(self._fmu, fn)()
+            except Exception as exc:  # noqa: BLE001 - cleaning up, report and go on
+                logger.debug("%s: %s failed during cleanup: %s", self.name, fn, exc)
+        self._fmu = None
+
+    # -- values ------------------------------------------------------------------
+    def set_many(self, values: dict[str, Any]) -> None:
+        """Set variables by name, grouped by type."""
+        groups: dict[str, tuple[list[int], list[Any]]] = defaultdict(lambda: ([], []))
+        for name, value in values.items():
+            var = self.variables[name]
+            refs, vals = groups[var.type]
+            refs.append(var.valueReference)
+            vals.append(_coerce(var.type, value))
+        for kind, (refs, vals) in groups.items():
+            self._call(f"set{kind}", refs, vals)
+
+    def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
+        """Fast path: set Reals by value reference."""
+        if refs:
+            self._call("setReal", list(refs), list(values))
+
+    def get_reals(self, refs: Sequence[int]) -> list[float]:
+        """Fast path: get Reals by value reference."""
+        return self._call("getReal", list(refs)) if refs else []
+
+    def get(self, names: Iterable[str]) -> dict[str, Any]:
+        """Values of variables by name."""
+        out = {}
+        by_type: dict[str, list[str]] = defaultdict(list)
+        for name in names:
+            by_type[self.variables[name].type].append(name)
+        for kind, group in by_type.items():
+            values = self._call(f"get{kind}", [self.vr(n) for n in group])
+            out.update(zip(group, values, strict=True))
+        return out
+
+    # -- stepping and state ---------------------------------------------------------
+    def do_step(self, t: float, h: float) -> None:
+        """One communication step.
+
+        Raises
+        ------
+        StepRefusedError
+            On fmi2Discard, with the unit's last messages.
+        UnitFailedError
+            On fmi2Error or fmi2Fatal.
+        """
+        self.messages.kept.clear()
+        try:
+            self._call("doStep", currentCommunicationPoint=t, communicationStepSize=h)
+        except FMICallException as exc:
+            said = "; ".join(self.messages.kept[-3:]) or "no message"
+            if exc.status == 2:
+                raise StepRefusedError(f"unit {self.name!r} refused the step at t = {t:.6g} s "
+                                  f"(h = {h:.3g} s): {said}") from None
+            raise UnitFailedError(f"unit {self.name!r} failed at t = {t:.6g} s with "
+                             f"{FMI_STATUS.get(exc.status, exc.status)}: {said}") from None
+
+    def get_state(self) -> object:
+        """Save the FMU state (for rollback)."""
+        return self._call("getFMUstate")
+
+    def set_state(self, state: object) -> None:
+        """Restore a saved FMU state."""
+        self._call("setFMUstate", state)
+
+    def free_state(self, state: object) -> None:
+        """Free a saved FMU state."""
+        self._call("freeFMUstate", state)
+
+    def _call(self, fn: str, *args, **kwargs):
+        if self._fmu is None:
+            raise UnitFailedError(f"unit {self.name!r} is not instantiated")
+        start = time.perf_counter()
+        try:
+            if fn == "instantiate":
+                return self._fmu.instantiate(*args, **kwargs)
+            return getattr(self._fmu, fn)(*args, **kwargs)
+        except FMICallException as exc:
+            if fn == "doStep":
+                raise
+            said = "; ".join(self.messages.kept[-5:]) or "no message"
+            raise UnitFailedError(f"unit {self.name!r}: {fn} failed with "
+                             f"{FMI_STATUS.get(exc.status, exc.status)}: {said}") from None
+        finally:
+            self.calls[fn] += 1
+            self.seconds[fn] += time.perf_counter() - start
+
+
+def _coerce(kind: str, value: Any) -> Any:
+    if kind == "Real":
+        return float(value)
+    if kind in ("Integer", "Enumeration"):
+        return int(value)
+    if kind == "Boolean":
+        return bool(value)
+    return str(value)

@@ -1,0 +1,255 @@
+"""Check a scene against its units' model descriptions, before anything runs.
+
+Every problem is collected, each naming the unit and variable, in the manner
+of libcosim's ``system_structure`` and Drake's ``DiagramBuilder``: unknown
+units, variables and effects; inputs fed twice; outputs fed into outputs;
+unit and type mismatches; a bond whose effort and flow do not make a power;
+algebraic loops through direct feedthrough; drivers, events, recorded and
+plotted variables that do not exist. :func:`check_through_fmi` then
+instantiates each unit with its parameters and enters initialisation mode,
+so a unit's own configuration problems (a malformed reeving, an unknown
+effect) are reported too — through FMI only.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import defaultdict
+from dataclasses import dataclass
+from pathlib import Path
+
+from fmpy import read_model_description
+
+from .catalog import DEFAULT_FMU_DIR, is_ours, resolve_fmu
+from .scene import BOND_KINDS, Scene, SceneError, VarRef
+
+__all__ = ["Structure", "resolve_units", "check_structure", "check_through_fmi",
+           "validate_scene", "feedthrough_loops"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Structure:
+    """Model descriptions of a scene's units, by unit name."""
+
+    paths: dict[str, Path]
+    descriptions: dict[str, object]
+
+    def variable(self, ref: VarRef):
+        """The model variable ``ref`` names, or None."""
+        md = self.descriptions.get(ref.unit)
+        if md is None:
+            return None
+        for var in md.modelVariables:
+            if var.name == ref.variable:
+                return var
+        return None
+
+    def dependencies(self, unit: str) -> dict[str, list[str]]:
+        """Each output's direct-feedthrough inputs (all inputs when undeclared)."""
+        md = self.descriptions[unit]
+        inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+        out = {}
+        for unknown in md.outputs:
+            deps = unknown.dependencies
+            out[unknown.variable.name] = inputs if deps is None else [d.name for d in deps]
+        return out
+
+
+def resolve_units(scene: Scene, fmu_dir: Path = DEFAULT_FMU_DIR) -> tuple[Structure, list[str]]:
+    """Find (and build) every unit's FMU and read its model description."""
+    problems, paths, descriptions = [], {}, {}
+    for name, spec in scene.units.items():
+        path, problem = resolve_fmu(spec.fmu, scene.base_dir, fmu_dir)
+        if problem:
+            problems.append(f"unit {name!r}: {problem}")
+            continue
+        try:
+            md = read_model_description(str(path))
+        except Exception as exc:  # noqa: BLE001 - any unreadable FMU is a scene problem
+            problems.append(f"unit {name!r}: cannot read {path}: {exc}")
+            continue
+        if md.coSimulation is None or md.fmiVersion != "2.0":
+            problems.append(f"unit {name!r}: {path.name} is not an FMI 2.0 co-simulation FMU")
+            continue
+        paths[name], descriptions[name] = path, md
+    return Structure(paths, descriptions), problems
+
+
+def _variable_problem(structure: Structure, ref: VarRef, causality: str, what: str) -> str | None:
+    if ref.unit not in structure.descriptions:
+        return f"{what} {ref}: there is no unit {ref.unit!r}"
+    var = structure.variable(ref)
+    if var is None:
+        md = structure.descriptions[ref.unit]
+        names = [v.name for v in md.modelVariables if v.causality == causality]
+        return (f"{what} {ref}: unit {ref.unit!r} has no variable {ref.variable!r}; its "
+                f"{causality}s: {', '.join(names)}")
+    if var.causality != causality:
+        hint = " (an output cannot feed an output)" if causality == "input" else ""
+        return f"{what} {ref}: is an {var.causality}, expected an {causality}{hint}"
+    return None
+
+
+def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
+    problems, fed = [], defaultdict(list)
+    for c in scene.all_connections:
+        what = f"bond {c.bond!r} {c.role}" if c.bond else "connection"
+        p_src = _variable_problem(structure, c.source, "output", f"{what} from")
+        p_dst = _variable_problem(structure, c.target, "input", f"{what} to")
+        problems += [p for p in (p_src, p_dst) if p]
+        fed[c.target].append(f"{what} from {c.source}")
+        if p_src or p_dst:
+            continue
+        src, dst = structure.variable(c.source), structure.variable(c.target)
+        if src.type != dst.type:
+            problems.append(f"{what} {c.source} -> {c.target}: type {src.type} feeds {dst.type}")
+        elif src.type == "Real" and (src.unit or "") != (dst.unit or ""):
+            problems.append(f"{what} {c.source} -> {c.target}: unit mismatch, "
+                            f"{src.unit or 'no unit'} feeds {dst.unit or 'no unit'}")
+    for d in scene.drivers:
+        for ref in (d.target, d.rate_target):
+            if ref is not None:
+                fed[ref].append("a driver")
+    for target, sources in fed.items():
+        if len(sources) > 1:
+            problems.append(f"input {target} is fed twice: by {' and by '.join(sources)}")
+    return problems
+
+
+def _bond_problems(scene: Scene, structure: Structure) -> list[str]:
+    problems = []
+    for bond in scene.bonds:
+        units = dict(zip(("effort", "flow", "position"), BOND_KINDS.get(bond.kind, ()),
+                         strict=False))
+        for c in bond.connections:
+            var = structure.variable(c.source)
+            if var is None or var.type != "Real":
+                continue
+            expected = units.get(c.role)
+            if expected and (var.unit or "") != expected:
+                noun = {"effort": "an effort", "flow": "a flow", "position": "a position"}[c.role]
+                problems.append(
+                    f"bond {bond.name!r} ({bond.kind}): {c.source} has unit "
+                    f"{var.unit or 'none'} but {noun} of a {bond.kind} bond is in {expected} "
+                    f"(a force must pair with its velocity, a torque with its angular velocity)")
+    return problems
+
+
+def feedthrough_loops(scene: Scene, structure: Structure) -> list[list[str]]:
+    """Cycles of the signal graph through direct feedthrough (algebraic loops)."""
+    graph: dict[str, list[str]] = defaultdict(list)
+    for c in scene.all_connections:
+        graph[str(c.source)].append(str(c.target))
+    for unit in structure.descriptions:
+        for output, inputs in structure.dependencies(unit).items():
+            for name in inputs:
+                graph[f"{unit}.{name}"].append(f"{unit}.{output}")
+    loops, colour, stack = [], {}, []
+
+    def visit(node: str) -> None:
+        colour[node] = 1
+        stack.append(node)
+        for nxt in graph.get(node, ()):
+            if colour.get(nxt) == 1:
+                loops.append(stack[stack.index(nxt):] + [nxt])
+            elif nxt not in colour:
+                visit(nxt)
+        stack.pop()
+        colour[node] = 2
+
+    for node in list(graph):
+        if node not in colour:
+            visit(node)
+    return loops
+
+
+def _other_problems(scene: Scene, structure: Structure) -> list[str]:
+    problems = []
+    for d in scene.drivers:
+        for ref in (d.target, d.rate_target):
+            if ref is not None:
+                p = _variable_problem(structure, ref, "input", "driver target")
+                problems += [p] if p else []
+    for e in scene.events:
+        if e.time > scene.run.stop_time:
+            problems.append(f"event {e.label!r} at {e.time} s is after the stop time")
+        for ref in e.values:
+            p = _variable_problem(structure, ref, "input", f"event {e.label!r} sets")
+            problems += [p] if p else []
+    for ref in list(scene.outputs or ()) + [r for p in scene.plots for r in p.variables]:
+        if ref.unit not in structure.descriptions or structure.variable(ref) is None:
+            problems.append(f"recorded/plotted variable {ref} does not exist")
+    for name, spec in scene.units.items():
+        md = structure.descriptions.get(name)
+        if md is None:
+            continue
+        params = {v.name for v in md.modelVariables if v.causality in ("parameter", "input")}
+        for key in spec.parameters:
+            if key not in params:
+                problems.append(f"unit {name!r}: no parameter {key!r}")
+        if spec.effects and not is_ours(spec.fmu) and "effects" not in params:
+            problems.append(f"unit {name!r}: effects are only known for our FMUs")
+    needs_state = scene.run.iterations > 1 or scene.run.adaptive
+    if needs_state:
+        for name, md in structure.descriptions.items():
+            if not md.coSimulation.canGetAndSetFMUstate:
+                problems.append(f"unit {name!r} cannot save its state, which iteration and "
+                                "adaptive steps need (rollback)")
+    return problems
+
+
+def check_structure(scene: Scene, structure: Structure) -> list[str]:
+    """Every structural problem of ``scene`` (empty when sound)."""
+    problems = _connection_problems(scene, structure) + _bond_problems(scene, structure)
+    for loop in feedthrough_loops(scene, structure):
+        problems.append("algebraic loop through direct feedthrough: " + " -> ".join(loop))
+    problems += _other_problems(scene, structure)
+    from .drivers import make_driver
+
+    for i, d in enumerate(scene.drivers):
+        _, more = make_driver(d.spec, where=f"driver {i} ({d.target})", base_dir=scene.base_dir)
+        problems += more
+    return problems
+
+
+def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
+    """Instantiate each unit with its parameters and enter initialisation mode."""
+    from .slave import Slave, UnitFailedError
+
+    problems = []
+    for name, spec in scene.units.items():
+        if name not in structure.paths:
+            continue
+        slave = Slave(name, structure.paths[name])
+        try:
+            slave.instantiate()
+            slave.initialize(0.0, unit_start_values(spec, slave))
+        except UnitFailedError:
+            said = slave.messages.kept or ["the unit refused its parameters"]
+            problems += [f"unit {name!r}: {m}" for m in said]
+        finally:
+            slave.terminate()
+    return problems
+
+
+def unit_start_values(spec, slave) -> dict:
+    """Parameters (and the effects list of ours) as FMI values for ``slave``."""
+    values = spec.parameter_values()
+    if spec.effects or is_ours(spec.fmu):
+        if "effects" in slave.variables:
+            values["effects"] = ",".join(spec.effects)
+    return values
+
+
+def validate_scene(scene: Scene, fmu_dir: Path = DEFAULT_FMU_DIR, *,
+                   through_fmi: bool = True) -> Structure:
+    """All checks; raise :class:`SceneError` listing every problem."""
+    structure, problems = resolve_units(scene, fmu_dir)
+    problems += check_structure(scene, structure)
+    if through_fmi and not problems:
+        problems += check_through_fmi(scene, structure)
+    if problems:
+        raise SceneError(f"scene {scene.name!r}", problems)
+    return structure
