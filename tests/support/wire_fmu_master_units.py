@@ -41,6 +41,8 @@ class CoupledMassUnit(Unit):
         input_("flange.velocity", 0.0, "m/s", "Velocity of the partner's flange"),
         output("force_on_flange", "N", "Spring-damper force on the partner's flange, along x",
                depends_on=_FLANGE),
+        output("stretch", "m", "Coupling spring stretch, mass minus flange position",
+               depends_on=_FLANGE),
         output("position", "m", "Position of the mass"),
         output("velocity", "m/s", "Velocity of the mass"),
         output("stored_energy", "J", "Kinetic and spring energy", depends_on=_FLANGE),
@@ -99,6 +101,7 @@ class CoupledMassUnit(Unit):
         p, (x, v, dissipated, work) = self.values, self._y
         p["force_on_flange"] = float(self._spring(x, v, xf, vf))
         p["position"], p["velocity"] = float(x), float(v)
+        p["stretch"] = float(x - xf)
         energy = 0.5 * p["mass"] * v * v + 0.5 * p["stiffness"] * (x - xf) ** 2
         energy += 0.5 * p["ground_stiffness"] * x * x
         p["stored_energy"] = float(energy)
