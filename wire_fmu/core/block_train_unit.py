@@ -86,6 +86,10 @@ def _variables():
             output(f"{p}.velocity", "m/s", f"Velocity of block {p} along its direction"),
         ]
     outputs += [
+        output("path_start.tension", "N", "Rope tension at the first node of the path",
+               depends_on=deps),
+        output("path_end.tension", "N", "Rope tension at the last node of the path",
+               depends_on=deps),
         output("tension_max", "N", "Largest rope tension in any span", depends_on=deps),
         output("slack_spans", "", "Number of slack rope spans", type=int, depends_on=deps),
         output("broken", "", "Whether any rope span has broken", type=bool),
@@ -252,6 +256,8 @@ class BlockTrainUnit(Unit):
             if body.port:
                 out[f"{body.port}.position"] = float(body.position + m.q[j])
                 out[f"{body.port}.velocity"] = float(m.v[j])
+        out["path_start.tension"] = float(tension[0])
+        out["path_end.tension"] = float(tension[-1])
         out["tension_max"] = float(tension.max()) if tension.size else 0.0
         out["slack_spans"] = int(np.count_nonzero(~m.taut_mask & ~m.broken_mask))
         out["broken"] = any(m.broken)

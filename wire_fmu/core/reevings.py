@@ -17,7 +17,8 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["drilling_line", "drilling_block_train", "single_fall"]
+__all__ = ["drilling_line", "drilling_block_train", "single_fall", "riser_tensioner",
+           "tensioner_line"]
 
 GRAVITY = (0.0, -9.81, 0.0)
 
@@ -100,6 +101,86 @@ def drilling_block_train(
         "anchors": {"deadline": {"body": "ground",
                                  "point": [(2 * n_lines) * radius + radius, 0.0, 0.0]}},
         "path": path,
+    }
+
+
+def tensioner_line() -> dict[str, float]:
+    """A 2-1/4 in (57 mm) 6x41 IWRC tensioner wire: EA about 1.3e8 N, MBL about 2.8 MN,
+    about 13.5 kg/m (manufacturers' tables for 2-1/4 in 6x36/6x41 IWRC); damping for a few
+    per cent of critical damping of the line spans."""
+    return {"axial_stiffness": 1.3e8, "damping": 2.0e5, "breaking_load": 2.8e6,
+            "linear_mass": 13.5}
+
+
+def riser_tensioner(
+    *,
+    radius: float = 0.75,
+    cluster_gap: float = 4.0,
+    guide_height: float = 14.0,
+    riser_depth: float = 10.0,
+    inertia: float = 250.0,
+    efficiency: float = 0.98,
+) -> dict[str, Any]:
+    """Single wire-line riser tensioner (paper 000, Fig. 6), drawn in the x-y plane.
+
+    Two fixed sheaves at the bottom and two moving sheaves on the rod of a
+    vertical hydraulic cylinder (body ``rod``, driven through ``mover_a``,
+    extension upwards) give a 4:1 reeving: the dead end is anchored at the
+    bottom, the rope goes up and down between the clusters four times, then
+    up over a guide sheave and down to the riser's tension ring (body
+    ``riser``, driven through ``mover_b`` by the vessel's heave: its direction
+    points down, so a vessel heaving up moves the ring down relative to the
+    deck). Rope force on the rod (``mover_a.force``) is minus four times the
+    tension; the riser tension is the tension at the path's end.
+
+    Parameters
+    ----------
+    radius : float
+        Sheave pitch radius, m (60 in sheaves for a 2-1/4 in wire: about
+        27 rope diameters; tensioner sheaves are commonly 60-72 in).
+    cluster_gap : float
+        Vertical distance between fixed and moving sheave centres at mid stroke, m.
+    guide_height : float
+        Height of the guide sheave centre above the fixed sheaves, m.
+    riser_depth : float
+        Depth of the riser's tension ring below the fixed sheaves, m.
+    inertia : float
+        Sheave inertia, kg m^2.
+    efficiency : float
+        Tension ratio across one moving sheave, 1.
+    """
+    r = radius
+    sheave = {"radius": r, "axis": [0.0, 0.0, 1.0], "inertia": inertia,
+              "efficiency": efficiency, "groove_friction": 0.1}
+    sheaves = {
+        "moving_1": {**sheave, "body": "rod", "centre": [1 * r, cluster_gap, 0.0]},
+        "fixed_1": {**sheave, "body": "ground", "centre": [3 * r, 0.0, 0.0]},
+        "moving_2": {**sheave, "body": "rod", "centre": [5 * r, cluster_gap, 0.0]},
+        "fixed_2": {**sheave, "body": "ground", "centre": [7 * r, 0.0, 0.0]},
+        "guide": {**sheave, "body": "ground", "centre": [9 * r, guide_height, 0.0]},
+    }
+    return {
+        "name": "single wire-line riser tensioner (4:1)",
+        "rope": tensioner_line(),
+        "gravity": list(GRAVITY),
+        "bodies": {
+            "rod": {"kind": "driven", "direction": [0.0, 1.0, 0.0], "port": "mover_a"},
+            "riser": {"kind": "driven", "direction": [0.0, -1.0, 0.0], "port": "mover_b"},
+        },
+        "sheaves": sheaves,
+        "anchors": {
+            "dead_end": {"body": "ground", "point": [0.0, -2.0, 0.0]},
+            "tension_ring": {"body": "riser", "point": [10 * r, -riser_depth, 0.0]},
+        },
+        "path": [
+            {"anchor": "dead_end"},
+            {"sheave": "moving_1", "wrap": "cw"},
+            {"sheave": "fixed_1", "wrap": "ccw"},
+            {"sheave": "moving_2", "wrap": "cw"},
+            {"sheave": "fixed_2", "wrap": "ccw"},
+            {"sheave": "guide", "wrap": "cw"},
+            {"anchor": "tension_ring"},
+        ],
     }
 
 
