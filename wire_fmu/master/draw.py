@@ -464,11 +464,13 @@ def _parts_by_body(sheaves, anchors, line_ends) -> dict[str, list[np.ndarray]]:
 
 
 def _body_label(body) -> str:
+    """Two lines: the name; kind, mass (block) and port."""
+    parts = [body.kind]
     if body.kind == "block":
-        text = f"{body.name} (block, {body.mass:g} kg"
-    else:
-        text = f"{body.name} (driven"
-    return text + (f", port {body.port})" if body.port else ")")
+        parts.append(f"{body.mass / 1000.0:g} t" if body.mass >= 1000.0 else f"{body.mass:g} kg")
+    if body.port:
+        parts.append(f"port {body.port}")
+    return f"{body.name}\n{', '.join(parts)}"
 
 
 def _bodies(r: Reeving, parts: dict[str, list[np.ndarray]], view: _View, pad: float):
@@ -585,18 +587,31 @@ def _figure_size(lower: np.ndarray, upper: np.ndarray) -> tuple[float, float]:
     return 10.0, float(np.clip(10.0 * aspect + 2.0, 5.0, 9.0))
 
 
-def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_by_sheave: dict[str, np.ndarray]) -> None:
+_LABEL_BOX = {"boxstyle": "square,pad=0.1", "facecolor": "white", "alpha": 0.75,
+              "edgecolor": "none"}
+
+
+def _radial_text(direction: np.ndarray) -> tuple[float, str]:
+    """Rotation (deg) and horizontal alignment for text running outwards along ``direction``."""
+    angle = math.degrees(math.atan2(direction[1], direction[0]))
+    if -90.0 < angle <= 90.0:
+        return angle, "left"
+    return (angle + 180.0 + 180.0) % 360.0 - 180.0, "right"
+
+
+def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) -> None:
+    """Sheave outlines, centres, and names running outwards opposite the wrapped rope."""
     for s in drawing.sheaves:
         style = "-" if s.reeved else "--"
         ax.fill(s.outline[:, 0], s.outline[:, 1], facecolor=_SHEAVE_FILL, edgecolor=_SHEAVE_EDGE,
                 linewidth=1.0, linestyle=style, zorder=2)
         ax.plot(*s.centre, marker="+", color=_SHEAVE_EDGE, markersize=4, zorder=3)
-        away = s.centre - arcs_by_sheave[s.name] if s.name in arcs_by_sheave else np.array([0, -1])
-        away = _unit(away)
-        at = s.centre + away * s.radius * 1.25
+        away = _unit(s.centre - arcs_mid[s.name]) if s.name in arcs_mid else np.array([0.0, -1.0])
+        rotation, ha = _radial_text(away)
         text = s.name if s.reeved else f"{s.name} (not reeved)"
-        ax.annotate(text, at, ha=_h_align(away[0]), va=_v_align(away[1]), fontsize=7,
-                    color=_SHEAVE_EDGE, zorder=6)
+        ax.annotate(text, s.centre + away * s.radius * 1.15, rotation=rotation,
+                    rotation_mode="anchor", ha=ha, va="center", fontsize=7, color=_SHEAVE_EDGE,
+                    bbox=_LABEL_BOX, zorder=6)
 
 
 def _h_align(x: float) -> str:
@@ -608,6 +623,7 @@ def _v_align(y: float) -> str:
 
 
 def _draw_rope(ax, drawing: ReevingDrawing, arrow: float) -> None:
+    """Straight spans with a path-direction arrowhead at each middle, and wrapped arcs."""
     for span in drawing.spans:
         xs, ys = np.array([span.start, span.end]).T
         ax.plot(xs, ys, color=_ROPE_COLOUR, linewidth=1.8, solid_capstyle="round", zorder=4)
@@ -621,13 +637,14 @@ def _draw_rope(ax, drawing: ReevingDrawing, arrow: float) -> None:
 
 
 def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
+    """Anchors as triangles, line ends as labelled arrows."""
     for a in drawing.anchors:
         face = "black" if a.used else "white"
         ax.plot(*a.point, marker="^", markersize=11, markerfacecolor=face,
                 markeredgecolor="black", zorder=7)
         label = a.name if a.used else f"{a.name} (unused)"
         ax.annotate(label, a.point, xytext=(7, -10), textcoords="offset points", fontsize=8,
-                    zorder=7)
+                    bbox=_LABEL_BOX, zorder=7)
     for e in drawing.line_ends:
         tip = e.point + arrow * e.direction
         ax.annotate("", xy=tip, xytext=e.point, zorder=7,
@@ -638,26 +655,56 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
                     va=_v_align(e.direction[1]), fontsize=9, fontweight="bold", zorder=7)
 
 
+def _distance_to_rope(points: np.ndarray, drawing: ReevingDrawing) -> float:
+    """Smallest distance from any of ``points`` (n, 2) to the rope, m."""
+    lines = [np.array([s.start, s.end]) for s in drawing.spans] + [a.points for a in drawing.arcs]
+    a = np.vstack([poly[:-1] for poly in lines])
+    ab = np.vstack([poly[1:] for poly in lines]) - a
+    ap = points[:, None, :] - a[None, :, :]
+    along = np.clip(np.sum(ap * ab, axis=2) / np.maximum(np.sum(ab * ab, axis=1), 1e-30), 0, 1)
+    gap = ap - along[:, :, None] * ab[None, :, :]
+    return float(np.sqrt(np.min(np.sum(gap * gap, axis=2))))
+
+
+def _direction_arrow_start(box: BodyBox, d: np.ndarray, length: float,
+                           drawing: ReevingDrawing) -> np.ndarray:
+    """Start of a body's direction arrow: beside the box, where it is farthest from the rope."""
+    centre = 0.5 * (box.lower + box.upper)
+    half = 0.5 * (box.upper - box.lower)
+    offsets = [np.array([half[0] + 0.4 * length, 0.0]), np.array([-half[0] - 0.4 * length, 0.0]),
+               np.array([0.0, half[1] + 0.6 * length])]
+    best, best_gap = None, -1.0
+    for off in offsets:
+        start = centre + off - 0.5 * length * d
+        samples = start + np.outer(np.linspace(0.0, 1.0, 5), length * d)
+        gap = _distance_to_rope(samples, drawing)
+        if gap > best_gap + 1e-9:
+            best, best_gap = start, gap
+    return best
+
+
 def _draw_bodies(ax, drawing: ReevingDrawing, arrow: float) -> None:
+    """Dashed boxes, labels under them, direction-of-motion arrows beside them."""
     from matplotlib.patches import Rectangle
 
     for b in drawing.bodies:
         size = b.upper - b.lower
         ax.add_patch(Rectangle(tuple(b.lower), size[0], size[1], fill=False, linestyle="--",
                                edgecolor=_BODY_COLOUR, linewidth=1.2, zorder=1))
-        ax.annotate(b.label, (b.lower[0], b.upper[1]), xytext=(0, 3), textcoords="offset points",
-                    fontsize=8, color=_BODY_COLOUR, va="bottom", zorder=6)
+        ax.annotate(b.label, (b.lower[0], b.lower[1]), xytext=(0, -3), textcoords="offset points",
+                    fontsize=8, color=_BODY_COLOUR, va="top", bbox=_LABEL_BOX, zorder=6)
         if np.linalg.norm(b.direction) > 1e-6:
             d = _unit(b.direction)
-            start = np.array([b.upper[0], 0.5 * (b.lower[1] + b.upper[1])])
-            start = start + np.array([0.3 * arrow, 0.0])
-            ax.annotate("", xy=start + 0.8 * arrow * d, xytext=start, zorder=6,
+            start = _direction_arrow_start(b, d, 0.8 * arrow, drawing)
+            tip = start + 0.8 * arrow * d
+            ax.annotate("", xy=tip, xytext=start, zorder=6,
                         arrowprops={"arrowstyle": "-|>", "color": _BODY_COLOUR, "lw": 1.6})
-            ax.annotate("+ motion", start + 0.8 * arrow * d, xytext=(3, 0),
-                        textcoords="offset points", fontsize=7, color=_BODY_COLOUR, va="center")
+            ax.annotate("+", tip, xytext=(4 * d[0] + 3, 4 * d[1]), textcoords="offset points",
+                        fontsize=9, fontweight="bold", color=_BODY_COLOUR, va="center", zorder=6)
 
 
 def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
+    """Floors as hatched lines, labelled with the travel to contact."""
     for f in drawing.floors:
         xs, ys = np.array([f.start, f.end]).T
         ax.plot(xs, ys, color=_FLOOR_COLOUR, linewidth=2.0, zorder=3)
@@ -667,8 +714,10 @@ def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
             p = f.start + s * along
             ax.plot([p[0], p[0] + tick[0]], [p[1], p[1] + tick[1]], color=_FLOOR_COLOUR,
                     linewidth=0.8, zorder=3)
-        ax.annotate(f"floor of {f.body} (lands after {f.travel:+.2f} m)", f.end,
-                    xytext=(4, 2), textcoords="offset points", fontsize=7, color=_FLOOR_COLOUR)
+        ax.annotate(f"floor of {f.body}\ncontact after {f.travel:+.2f} m travel",
+                    0.5 * (f.start + f.end), xytext=(-4.0 * f.below[0], -4.0 * f.below[1]),
+                    textcoords="offset points", ha="center", va=_v_align(-f.below[1]),
+                    fontsize=7, color=_FLOOR_COLOUR, bbox=_LABEL_BOX, zorder=6)
 
 
 def _legend(fig) -> None:

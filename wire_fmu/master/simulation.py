@@ -29,12 +29,12 @@ import math
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Protocol
 
 from .algorithms import make_algorithm, step_order
-from .drivers import make_driver
 from .extrapolation import History, held_value
-from .scene import Bond, Connection, Scene, VarRef
+from .manipulators import DriverSet, ScheduledEvents
+from .scene import Bond, Connection, Scene
 from .slave import Slave, StepRefusedError, UnitFailedError
 from .validate import Structure, unit_start_values
 
@@ -69,13 +69,6 @@ class _Link:
     key: str  # source "unit.var"
     target_vr: int
     scheme: str
-
-
-@dataclass
-class _Driven:
-    driver: Any
-    target: VarRef
-    rate: VarRef | None
 
 
 @dataclass
@@ -125,9 +118,8 @@ class Simulation:
         self.time = 0.0
         self.step_size = scene.run.step
         self._build_links()
-        self._build_drivers()
-        self.overrides: dict[VarRef, Any] = {}
-        self.pending_events = list(scene.events)
+        self.drivers = DriverSet(scene.drivers, scene.base_dir)
+        self.events = ScheduledEvents(scene.events)
         self.algorithm = make_algorithm(scene.run.algorithm, self._order(structure))
         self.bond_residual = {b.name: 0.0 for b in scene.bonds}
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
@@ -154,15 +146,6 @@ class Simulation:
         }
         self.histories = {k: History() for keys in self.source_keys.values() for k in keys}
 
-    def _build_drivers(self) -> None:
-        self.driven: dict[str, list[_Driven]] = defaultdict(list)
-        for i, d in enumerate(self.scene.drivers):
-            driver, problems = make_driver(d.spec, where=f"driver {i}",
-                                           base_dir=self.scene.base_dir)
-            if problems:
-                raise ValueError("; ".join(problems))
-            self.driven[d.target.unit].append(_Driven(driver, d.target, d.rate_target))
-
     def _order(self, structure: Structure) -> list[str]:
         flows_to, feeds = defaultdict(set), defaultdict(set)
         for c in self.scene.all_connections:
@@ -179,8 +162,8 @@ class Simulation:
             slave = self.slaves[name]
             slave.instantiate()
             values = unit_start_values(self.scene.units[name], slave)
-            values.update(self._driven_values(name, start, None))
-            values.update(self._overrides_for(name, start))
+            values.update(self.drivers.values(name, start, None))
+            values.update(self.events.values(name))
             slave.initialize(start, values)
         for name in self.algorithm.order:  # sources first: their outputs feed the next
             self._set_connected_from_latest(name)
@@ -225,8 +208,8 @@ class Simulation:
             self.held[f"{link.connection.target}"] = value
         slave = self.slaves[unit]
         slave.set_reals(refs, values)
-        driven = self._driven_values(unit, t, h)
-        driven.update(self._overrides_for(unit, t))
+        driven = self.drivers.values(unit, t, h)
+        driven.update(self.events.values(unit))
         if driven:
             slave.set_many(driven)
 
@@ -234,29 +217,9 @@ class Simulation:
         """Step one unit (errors propagate as StepRefusedError / UnitFailedError)."""
         self.slaves[unit].do_step(t, h)
 
-    # -- manipulators -------------------------------------------------------------------
-    def _driven_values(self, unit: str, t: float, h: float | None) -> dict[str, float]:
-        out = {}
-        for d in self.driven.get(unit, ()):
-            if d.rate is None:  # held at the step's midpoint: second order
-                out[d.target.variable] = d.driver.value(t if h is None else t + 0.5 * h)
-            else:  # position now, mean rate over the step: the unit lands on value(t + h)
-                out[d.target.variable] = d.driver.value(t)
-                out[d.rate.variable] = (d.driver.rate(t) if not h else
-                                        (d.driver.value(t + h) - d.driver.value(t)) / h)
-        return out
-
-    def _overrides_for(self, unit: str, t: float) -> dict[str, Any]:
-        return {ref.variable: v for ref, v in self.overrides.items() if ref.unit == unit}
-
-    def _apply_events(self, t: float) -> list[str]:
-        fired = []
-        while self.pending_events and self.pending_events[0].time <= t + 1e-12:
-            event = self.pending_events.pop(0)
-            self.overrides.update(event.values)
-            fired.append(event.label)
-            logger.info("t = %.6g s: %s", t, event.label)
-        if fired:
+    def _fire_events(self, t: float) -> list[str]:
+        fired = self.events.fire_due(t)
+        if fired:  # inputs jump: nothing may be extrapolated across
             for history in self.histories.values():
                 history.reset()
         return fired
@@ -371,7 +334,7 @@ class Simulation:
         result = RunResult("finished")
         try:
             self.initialize()
-            self._apply_events(self.time)
+            self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_start(self)
             self._loop(result)
@@ -396,9 +359,9 @@ class Simulation:
         while self.time < stop - 1e-12:
             t = self.time
             h = min(h, stop - t)
-            if self.pending_events:
-                h = min(h, self.pending_events[0].time - t) if self.pending_events[0].time > t \
-                    else h
+            upcoming = self.events.next_time
+            if upcoming is not None and upcoming > t:
+                h = min(h, upcoming - t)
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps
             if not attempt.accepted:
@@ -413,7 +376,7 @@ class Simulation:
                 continue
             self._accept(t, h, attempt.new, attempt.residuals)
             result.steps += 1
-            self._apply_events(self.time)
+            self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_step(self)
             h = self._next_step(h, attempt.residuals)
