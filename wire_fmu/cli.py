@@ -69,7 +69,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     from wire_fmu.master.observers import summary_rows
     from wire_fmu.master.run import run_scene
 
-    outcome = run_scene(args.scene, args.output, progress=not args.quiet, fmu_dir=args.fmu_dir)
+    outcome = run_scene(args.scene, args.output, progress=not args.quiet, fmu_dir=args.fmu_dir,
+                        stop_time=args.stop_time, step=args.step)
     _print(f"\nscene {outcome.scene.name!r}")
     _print(_table(summary_rows(outcome.simulation, outcome.result)))
     _print(f"\nresults: {outcome.csv_path.resolve()}")
@@ -132,6 +133,8 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("-o", "--output", type=Path, help="results folder")
         if name == "run":
             p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+            p.add_argument("--stop-time", type=float, help="stop earlier (s), e.g. a quick look")
+            p.add_argument("--step", type=float, help="macro step (s) instead of the scene's")
         p.set_defaults(func=func)
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")

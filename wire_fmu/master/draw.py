@@ -328,7 +328,7 @@ def _axis_label(axis: np.ndarray) -> str:
     if abs(abs(axis[k]) - 1.0) < 1e-9:
         sign = "" if axis[k] > 0 else "-"
         return f"{sign}{_AXIS_NAMES[k]} (m)"
-    return "(" + ", ".join(f"{c:.3g}" for c in axis) + ") (m)"
+    return "(" + ", ".join(f"{c + 0.0:.3f}" for c in np.round(axis, 3)) + ") (m)"
 
 
 def _best_fit_normal(points: np.ndarray) -> np.ndarray:
@@ -655,52 +655,25 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
                     va=_v_align(e.direction[1]), fontsize=9, fontweight="bold", zorder=7)
 
 
-def _distance_to_rope(points: np.ndarray, drawing: ReevingDrawing) -> float:
-    """Smallest distance from any of ``points`` (n, 2) to the rope, m."""
-    lines = [np.array([s.start, s.end]) for s in drawing.spans] + [a.points for a in drawing.arcs]
-    a = np.vstack([poly[:-1] for poly in lines])
-    ab = np.vstack([poly[1:] for poly in lines]) - a
-    ap = points[:, None, :] - a[None, :, :]
-    along = np.clip(np.sum(ap * ab, axis=2) / np.maximum(np.sum(ab * ab, axis=1), 1e-30), 0, 1)
-    gap = ap - along[:, :, None] * ab[None, :, :]
-    return float(np.sqrt(np.min(np.sum(gap * gap, axis=2))))
-
-
-def _direction_arrow_start(box: BodyBox, d: np.ndarray, length: float,
-                           drawing: ReevingDrawing) -> np.ndarray:
-    """Start of a body's direction arrow: beside the box, where it is farthest from the rope."""
-    centre = 0.5 * (box.lower + box.upper)
-    half = 0.5 * (box.upper - box.lower)
-    offsets = [np.array([half[0] + 0.4 * length, 0.0]), np.array([-half[0] - 0.4 * length, 0.0]),
-               np.array([0.0, half[1] + 0.6 * length])]
-    best, best_gap = None, -1.0
-    for off in offsets:
-        start = centre + off - 0.5 * length * d
-        samples = start + np.outer(np.linspace(0.0, 1.0, 5), length * d)
-        gap = _distance_to_rope(samples, drawing)
-        if gap > best_gap + 1e-9:
-            best, best_gap = start, gap
-    return best
-
-
-def _draw_bodies(ax, drawing: ReevingDrawing, arrow: float) -> None:
-    """Dashed boxes, labels under them, direction-of-motion arrows beside them."""
+def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
+    """Dashed boxes, labels under them, a direction-of-motion arrow after each label."""
     from matplotlib.patches import Rectangle
+    from matplotlib.text import OffsetFrom
 
     for b in drawing.bodies:
         size = b.upper - b.lower
         ax.add_patch(Rectangle(tuple(b.lower), size[0], size[1], fill=False, linestyle="--",
                                edgecolor=_BODY_COLOUR, linewidth=1.2, zorder=1))
-        ax.annotate(b.label, (b.lower[0], b.lower[1]), xytext=(0, -3), textcoords="offset points",
-                    fontsize=8, color=_BODY_COLOUR, va="top", bbox=_LABEL_BOX, zorder=6)
+        label = ax.annotate(b.label, (b.lower[0], b.lower[1]), xytext=(0, -3),
+                            textcoords="offset points", fontsize=8, color=_BODY_COLOUR, va="top",
+                            bbox=_LABEL_BOX, zorder=6)
         if np.linalg.norm(b.direction) > 1e-6:
-            d = _unit(b.direction)
-            start = _direction_arrow_start(b, d, 0.8 * arrow, drawing)
-            tip = start + 0.8 * arrow * d
-            ax.annotate("", xy=tip, xytext=start, zorder=6,
+            d = _unit(b.direction)  # equal aspect: the same direction on screen
+            centre = np.array([16.0, 0.0])  # points right of the label's right edge
+            anchor = OffsetFrom(label, (1.0, 0.5), unit="points")
+            ax.annotate("", xy=tuple(centre + 9.0 * d), xycoords=anchor,
+                        xytext=tuple(centre - 9.0 * d), textcoords=anchor, zorder=6,
                         arrowprops={"arrowstyle": "-|>", "color": _BODY_COLOUR, "lw": 1.6})
-            ax.annotate("+", tip, xytext=(4 * d[0] + 3, 4 * d[1]), textcoords="offset points",
-                        fontsize=9, fontweight="bold", color=_BODY_COLOUR, va="center", zorder=6)
 
 
 def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
@@ -736,6 +709,23 @@ def _legend(fig) -> None:
     fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=8, frameon=False)
 
 
+def _fit_limits(fig, ax, lower: np.ndarray, upper: np.ndarray) -> None:
+    """Limits that show the drawing and every label, with equal aspect filling the axes."""
+    ax.update_datalim([tuple(lower), tuple(upper)])
+    ax.autoscale_view()
+    for _ in range(4):  # text sizes in data units change with the limits
+        fig.draw_without_rendering()
+        to_data = ax.transData.inverted()
+        renderer = fig.canvas.get_renderer()
+        for text in ax.texts:
+            if text.get_text():
+                ax.update_datalim(to_data.transform(text.get_window_extent().padded(6.0)))
+            arrow = getattr(text, "arrow_patch", None)
+            if arrow is not None:
+                ax.update_datalim(to_data.transform(arrow.get_window_extent(renderer).padded(4.0)))
+        ax.autoscale_view()
+
+
 def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -749,18 +739,17 @@ def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
     _draw_sheaves(ax, drawing, arcs_mid)
     _draw_rope(ax, drawing, arrow)
     _draw_ends(ax, drawing, arrow)
-    _draw_bodies(ax, drawing, arrow)
+    _draw_bodies(ax, drawing)
     _draw_floors(ax, drawing, arrow)
-    ax.set_aspect("equal", adjustable="box")
-    margin = 1.6 * arrow
-    ax.set_xlim(lower[0] - margin, upper[0] + margin)
-    ax.set_ylim(lower[1] - margin, upper[1] + margin)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.margins(0.0)
     ax.set_xlabel(drawing.axis_labels[0])
     ax.set_ylabel(drawing.axis_labels[1])
     ax.grid(True, linewidth=0.4, alpha=0.4)
     ax.set_title(title or drawing.title, fontsize=10)
     _legend(fig)
     fig.tight_layout(rect=(0.0, 0.04, 1.0, 1.0))
+    _fit_limits(fig, ax, lower - 1.3 * arrow, upper + 1.3 * arrow)
     fig.savefig(path, dpi=_DPI)
 
 

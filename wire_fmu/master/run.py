@@ -10,7 +10,7 @@ A scene is named (one we ship, see :func:`shipped_scenes`) or given by path.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .catalog import DEFAULT_FMU_DIR
@@ -19,7 +19,8 @@ from .scene import Scene, SceneError, load_scene
 from .simulation import RunResult, Simulation
 from .validate import validate_scene
 
-__all__ = ["SCENE_DIR", "shipped_scenes", "find_scene", "run_scene", "Outcome"]
+__all__ = ["SCENE_DIR", "shipped_scenes", "find_scene", "run_scene", "with_run_settings",
+           "Outcome"]
 
 logger = logging.getLogger(__name__)
 
@@ -63,6 +64,18 @@ class Outcome:
     simulation: Simulation | None = None
 
 
+def with_run_settings(scene: Scene, **changes) -> Scene:
+    """A copy of ``scene`` with some run settings replaced (checked like the file's)."""
+    from .scene import _check_run
+
+    settings = replace(scene.run, **{k: v for k, v in changes.items() if v is not None})
+    problems: list[str] = []
+    _check_run(settings, problems)
+    if problems:
+        raise SceneError(f"scene {scene.name!r}", problems)
+    return replace(scene, run=settings)
+
+
 def run_scene(
     scene: str | Path | Scene,
     results: Path | None = None,
@@ -71,6 +84,7 @@ def run_scene(
     plots: bool = True,
     fmu_dir: Path = DEFAULT_FMU_DIR,
     observers=(),
+    **run_overrides,
 ) -> Outcome:
     """Validate and run a scene; write results (and plots) to ``results``.
 
@@ -88,9 +102,13 @@ def run_scene(
         Where our FMUs are built and cached.
     observers : sequence
         More observers (see :class:`~wire_fmu.master.simulation.Observer`).
+    **run_overrides
+        Replace run settings of the scene, e.g. ``stop_time=5.0`` for a quick run.
     """
     if not isinstance(scene, Scene):
         scene = load_scene(find_scene(scene))
+    if run_overrides:
+        scene = with_run_settings(scene, **run_overrides)
     structure = validate_scene(scene, fmu_dir)
     directory = Path(results) if results else Path("results") / scene.name
     recorder = CsvRecorder(directory, scene.run.output_interval)
