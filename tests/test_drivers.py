@@ -152,6 +152,8 @@ def test_sine_problems_all_at_once():
     assert "not both" in problems_of({"kind": "sine", "amplitude": 1, "period": 1,
                                       "frequency": 1})[0]
     assert "is required" in problems_of({"kind": "sine", "amplitude": 1})[0]
+    assert "'period' must be > 0 s, got 0" in problems_of({"kind": "sine", "amplitude": 1,
+                                                           "period": 0})[0]
 
 
 # ----------------------------------------------------------------- sea state
@@ -255,6 +257,8 @@ def test_sea_state_problems_all_at_once():
                  "did you mean 'jonswap'", "'gamma' must be in [1, 7]", "'cutoff'",
                  "'components' must be an integer", "'seed' must be an integer >= 0"):
         assert part in text
+    assert "'components' must be an integer <= 20000" in problems_of(
+        {"kind": "sea_state", "significant_height": 1, "peak_period": 8, "components": 10**6})[0]
     assert "'gamma' applies to spectrum 'jonswap' only" in problems_of(
         {"kind": "sea_state", "significant_height": 1, "peak_period": 8,
          "spectrum": "pierson_moskowitz", "gamma": 3.3})[0]

@@ -340,24 +340,17 @@ def _best_fit_normal(points: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------- geometry
 
 
-def _point_of(r: Reeving, k: int) -> tuple[str, tuple[float, float, float]]:
-    """Name and position (m) of path node ``k`` if it is a point (anchor or line end)."""
-    node = r.path[k]
-    if node.kind == "anchor":
-        return f"anchor {node.name!r}", r.anchors[node.name].point
-    return f"line end {node.name!r}", node.point
-
-
 def _path_nodes(r: Reeving) -> list[PathNode]:
-    """The core's path nodes at zero body displacement (as the block train builds them)."""
+    """The core's path nodes at zero body displacement, named as the block train names them."""
     nodes = []
-    for k, node in enumerate(r.path):
+    for node in r.path:
         if node.kind == "sheave":
             s = r.sheaves[node.name]
             nodes.append(PathNode(Circle(s.name, s.centre, s.axis, s.radius), node.sense))
         else:
-            name, point = _point_of(r, k)
-            nodes.append(PathNode(Circle(name, point, (0.0, 0.0, 1.0), 0.0), 0))
+            point = r.anchors[node.name].point if node.kind == "anchor" else node.point
+            circle = Circle(f"{node.kind} {node.name!r}", point, (0.0, 0.0, 1.0), 0.0)
+            nodes.append(PathNode(circle, 0))
     return nodes
 
 
