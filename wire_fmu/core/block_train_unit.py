@@ -31,7 +31,7 @@ import numpy as np
 from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
 from .errors import ConfigurationError
 from .hybrid import IntegrationError, SolverSettings
-from .interface import StepResult, Unit, input_, output, parameter
+from .interface import OdeView, StepResult, Unit, input_, output, parameter
 from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
 from .reevings import drilling_block_train
 
@@ -190,6 +190,10 @@ class BlockTrainUnit(Unit):
         finally:
             model.restore_held_inputs(held)
 
+    def ode(self) -> OdeView:
+        """The block train's hybrid ODE, for a monolithic model."""
+        return _BlockTrainOde(self)
+
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
         """Complete state: continuous state, modes, broken spans, offsets."""
@@ -272,3 +276,68 @@ class BlockTrainUnit(Unit):
         out["mode_changes"] = int(m.mode_changes)
         if not all(math.isfinite(out[k]) for k in ("stored_energy", "tension_max")):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
+
+
+class _BlockTrainOde(OdeView):
+    """:class:`BlockTrainUnit` as a piece of a monolithic ODE."""
+
+    def __init__(self, unit: BlockTrainUnit) -> None:
+        self.unit = unit
+        self.model = unit._require_model()
+
+    @property
+    def state(self) -> np.ndarray:
+        """Continuous state ``[q, v, dissipated, external work]``."""
+        return self.model.state.copy()
+
+    def set_state(self, x: np.ndarray, t: float) -> None:
+        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        self.model.state = np.array(x, dtype=float)
+        self.unit.time = t
+        self.bind_inputs(t)
+        self.unit._update_outputs()
+
+    def bind_inputs(self, t: float) -> None:
+        """Inputs in ``values`` are the values at ``t``."""
+        self.model.set_inputs(t, self.unit._inputs())
+
+    def publish(self, t: float, x: np.ndarray) -> None:
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        saved, self.model.state = self.model.state, x
+        saved_time, self.unit.time = self.unit.time, t
+        try:
+            self.unit._update_outputs()
+        finally:
+            self.model.state, self.unit.time = saved, saved_time
+
+    def rhs(self, t, x):
+        """See :meth:`BlockTrainModel.rhs`."""
+        return self.model.rhs(t, x)
+
+    def guards(self, t, x):
+        """See :meth:`BlockTrainModel.guards`."""
+        return self.model.guards(t, x)
+
+    def guard_directions(self):
+        """See :meth:`BlockTrainModel.guard_directions`."""
+        return self.model.guard_directions()
+
+    def handle_events(self, t, x, fired):
+        """See :meth:`BlockTrainModel.handle_events`."""
+        return self.model.handle_events(t, x, fired)
+
+    def project(self, x):
+        """See :meth:`BlockTrainModel.project`."""
+        return self.model.project(x)
+
+    def reconcile(self, t, x):
+        """Break a commanded segment, then settle contact and friction modes."""
+        m = self.model
+        m.state = np.array(x, dtype=float)
+        self.bind_inputs(t)
+        segment = int(self.unit.values["break_segment"])
+        if 0 < segment <= m.n_segments:
+            m._break_span(m.span_of_segment[segment - 1], m.state, t)
+        m._settle_contact_modes(t, m.state)
+        m.state = m._settle_modes(t, m.state)
+        return m.state.copy()

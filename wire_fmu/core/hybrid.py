@@ -308,7 +308,13 @@ def _finite_difference_jacobian(system: HybridSystem, t: float, x: np.ndarray) -
 
 
 class ScipySolver:
-    """SciPy's ``solve_ivp`` per communication step, restarted at events."""
+    """SciPy's ``solve_ivp`` per communication step, restarted at events.
+
+    Like the fixed-step solvers, an event is taken just *after* the crossing
+    (the dense output of the last step, ``event_time_tolerance`` past the
+    located root), so the guard that fired is past its zero when the mode
+    switches and cannot fire again at the restart.
+    """
 
     def __init__(self, settings: SolverSettings, method: str) -> None:
         self.settings = settings
@@ -317,10 +323,10 @@ class ScipySolver:
         self.steps = 0
 
     def advance(self, system, t0, x0, t1):
+        tol = self.settings.event_time_tolerance
         t, x = t0, np.array(x0, dtype=float)
         events = 0
-        while t < t1 - self.settings.event_time_tolerance:
-            event_functions = self._event_functions(system)
+        while t < t1 - tol:
             sol = solve_ivp(
                 system.rhs,
                 (t, t1),
@@ -329,7 +335,8 @@ class ScipySolver:
                 rtol=self.settings.rtol,
                 atol=self.settings.atol,
                 max_step=self.settings.max_step,
-                events=event_functions or None,
+                events=self._event_functions(system) or None,
+                dense_output=True,
             )
             self.rhs_calls += sol.nfev
             self.steps += max(0, sol.t.size - 1)
@@ -337,23 +344,35 @@ class ScipySolver:
                 raise IntegrationError(f"{self.method}: {sol.message}")
             if sol.status == 0:
                 return system.project(sol.y[:, -1]), events
-            fired = [i for i, te in enumerate(sol.t_events) if te.size]
-            t = float(min(sol.t_events[i][0] for i in fired))
-            x_event = sol.y_events[fired[0]][0]
+            times = {i: float(te[0]) for i, te in enumerate(sol.t_events) if te.size}
+            t_root = min(times.values())
+            fired = [i for i, te in times.items() if te <= t_root + tol]
+            t = min(t_root + tol, t1)
+            x_after = sol.sol(t)
+            if not np.all(np.isfinite(x_after)):
+                raise IntegrationError(f"{self.method}: non-finite state at an event, t = {t}")
             events += 1
             if events > _MAX_EVENTS_PER_STEP:
                 raise IntegrationError(f"more than {_MAX_EVENTS_PER_STEP} events in one step")
-            x = system.handle_events(t, x_event, fired)
+            x = system.handle_events(t, x_after, fired)
         return x, events
 
     @staticmethod
     def _event_functions(system):
         directions = system.guard_directions()
+        cache: dict = {}
+
+        def guards(t, x):
+            key = (t, x.tobytes())
+            if cache.get("key") != key:
+                cache["key"], cache["g"] = key, system.guards(t, x)
+            return cache["g"]
+
         functions = []
         for i, direction in enumerate(directions):
 
             def event(t, x, i=i):
-                return system.guards(t, x)[i]
+                return guards(t, x)[i]
 
             event.terminal = True
             event.direction = float(direction)

@@ -38,6 +38,7 @@ __all__ = [
     "parameter",
     "input_",
     "output",
+    "OdeView",
 ]
 
 
@@ -280,6 +281,16 @@ class Unit(ABC):
         """
         return None
 
+    # -- the unit as one piece of a monolithic ODE --------------------------------
+    # A unit that implements these can be assembled with others into one
+    # hybrid ODE (wire_fmu.study.monolithic), the reference co-simulation is
+    # measured against. Inputs are then read from :attr:`values` as
+    # instantaneous values (a position input at time t, its rate input as
+    # its derivative), not held over a step.
+    def ode(self) -> OdeView:
+        """The unit's continuous dynamics (raises if the unit has none to offer)."""
+        raise NotImplementedError(f"{self.NAME} cannot be part of a monolithic model")
+
     # -- helpers --------------------------------------------------------------
     def parameters(self) -> dict[str, Any]:
         """Current parameter values by name."""
@@ -296,6 +307,62 @@ class Unit(ABC):
             for v in self.VARIABLES
             if v.causality is Causality.output
         }
+
+
+class OdeView(ABC):
+    """A configured, initialised unit seen as a hybrid ODE (see :mod:`wire_fmu.core.hybrid`).
+
+    ``bind_inputs(t)`` reads the unit's inputs from its ``values`` as their
+    instantaneous values at ``t``; ``rhs``, ``guards``, ``guard_directions``,
+    ``handle_events`` and ``project`` are those of a
+    :class:`~wire_fmu.core.hybrid.HybridSystem`; ``publish(t, x)`` writes the
+    outputs for state ``x`` into ``values``; ``state``/``set_state`` move the
+    continuous state in and out of the unit.
+    """
+
+    @property
+    @abstractmethod
+    def state(self) -> Any:
+        """Continuous state vector (a copy)."""
+
+    @abstractmethod
+    def set_state(self, x: Any, t: float) -> None:
+        """Adopt ``x`` at time ``t`` (and refresh the outputs)."""
+
+    @abstractmethod
+    def bind_inputs(self, t: float) -> None:
+        """Take the inputs now in ``values`` as their values at ``t``."""
+
+    @abstractmethod
+    def publish(self, t: float, x: Any) -> None:
+        """Write the outputs of state ``x`` at ``t`` into ``values``."""
+
+    @abstractmethod
+    def rhs(self, t: float, x: Any) -> Any:
+        """State derivative."""
+
+    @abstractmethod
+    def guards(self, t: float, x: Any) -> Any:
+        """Guard values."""
+
+    @abstractmethod
+    def guard_directions(self) -> Any:
+        """Guard directions."""
+
+    @abstractmethod
+    def handle_events(self, t: float, x: Any, fired: list[int]) -> Any:
+        """Switch modes; return the projected state."""
+
+    @abstractmethod
+    def project(self, x: Any) -> Any:
+        """Enforce the mode's invariants."""
+
+    def reconcile(self, t: float, x: Any) -> Any:
+        """Inputs jumped at ``t`` (an event): settle modes, act on commands; return the state.
+
+        The default changes nothing.
+        """
+        return x
 
 
 def is_finite(value: float) -> bool:

@@ -1,0 +1,1 @@
+"""Studies: the monolithic reference, accuracy against cost, the price of each effect."""
