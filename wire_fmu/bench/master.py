@@ -1,0 +1,91 @@
+"""What the master costs beyond the FMUs, and each shipped scene's real-time factor.
+
+Run ``python -m wire_fmu.bench.master [--stop-time S] [--out FILE]``. Each
+shipped scene is run (shortened to ``--stop-time`` if given) with the
+master; the time spent inside fmpy's calls to the FMUs is measured per call
+by the master itself (:class:`~wire_fmu.master.slave.Slave` counts every FMI
+call and its time), so
+
+* master overhead per unit per macro step = (wall time of the stepping loop
+  − time in FMI calls) / (units × macro steps), and
+* the real-time factor = simulated time / wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from wire_fmu.master.run import run_scene, shipped_scenes
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SceneFigures:
+    """Benchmark figures of one scene."""
+
+    scene: str
+    units: int
+    steps: int
+    simulated: float
+    wall: float
+    fmi_seconds: float
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall-clock second."""
+        return self.simulated / self.wall
+
+    @property
+    def overhead_us(self) -> float:
+        """Master time per unit per macro step beyond the FMI calls, microseconds."""
+        return 1e6 * (self.wall - self.fmi_seconds) / max(1, self.units * self.steps)
+
+
+def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
+    """Run one scene and collect its figures."""
+    outcome = run_scene(name, out / name, plots=False, stop_time=stop_time)
+    sim, result = outcome.simulation, outcome.result
+    if result.status != "finished":
+        raise RuntimeError(f"{name}: {result.status}: {result.message}")
+    fmi = sum(sum(s.seconds.values()) for s in sim.slaves.values())
+    return SceneFigures(name, len(sim.slaves), result.steps, result.end_time, result.wall_time,
+                        fmi)
+
+
+def table(rows: list[SceneFigures]) -> str:
+    """Markdown table of the figures."""
+    lines = ["| scene | units | macro steps | simulated s | wall s | real-time factor | "
+             "master overhead per unit per step |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
+                     f"{r.real_time_factor:.3g} | {r.overhead_us:.0f} µs |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--stop-time", type=float, help="shorten every scene to this, s")
+    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in shipped_scenes():
+            rows.append(measure(name, args.stop_time, Path(tmp)))
+            logger.info("%s: RTF %.3g, overhead %.0f µs per unit per step", name,
+                        rows[-1].real_time_factor, rows[-1].overhead_us)
+    text = table(rows)
+    logger.info("\n%s", text)
+    if args.out:
+        args.out.write_text(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
