@@ -165,6 +165,7 @@ class CoreFacade(Fmi2Slave):
         self._start_time = 0.0
         self._reconfigure = False
         self._inputs_changed = False
+        self._initial_outputs_stale = True
         for var in unit_class.variables():
             self._register(var)
 
@@ -228,9 +229,20 @@ class CoreFacade(Fmi2Slave):
 
     # -- variable access --------------------------------------------------------
     def _get_value(self, var: Variable) -> Any:
-        if var.depends_on and self._inputs_changed and self._phase is Phase.step:
-            self._evaluate_outputs()
+        if var.causality is Causality.output:
+            if self._phase is Phase.initialization and self._initial_outputs_stale:
+                self._initialize_unit()  # masters (libcosim) read outputs before exiting
+            elif var.depends_on and self._inputs_changed and self._phase is Phase.step:
+                self._evaluate_outputs()
         return self.unit.values[var.name]
+
+    def _initialize_unit(self) -> None:
+        # the unit's initial state and outputs for the parameters and inputs set so far
+        if self._reconfigure:
+            self._rebuild_unit(self.unit.values)
+            self._reconfigure = False
+        self.unit.initialize(self._start_time)
+        self._initial_outputs_stale = False
 
     def _evaluate_outputs(self) -> None:
         # recompute direct-feedthrough outputs from the new inputs, without stepping
@@ -246,6 +258,7 @@ class CoreFacade(Fmi2Slave):
                 f"fixed parameter {var.name!r} can only be set before fmi2ExitInitializationMode"
             )
         self.unit.values[var.name] = var.type(value)
+        self._initial_outputs_stale = True
         if var.causality is Causality.input:
             self._inputs_changed = True
         elif self._phase is Phase.initialization:
@@ -298,14 +311,13 @@ class CoreFacade(Fmi2Slave):
         self.unit.configure()
         self._phase = Phase.initialization
         self._reconfigure = False
+        self._initial_outputs_stale = True
 
     @fmi_entry("fmi2ExitInitializationMode")
     def exit_initialization_mode(self) -> None:
         """Initialise the unit at the start time."""
         self._require("fmi2ExitInitializationMode", Phase.initialization)
-        if self._reconfigure:
-            self._rebuild_unit(self.unit.values)
-        self.unit.initialize(self._start_time)
+        self._initialize_unit()
         self._phase = Phase.step
         self._inputs_changed = False
 

@@ -1,0 +1,255 @@
+"""Write a scene as an SSP 1.0 package (``.ssp``), for any SSP-aware tool.
+
+Layout of the package (a zip)::
+
+    SystemStructure.ssd           the system: components, connectors, connections
+    resources/<Model>.fmu         each distinct FMU once (two units may share one)
+    resources/<unit>.ssv          each unit's parameter values (SSV 1.0)
+
+Mapping
+-------
+* Every unit is an ``ssd:Component`` (``application/x-fmu-sharedlibrary``)
+  with a typed ``ssd:Connector`` for every input, output and parameter of
+  its FMU; Reals carry their unit, and ``ssd:Units`` defines every unit
+  used by its SI exponents (taken from the FMU's own ``UnitDefinitions``).
+* Parameters, including String parameters such as a block train's JSON
+  ``reeving`` and the ``effects`` list of our units, are bound through one
+  ``ssd:ParameterBinding`` per component to ``resources/<unit>.ssv``; Reals
+  are written with ``repr`` so they round-trip bit for bit.
+* A power bond's effort, flow and position are ordinary
+  ``ssd:Connection`` elements (any tool can run them), each marked with an
+  annotation of type ``org.wire-fmu.bond`` naming the bond, its kind
+  (``translational``, ``rotational``, ``rope``, ``hydraulic``) and the
+  connection's role (``effort``, ``flow``, ``position``).
+* Drivers and scheduled events become the generated signals component
+  (:mod:`wire_fmu.interop.signals`) and plain connections from it.
+* ``ssd:DefaultExperiment`` gives the start and stop time; an annotation of
+  type ``com.opensimulationplatform`` gives libcosim the fixed step
+  (``osp:FixedStepAlgorithm baseStepSize``); an annotation of type
+  ``org.wire-fmu.scene`` on the system keeps, as JSON, what SSP has no
+  element for (run settings, drivers, events, outputs, plots), so that
+  :mod:`wire_fmu.interop.ssp_read` restores the scene exactly.
+
+libcosim reads SSD files with a parser that matches element names by their
+prefix, so the prefixes ``ssd``, ``ssc``, ``ssv`` and ``osp`` are fixed here.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import zipfile
+from datetime import UTC, datetime
+from pathlib import Path
+
+from lxml import etree
+
+import wire_fmu
+from wire_fmu.master.catalog import DEFAULT_FMU_DIR
+from wire_fmu.master.scene import Scene
+
+from .plan import ExportPlan, PlannedUnit, archive_names, plan_export
+
+__all__ = ["NS", "BOND_ANNOTATION", "SCENE_ANNOTATION", "OSP_ANNOTATION", "SSD_NAME",
+           "ssd_tree", "ssv_tree", "write_ssp", "export_ssp"]
+
+logger = logging.getLogger(__name__)
+
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+    "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
+    "wf": "https://wire-fmu.org/SSP/annotations/1",
+}
+"""Namespaces by the prefix every document here uses."""
+
+BOND_ANNOTATION = "org.wire-fmu.bond"
+SCENE_ANNOTATION = "org.wire-fmu.scene"
+OSP_ANNOTATION = "com.opensimulationplatform"
+SSD_NAME = "SystemStructure.ssd"
+_KINDS = {"input": "input", "output": "output", "parameter": "parameter",
+          "calculatedParameter": "calculatedParameter"}
+_BASE = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+
+
+def _q(prefix: str, tag: str) -> str:
+    return f"{{{NS[prefix]}}}{tag}"
+
+
+def _sub(parent: etree._Element, prefix: str, tag: str, **attrs: str) -> etree._Element:
+    return etree.SubElement(parent, _q(prefix, tag), {k: v for k, v in attrs.items()
+                                                       if v is not None})
+
+
+def _type_element(parent: etree._Element, var) -> None:
+    kind = "Integer" if var.type == "Enumeration" else var.type
+    _sub(parent, "ssc", kind, unit=(var.unit or None) if kind == "Real" else None)
+
+
+def _connectors(component: etree._Element, unit: PlannedUnit) -> None:
+    connectors = _sub(component, "ssd", "Connectors")
+    for var in unit.model.modelVariables:
+        kind = _KINDS.get(var.causality)
+        if kind is None:
+            continue
+        connector = _sub(connectors, "ssd", "Connector", name=var.name, kind=kind,
+                         description=var.description or None)
+        _type_element(connector, var)
+
+
+def _component(elements: etree._Element, unit: PlannedUnit, fmu_name: str) -> None:
+    component = _sub(elements, "ssd", "Component", name=unit.name,
+                     type="application/x-fmu-sharedlibrary", source=f"resources/{fmu_name}",
+                     description=unit.model.description or None)
+    _connectors(component, unit)
+    if unit.start_values:
+        bindings = _sub(component, "ssd", "ParameterBindings")
+        _sub(bindings, "ssd", "ParameterBinding", type="application/x-ssp-parameter-set",
+             source=f"resources/{unit.name}.ssv")
+
+
+def _annotation(parent: etree._Element, kind: str) -> etree._Element:
+    annotations = _sub(parent, "ssd", "Annotations")
+    return _sub(annotations, "ssc", "Annotation", type=kind)
+
+
+def _connections(system: etree._Element, plan: ExportPlan) -> None:
+    connections = _sub(system, "ssd", "Connections")
+    roles = {id(c): b for b in plan.bonds for c in b.connections}
+    for c in plan.all_connections:
+        element = _sub(connections, "ssd", "Connection", startElement=c.source.unit,
+                       startConnector=c.source.variable, endElement=c.target.unit,
+                       endConnector=c.target.variable)
+        bond = roles.get(id(c))
+        if bond is not None:
+            note = _annotation(element, BOND_ANNOTATION)
+            _sub(note, "wf", "Bond", name=bond.name, kind=bond.kind, role=c.role)
+
+
+def _units(parent: etree._Element, prefix: str, used: set[str], models) -> None:
+    """``<prefix>:Units`` defining each unit in ``used`` by its SI exponents."""
+    if not used:
+        return
+    definitions = {}
+    for model in models:
+        for definition in model.unitDefinitions:
+            definitions.setdefault(definition.name, definition)
+    units = _sub(parent, prefix, "Units")
+    for name in sorted(used):
+        element = _sub(units, "ssc", "Unit", name=name)
+        base = definitions.get(name)
+        attrs = {}
+        if base is not None and base.baseUnit is not None:
+            b = base.baseUnit
+            attrs = {k: str(getattr(b, k)) for k in _BASE if getattr(b, k)}
+            if b.factor != 1.0:
+                attrs["factor"] = repr(b.factor)
+            if b.offset != 0.0:
+                attrs["offset"] = repr(b.offset)
+        _sub(element, "ssc", "BaseUnit", **attrs)
+
+
+def _default_experiment(root: etree._Element, plan: ExportPlan) -> None:
+    experiment = _sub(root, "ssd", "DefaultExperiment", startTime="0.0",
+                      stopTime=repr(float(plan.scene.run.stop_time)))
+    note = _annotation(experiment, OSP_ANNOTATION)
+    algorithm = _sub(note, "osp", "Algorithm")
+    _sub(algorithm, "osp", "FixedStepAlgorithm", baseStepSize=repr(float(plan.scene.run.step)))
+
+
+def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etree._Element:
+    """The ``SystemStructure.ssd`` document of ``plan``.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        What to write.
+    fmu_names : dict, optional
+        File name in ``resources/`` of each FMU (default :func:`archive_names`).
+    """
+    names = fmu_names or archive_names(plan.units)
+    scene = plan.scene
+    root = etree.Element(_q("ssd", "SystemStructureDescription"),
+                         {"version": "1.0", "name": scene.name,
+                          "generationTool": f"wire_fmu {wire_fmu.__version__}",
+                          "generationDateAndTime": _now()},
+                         nsmap={k: NS[k] for k in ("ssd", "ssc", "osp", "wf")})
+    system = _sub(root, "ssd", "System", name=scene.name,
+                  description=scene.description.strip() or None)
+    elements = _sub(system, "ssd", "Elements")
+    for unit in plan.units:
+        _component(elements, unit, names[unit.fmu.resolve()])
+    _connections(system, plan)
+    note = _annotation(system, SCENE_ANNOTATION)
+    meta = dict(plan.metadata, signals=plan.signals)
+    _sub(note, "wf", "Scene").text = json.dumps(meta, indent=1, sort_keys=True)
+    used = {v.unit for u in plan.units for v in u.model.modelVariables if v.unit}
+    _units(root, "ssd", used, [u.model for u in plan.units])
+    _default_experiment(root, plan)
+    return root
+
+
+def ssv_tree(unit: PlannedUnit) -> etree._Element:
+    """The SSV 1.0 parameter set of ``unit`` (Reals with their units)."""
+    root = etree.Element(_q("ssv", "ParameterSet"),
+                         {"version": "1.0", "name": unit.name,
+                          "generationTool": f"wire_fmu {wire_fmu.__version__}"},
+                         nsmap={k: NS[k] for k in ("ssv", "ssc")})
+    parameters = _sub(root, "ssv", "Parameters")
+    used = set()
+    for name, typed in unit.start_values.items():
+        parameter = _sub(parameters, "ssv", "Parameter", name=name)
+        var_unit = unit.variable(name).unit if typed.type == "Real" else None
+        _sub(parameter, "ssv", typed.type, value=typed.text(), unit=var_unit or None)
+        used |= {var_unit} if var_unit else set()
+    _units(root, "ssv", used, [unit.model])
+    return root
+
+
+def _now() -> str:
+    return datetime.now(UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def _xml(root: etree._Element) -> bytes:
+    return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+
+
+def write_ssp(plan: ExportPlan, path: Path) -> Path:
+    """Write ``plan`` as the SSP package ``path`` (a ``.ssp`` zip).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    names = archive_names(plan.units)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr(SSD_NAME, _xml(ssd_tree(plan, names)))
+        for source, name in names.items():
+            archive.write(source, f"resources/{name}")
+        for unit in plan.units:
+            if unit.start_values:
+                archive.writestr(f"resources/{unit.name}.ssv", _xml(ssv_tree(unit)))
+    logger.info("wrote %s (%d components, %d connections)", path, len(plan.units),
+                len(plan.all_connections))
+    return path
+
+
+def export_ssp(scene: Scene, out: Path, *, fmu_dir: Path = DEFAULT_FMU_DIR) -> Path:
+    """Plan and write ``scene`` as an SSP package.
+
+    Parameters
+    ----------
+    scene : Scene
+        The parsed scene.
+    out : Path
+        A ``.ssp`` file, or a folder to write ``<scene name>.ssp`` into.
+    fmu_dir : Path
+        Where our FMUs are built and cached (and the signals FMU is built).
+    """
+    out = Path(out)
+    target = out if out.suffix == ".ssp" else out / f"{scene.name}.ssp"
+    return write_ssp(plan_export(scene, fmu_dir=fmu_dir), target)
