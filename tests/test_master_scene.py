@@ -35,7 +35,7 @@ def test_parse_errors_are_all_listed(tmp_path):
         "colour": "red",
         "run": {"step": -1, "algorithm": "newton", "extrapolation": "cubic"},
         "units": {"a": {"fmu": 3}, "b.c": {"fmu": "X.fmu", "effects": 5}},
-        "bonds": [{"name": "x", "kind": "hydraulic", "effort": "a.f -> b.f"}],
+        "bonds": [{"name": "x", "kind": "magnetic", "effort": "a.f -> b.f"}],
         "connections": [{"from": "nodot", "to": "a.x"}],
         "events": [{"time": -2, "set": {"a.x": 1}}],
     }

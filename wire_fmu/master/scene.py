@@ -59,6 +59,12 @@ Format::
     [[plots]]
     title = "Riser tension"
     variables = ["rope.line_b.tension"]
+
+    [study]                   # optional, for wire-fmu study (wire_fmu.study.accuracy)
+    key_outputs = ["rope.line_b.tension"]    # default: the plots' variables
+    stop_time = 10.0          # s, of every study run
+    steps = [0.02, 0.01, 0.005]              # macro steps, s
+    output_interval = 0.02    # s, a multiple of every step
 """
 
 from __future__ import annotations
@@ -98,6 +104,7 @@ BOND_KINDS = {
     "translational": ("N", "m/s", "m"),
     "rope": ("N", "m/s", "m"),
     "rotational": ("N.m", "rad/s", "rad"),
+    "hydraulic": ("Pa", "m3/s", "m3"),
 }
 
 
@@ -248,6 +255,7 @@ class Scene:
     run: RunSettings
     base_dir: Path
     source: Path | None = None
+    study: dict = field(default_factory=dict)
 
     @property
     def all_connections(self) -> tuple[Connection, ...]:
@@ -256,7 +264,7 @@ class Scene:
 
 
 _TOP_KEYS = {"name", "description", "run", "units", "bonds", "connections", "drivers",
-             "events", "outputs", "plots"}
+             "events", "outputs", "plots", "study"}
 _RUN_KEYS = set(RunSettings.__dataclass_fields__)
 
 
@@ -293,10 +301,14 @@ def parse_scene(data: Mapping[str, Any], *, base_dir: Path, source: Path | None 
     outputs = _parse_outputs(data.get("outputs", {}), problems)
     plots = _parse_plots(data.get("plots", []), problems)
     run = _parse_run(data.get("run", {}), problems)
+    study = data.get("study", {})
+    if not isinstance(study, Mapping):
+        problems.append("[study] must be a table (see wire_fmu.study.accuracy)")
+        study = {}
     if problems:
         raise SceneError(f"scene {name!r}", problems)
     return Scene(name, str(data.get("description", "")), units, bonds, connections, drivers,
-                 events, outputs, plots, run, Path(base_dir), source)
+                 events, outputs, plots, run, Path(base_dir), source, study=dict(study))
 
 
 def _as_list(value: Any, where: str, problems: list[str]) -> list:

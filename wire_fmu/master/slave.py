@@ -8,8 +8,9 @@ the ones of status Warning or worse so a refused step can be explained).
 
 fmpy keeps the logger callback it is handed in one global of a native
 library for the whole process, so the callback objects are kept alive in
-:data:`_CALLBACKS_ALIVE` for as long as the process lives (the only
-module-level state of the master, and it only grows by one per process).
+:data:`_KEEP_ALIVE` for as long as the process lives, and so are the FMU
+binaries once loaded (see :meth:`Slave.terminate`). That list is the only
+module-level state of the master; it grows by two entries per instance.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ __all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS"]
 logger = logging.getLogger(__name__)
 
 FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
-_CALLBACKS_ALIVE: list[object] = []
+_KEEP_ALIVE: list[object] = []
 
 
 class StepRefusedError(RuntimeError):
@@ -72,7 +73,7 @@ def _callbacks(messages: _Messages) -> fmi2CallbackFunctions:
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
     addLoggerProxy(ctypes.byref(callbacks))
-    _CALLBACKS_ALIVE.append(callbacks)
+    _KEEP_ALIVE.append(callbacks)
     return callbacks
 
 
@@ -136,14 +137,22 @@ class Slave:
         self._call("exitInitializationMode")
 
     def terminate(self) -> None:
-        """Terminate and free the instance (errors ignored: we are cleaning up)."""
+        """Terminate and free the instance (errors ignored: we are cleaning up).
+
+        The FMU's shared library stays loaded until the process ends: unloading
+        a pythonfmu binary while the interpreter it shares with us still holds
+        objects it created crashes the process at exit.
+        """
         if self._fmu is None:
             return
-        for fn in ("terminate", "freeInstance"):
+        fmu = self._fmu
+        for name, call in (("terminate", fmu.terminate),
+                           ("freeInstance", lambda: fmu.fmi2FreeInstance(fmu.component))):
             try:
-                getattr(self._fmu, fn)()
+                call()
             except Exception as exc:  # noqa: BLE001 - cleaning up, report and go on
-                logger.debug("%s: %s failed during cleanup: %s", self.name, fn, exc)
+                logger.debug("%s: %s failed during cleanup: %s", self.name, name, exc)
+        _KEEP_ALIVE.append(fmu)  # keep the library (and its handle) alive
         self._fmu = None
 
     # -- values ------------------------------------------------------------------
