@@ -312,3 +312,34 @@ class TestSpatialGeometry:
         with pytest.raises(ConfigurationError) as info:
             make_unit(self.offset_pulley(2.0), "spatial_geometry")
         assert "pulley" in str(info.value) and "hook" in str(info.value)
+
+
+def test_a_body_riding_on_a_driven_body_moves_with_it():
+    """A crown on cylinders on a heaving deck: its sheaves move by deck + rod displacement."""
+    reeving = drilling_block_train(4)
+    reeving["bodies"]["deck"] = {"kind": "driven", "direction": [0, 1, 0], "port": "mover_b"}
+    reeving["bodies"]["crown"] = {"kind": "driven", "direction": [0, 1, 0], "port": "mover_a",
+                                  "on": "deck"}
+    for name, sheave in reeving["sheaves"].items():
+        if name.startswith("crown"):
+            sheave["body"] = "crown"
+    unit = make_unit(reeving, "moving_geometry")
+    before = unit.values["block_a.position"]
+    # the deck rises 0.3 m and the rod retracts 0.3 m: the crown stays where it was
+    unit.values["mover_b.position"], unit.values["mover_a.position"] = 0.3, -0.3
+    unit.evaluate_outputs()
+    assert unit.values["line_a.tension"] == pytest.approx(1.2e5 * G / 4, rel=1e-8)
+    # the deck alone rises: every line between crown and block stretches by 0.3 m
+    unit.values["mover_a.position"] = 0.0
+    unit.evaluate_outputs()
+    assert unit.values["line_a.tension"] > 1.2e5 * G / 4
+    # the rope's force on the crown and on the deck (which carries the crown) are equal
+    assert unit.values["mover_a.force"] == pytest.approx(unit.values["mover_b.force"], rel=1e-12)
+    assert before == unit.values["block_a.position"]
+
+
+def test_blocks_cannot_ride_on_bodies():
+    reeving = drilling_block_train(4)
+    reeving["bodies"]["travelling_block"]["on"] = "ground"
+    with pytest.raises(ConfigurationError, match="cannot ride"):
+        make_unit(reeving)

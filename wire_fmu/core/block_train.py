@@ -202,8 +202,9 @@ class BlockTrainModel:
     def _node_circle(self, k: int, displacement: dict[str, float]) -> tuple[Circle, int]:
         r = self.reeving
         node = self.nodes[k]
-        body = r.bodies[r.node_body(node)]
-        shift = np.array(body.direction) * displacement.get(body.name, 0.0)
+        shift = np.zeros(3)
+        for name in r.carriers(r.node_body(node)):
+            shift += np.array(r.bodies[name].direction) * displacement.get(name, 0.0)
         if node.kind == "sheave":
             s = r.sheaves[node.name]
             centre = tuple(np.array(s.centre) + shift)
@@ -246,9 +247,9 @@ class BlockTrainModel:
         for b, name in enumerate(self.body_dof):
             d = np.array(self.reeving.bodies[name].direction)
             for k in range(self.n_segments):
-                if self.reeving.node_body(self.nodes[k + 1]) == name:
+                if name in self.reeving.carriers(self.reeving.node_body(self.nodes[k + 1])):
                     jac[k, b] += dirs[k] @ d
-                if self.reeving.node_body(self.nodes[k]) == name:
+                if name in self.reeving.carriers(self.reeving.node_body(self.nodes[k])):
                     jac[k, b] -= dirs[k] @ d
         self.length_jacobian0 = jac
         self.span_matrix = np.zeros((len(self.spans), self.n_segments))
@@ -275,16 +276,16 @@ class BlockTrainModel:
                          sum(a * c for a, c in zip(d, frame.v, strict=True))))
             del b
         for k in range(self.n_nodes):
-            body = self.reeving.node_body(self.nodes[k])
-            dof_of_node.append(self.body_dof.index(body) if body in self.body_dof else -1)
+            carriers = self.reeving.carriers(self.reeving.node_body(self.nodes[k]))
+            dof_of_node.append(tuple(self.body_dof.index(b) for b in carriers))
         self._planar = (xy0, np.array(frame.signed_radii), dof_of_node, dirs,
                         tuple(n.circle.name for n in nodes))
 
     def _planar_segment_lengths(self, y) -> np.ndarray:
         xy0, radii, dof_of_node, dirs, names = self._planar
         xy = [
-            (x, z) if b < 0 else (x + y[b] * dirs[b][0], z + y[b] * dirs[b][1])
-            for (x, z), b in zip(xy0, dof_of_node, strict=True)
+            (x + sum(y[b] * dirs[b][0] for b in dofs), z + sum(y[b] * dirs[b][1] for b in dofs))
+            for (x, z), dofs in zip(xy0, dof_of_node, strict=True)
         ]
         lengths, wraps = planar_path_lengths(xy, radii, names=names)
         seg = np.array(lengths)

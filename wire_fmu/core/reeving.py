@@ -107,6 +107,7 @@ class Body:
     position: float = 0.0
     port: str | None = None
     floor: Floor | None = None
+    on: str = "ground"
 
 
 @dataclass(frozen=True)
@@ -169,6 +170,14 @@ class Reeving:
         if element.kind == "anchor":
             return self.anchors[element.name].body
         return element.body
+
+    def carriers(self, body: str) -> list[str]:
+        """``body`` and the bodies it rides on, innermost first (ground excluded)."""
+        chain = []
+        while body != "ground":
+            chain.append(body)
+            body = self.bodies[body].on
+        return chain
 
     def bodies_of_kind(self, kind: str) -> list[Body]:
         """Bodies of one kind, in declaration order."""
@@ -299,8 +308,34 @@ def _parse_bodies(data: Mapping, p: _Problems) -> dict[str, Body]:
         else:
             if port not in MOVER_PORTS:
                 p.add(where, f"'port' of a driven body must be one of {MOVER_PORTS}, got {port!r}")
-            bodies[name] = Body(name, kind, direction, 0.0, 0.0, port)
+            bodies[name] = Body(name, kind, direction, 0.0, 0.0, port, on=spec.get("on", "ground"))
+    _check_carriers(bodies, data, p)
     return bodies
+
+
+def _check_carriers(bodies: dict[str, Body], data: Mapping, p: _Problems) -> None:
+    """A driven body may ride on another driven body (a crown on a heaving deck)."""
+    for name, body in bodies.items():
+        if body.on == "ground":
+            continue
+        where = f"body {name!r}"
+        carrier = bodies.get(body.on)
+        if carrier is None:
+            p.add(where, f"'on' names {body.on!r}, which is not a body")
+        elif carrier.kind != "driven":
+            p.add(where, f"'on' must name a driven body (its motion is an input), "
+                  f"{body.on!r} is a {carrier.kind}")
+        seen, current = {name}, body.on
+        while current in bodies and current != "ground":
+            if current in seen:
+                p.add(where, "bodies ride on each other in a circle")
+                break
+            seen.add(current)
+            current = bodies[current].on
+    for name, spec in data.items():
+        if isinstance(spec, Mapping) and spec.get("kind") == "block" and "on" in spec:
+            p.add(f"body {name!r}", "a block moves in the inertial frame; it cannot ride "
+                  "on another body")
 
 
 def _parse_floor(data: Any, where: str, p: _Problems) -> Floor | None:
