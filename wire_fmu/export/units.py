@@ -78,11 +78,13 @@ UNITS: dict[str, UnitDefinition] = {
         _u("kg.m2", kg=1, m=2),
         _u("kg/s", kg=1, s=-1),
         _u("kg/m3", kg=1, m=-3),
+        _u("kg/m", kg=1, m=-1),
         _u("N", (DisplayUnit("kN", 1e-3),), kg=1, m=1, s=-2),
         _u("kN", factor=1e3, kg=1, m=1, s=-2),
         _u("N.s", kg=1, m=1, s=-1),
         _u("N/m", kg=1, s=-2),
         _u("N.s/m", kg=1, s=-1),
+        _u("N.s2/m2", kg=1, m=-1),  # quadratic damping (hydraulic cushion F = c v^2)
         _u("N.m", (DisplayUnit("kN.m", 1e-3),), kg=1, m=2, s=-2),
         _u("N.m.s", kg=1, m=2, s=-1),
         _u("N.m/rad", kg=1, m=2, s=-2, rad=-1),
