@@ -1,0 +1,501 @@
+"""The hydraulic cylinder with gas accumulator as a co-simulation unit.
+
+Port (power bond)
+-----------------
+``rod``
+    Input ``rod.force`` (N): the external force on the rod along its
+    extension direction (positive pushes the rod out). In a riser tensioner
+    it is the block train's ``mover_a.force`` (the rope's force on the
+    driven body along the body's direction, which is the rod's extension
+    direction), negative because the rope pulls the rod in. Outputs
+    ``rod.position`` (m, extension from fully retracted) and
+    ``rod.velocity`` (m/s) are states of the rod mass and depend on no
+    input: the rope's compliance lives in the block train, the cut is at
+    the rod's inertia. ``rod.displacement`` (m) is the extension since the
+    start, for a block train whose reeving is drawn at the initial position.
+    Power into the hydraulics through the rod is ``rod.force * rod.velocity``.
+
+Outputs that depend on the input within a step
+----------------------------------------------
+``rod.acceleration``, ``seal.friction_force`` (a stuck seal holds whatever
+the forces need), ``chamber.pressure`` and ``hydraulic_force`` (with
+``line_inertance`` and incompressible oil the line's oil column is
+accelerated with the rod). Everything else is a function of the state.
+
+Initial state
+-------------
+With ``initial_equilibrium`` (the default) the unit starts at rest at
+``initial_position`` in static equilibrium with the value of ``rod.force``
+at initialisation: the gas pressure is set so that
+``s A (p - p_amb) + rod.force + m g_rod = 0`` (the gas having been charged
+slowly from the pre-charge, so its volume is ``V_full p_precharge / p``),
+the line is at rest and a seal starts stuck with no load on it: no start-up
+transient. Otherwise the gas starts at ``initial_gas_pressure`` and the rod
+moves at ``initial_velocity``.
+
+Parameter defaults and where they come from
+-------------------------------------------
+A push-type (bore-pressurised) cylinder of a single wire-line riser
+tensioner reeved 4:1 (paper 000, Fig. 6; the reeving
+:func:`wire_fmu.core.reevings.riser_tensioner`: vertical cylinder, rod
+extending upwards, so ``gravity_along_rod = -9.81``), sized for the common
+80 kip (356 kN) wire-line tensioner class with about 50 ft (15 m) of wire
+travel: 4 x 356 kN = 1.42 MN on the rod over a 3.81 m (12.5 ft) stroke.
+
+* Bore 14 in (0.356 m) gives 14.7 MPa (2130 psi) working pressure at that
+  load, within the 2000-3000 psi class of such tensioners; rod 9 in
+  (0.229 m), thick against buckling (estimate).
+* Moving mass 3500 kg: rod about 1450 kg (9 in x 4.5 m steel), piston
+  about 250 kg, moving sheave cluster (two 60 in sheaves and yoke) about
+  1800 kg (estimate).
+* Gas: air/oil accumulator 0.6 m^3 (the swept volume is 0.38 m^3) and
+  3.0 m^3 of air pressure vessels, so that the tension varies by about
+  10-15 % over the full stroke (API RP 16Q asks for a tension variation
+  the designer states; the gas volume is chosen for it). Pre-charge
+  13.5 MPa leaves about 0.3 m^3 of oil in the accumulator at mid stroke.
+  ``polytropic_exponent`` 1.4: nitrogen/air, adiabatic (fast heave).
+* Line: 15 m of 6 in (0.152 m) bore pipe and hose; mineral oil ISO VG 32
+  at 40 C: 870 kg/m^3, 0.028 Pa s; Darcy factor 0.025 (Blasius at
+  Re ~ 2e4); minor losses K = 5 for the velocity-limiting (anti-recoil)
+  valve that API RP 16Q places between each tensioner and its air/oil
+  bottle, bends, entry and exit (estimate).
+* Oil: effective bulk modulus 1.5 GPa (mineral oil about 1.7 GPa, less
+  with entrained air and pipe compliance); cavitation at 0.1 bar absolute.
+* Seals: breakaway 25 kN (about 1.7 % of the rated force; large cylinder
+  seals take 1-3 %), Coulomb 15 kN, viscous 2e4 N s/m, Stribeck velocity
+  0.01 m/s (estimates).
+* End stops: 0.15 m cushions with ``c = 1e5 N s^2/m^2``: 2.5 MN at 5 m/s,
+  enough to catch a rod that runs away when a wire breaks (1.46 MN of gas
+  force), and an e-folding length ``m / c = 35 mm`` well inside the cushion;
+  stop 1e9 N/m, restitution 0.3 (estimates).
+* Solver ``ros2``, 1 ms: linearly implicit and L-stable, so the stiff oil
+  column (line time constant ``R_l C`` about 10 microseconds) and the stuck
+  seal cost no more than the gas spring, and its fixed steps make FMU runs
+  bit-reproducible; during stop impacts and cushion runs the model refines
+  the fixed step itself (see :mod:`wire_fmu.core.hydraulics`, Numerics).
+  ``radau`` is the adaptive alternative, e.g. for a line restricted so much
+  that its turbulent loss changes stiffness by orders of magnitude within
+  one communication step (ROS2 keeps one Jacobian per step).
+
+Connecting it to a block train
+------------------------------
+``rope.mover_a.force -> rod.force`` and ``rod.velocity ->
+rope.mover_a.velocity``; for the position use ``rod.displacement`` when the
+reeving is drawn at the initial extension (as
+:func:`~wire_fmu.core.reevings.riser_tensioner` is, at mid stroke, the default
+``initial_position``), ``rod.position`` when it is drawn fully retracted.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .errors import ConfigurationError, ModelError
+from .hybrid import IntegrationError, SolverSettings
+from .hydraulic_line import HydraulicLine
+from .hydraulics import (
+    HYDRAULICS_EFFECTS,
+    AccumulatorSpec,
+    CylinderSpec,
+    EndStopSpec,
+    HydraulicsModel,
+    HydraulicsSpec,
+    OilSpec,
+    SealSpec,
+)
+from .interface import OdeView, StepResult, Unit, input_, output, parameter
+
+__all__ = ["HydraulicsUnit", "DEFAULT_ROD_FORCE"]
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_ROD_FORCE = -4.0 * 356.0e3
+"""Start value of ``rod.force``: an 80 kip rope tension through a 4:1 reeving, N."""
+
+_FEEDTHROUGH = ("rod.force",)
+
+
+def _physical_parameters():
+    return (
+        parameter("pressurised_side", "bore", "", "Oil-filled side: 'bore' (gas pushes the rod "
+                  "out) or 'annulus' (gas pulls it in); the other side is vented", type=str),
+        parameter("bore_diameter", 0.356, "m", "Piston (bore) diameter", min=0.0),
+        parameter("rod_diameter", 0.229, "m", "Rod diameter", min=0.0),
+        parameter("stroke", 3.81, "m", "Stroke", min=0.0),
+        parameter("moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries",
+                  min=0.0),
+        parameter("chamber_dead_volume", 0.01, "m3",
+                  "Oil in the pressurised chamber at zero working length", min=0.0),
+        parameter("gravity_along_rod", -9.81, "m/s2",
+                  "Gravity along the extension direction (-9.81: vertical, rod extends up)"),
+        parameter("ambient_pressure", 101325.0, "Pa",
+                  "Absolute pressure on the vented side and the rod's outer end", min=0.0),
+        parameter("accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)",
+                  min=0.0),
+        parameter("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels", min=0.0),
+        parameter("accumulator_dead_volume", 0.01, "m3",
+                  "Gas left in the accumulator when it is full of oil", min=0.0),
+        parameter("precharge_pressure", 13.5e6, "Pa",
+                  "Absolute gas pressure with no oil in the accumulator", min=0.0),
+        parameter("polytropic_exponent", 1.4, "1",
+                  "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)",
+                  min=1.0, max=2.0),
+        parameter("line_length", 15.0, "m", "Length of the oil line", min=0.0),
+        parameter("line_diameter", 0.1524, "m", "Inner diameter of the oil line", min=0.0),
+        parameter("oil_density", 870.0, "kg/m3", "Oil density", min=0.0),
+        parameter("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity", min=0.0),
+        parameter("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent",
+                  min=0.0),
+        parameter("line_loss_coefficient", 5.0, "1",
+                  "Sum of minor-loss coefficients (valves, bends, entry, exit)", min=0.0),
+        parameter("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus", min=0.0),
+        parameter("oil_volume", 0.0, "m3", "Oil volume whose compressibility is modelled "
+                  "(0: chamber at the initial position plus line)", min=0.0),
+        parameter("cavitation_pressure", 1.0e4, "Pa",
+                  "Absolute chamber pressure at which the step is refused (cavitation)", min=0.0),
+        parameter("seal_static_friction", 25.0e3, "N", "Seal breakaway force", min=0.0),
+        parameter("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force",
+                  min=0.0),
+        parameter("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient",
+                  min=0.0),
+        parameter("seal_stribeck_velocity", 0.01, "m/s",
+                  "Stribeck velocity (0: no Stribeck decay)", min=0.0),
+        parameter("cushion_length", 0.15, "m", "Length of the cushion zone at each end",
+                  min=0.0),
+        parameter("cushion_coefficient", 1.0e5, "N.s2/m2",
+                  "Cushion force coefficient c in F = c v^2", min=0.0),
+        parameter("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness", min=0.0),
+        parameter("stop_restitution", 0.3, "1", "Coefficient of restitution at an end stop",
+                  min=0.0, max=1.0),
+    )
+
+
+def _variables():
+    params = (
+        parameter("effects", "", "", "Effects to include, comma separated: "
+                  + ", ".join(HYDRAULICS_EFFECTS.names), type=str),
+        parameter("solver", "ros2", "", "Internal solver: rk4, ros2, radau, bdf, lsoda, rk45, "
+                  "dop853", type=str),
+        parameter("solver_max_step", 1e-3, "s", "Largest internal step", min=0.0),
+        parameter("solver_rtol", 1e-6, "1", "Relative tolerance of adaptive solvers", min=0.0),
+        parameter("solver_atol", 1e-9, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *_physical_parameters(),
+        parameter("initial_equilibrium", True, "", "Start at rest in static equilibrium with "
+                  "the initial rod.force", type=bool),
+        parameter("initial_position", 1.905, "m", "Initial extension from fully retracted"),
+        parameter("initial_velocity", 0.0, "m/s",
+                  "Initial rod velocity (0 required with initial_equilibrium)"),
+        parameter("initial_gas_pressure", 14.75e6, "Pa",
+                  "Initial absolute gas pressure when initial_equilibrium is false", min=0.0),
+    )
+    inputs = (input_("rod.force", DEFAULT_ROD_FORCE, "N",
+                     "External force on the rod along extension (positive pushes it out)"),)
+    deps = _FEEDTHROUGH
+    outputs = (
+        output("rod.position", "m", "Rod extension from fully retracted"),
+        output("rod.velocity", "m/s", "Rod velocity along extension"),
+        output("rod.displacement", "m", "Rod extension since the start"),
+        output("rod.acceleration", "m/s2", "Rod acceleration along extension", depends_on=deps),
+        output("rod.stiffness", "N/m", "Quasi-static spring rate of gas and oil at the rod"),
+        output("chamber.pressure", "Pa", "Absolute pressure at the cylinder port",
+               depends_on=deps),
+        output("hydraulic_force", "N", "Oil force on the rod along extension (gauge pressure "
+               "times area)", depends_on=deps),
+        output("gas.pressure", "Pa", "Absolute gas pressure"),
+        output("gas.volume", "m3", "Gas volume (accumulator gas side plus gas bank)"),
+        output("line.flow", "m3/s", "Oil flow from the accumulator to the cylinder"),
+        output("accumulator.oil_volume", "m3", "Oil in the accumulator"),
+        output("stroke_used", "1", "Rod extension as a fraction of the stroke"),
+        output("seal.friction_force", "N", "Seal friction on the rod along extension",
+               depends_on=deps),
+        output("seal.stuck", "", "Whether the seals hold the rod (stick)", type=bool),
+        output("end_stop.force", "N", "Cushion and stop force on the rod along extension"),
+        output("end_stop.contact", "", "Whether the rod is on an end stop", type=bool),
+        output("stored_energy", "J", "Kinetic, gas, oil, stop-pad and potential energy"),
+        output("dissipated_energy", "J", "Energy dissipated since the start"),
+        output("external_work", "J", "Work done on the unit through the rod since the start"),
+        output("energy_balance", "J",
+               "Ledger residual: stored change + dissipated - external work"),
+        output("mode_changes", "", "Number of mode events so far (stick/slip, end stops, "
+               "cushions)", type=int),
+    )
+    return params + inputs + outputs
+
+
+class HydraulicsUnit(Unit):
+    """Hydraulic cylinder with gas accumulator and gas bank (SPEC sections 11-12)."""
+
+    NAME = "Hydraulics"
+    DESCRIPTION = "Hydraulic cylinder with gas accumulator (hydro-pneumatic spring), wire_fmu"
+    VARIABLES = _variables()
+
+    def __init__(self, instance_name: str = "hydraulics") -> None:
+        super().__init__(instance_name)
+        self.model: HydraulicsModel | None = None
+        self.initial_energy = 0.0
+        self.time = 0.0
+
+    @property
+    def who(self) -> str:
+        """``"Hydraulics '<instance>'"``, the prefix of every message."""
+        return f"{self.NAME} {self.instance_name!r}"
+
+    # ------------------------------------------------------------ life cycle
+    def configure(self) -> None:
+        """Parse effects, solver and physical parameters; build the model.
+
+        Raises
+        ------
+        ConfigurationError
+            Listing every problem with the parameters.
+        """
+        v = self.values
+        problems: list[str] = []
+        effects, effect_problems = HYDRAULICS_EFFECTS.parse(v["effects"])
+        problems += [f"parameter 'effects': {p}" for p in effect_problems]
+        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
+                                  float(v["solver_rtol"]), float(v["solver_atol"]))
+        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
+                     for p in settings.problems()]
+        spec = self.spec()
+        problems += spec.problems()
+        problems += self._initial_problems()
+        if problems:
+            raise ConfigurationError(self.who, problems)
+        self.model = HydraulicsModel(spec, effects, settings)
+
+    def spec(self) -> HydraulicsSpec:
+        """The physical parameters now in :attr:`values`, unvalidated."""
+        v = {k: val for k, val in self.values.items()}
+        f = {k: float(val) for k, val in v.items()
+             if not isinstance(val, str | bool)}
+        return HydraulicsSpec(
+            cylinder=CylinderSpec(f["bore_diameter"], f["rod_diameter"], f["stroke"],
+                                  f["moving_mass"], str(v["pressurised_side"]),
+                                  f["chamber_dead_volume"], f["gravity_along_rod"],
+                                  f["ambient_pressure"]),
+            accumulator=AccumulatorSpec(f["accumulator_volume"], f["gas_bank_volume"],
+                                        f["accumulator_dead_volume"], f["precharge_pressure"],
+                                        f["polytropic_exponent"]),
+            line=HydraulicLine(f["line_length"], f["line_diameter"], f["oil_density"],
+                               f["oil_viscosity"], f["line_friction_factor"],
+                               f["line_loss_coefficient"]),
+            oil=OilSpec(f["bulk_modulus"], f["oil_volume"], f["cavitation_pressure"]),
+            seal=SealSpec(f["seal_static_friction"], f["seal_coulomb_friction"],
+                          f["seal_viscous_friction"], f["seal_stribeck_velocity"]),
+            stops=EndStopSpec(f["cushion_length"], f["cushion_coefficient"],
+                              f["stop_stiffness"], f["stop_restitution"]),
+        )
+
+    def _initial_problems(self) -> list[str]:
+        v = self.values
+        out = []
+        if bool(v["initial_equilibrium"]) and float(v["initial_velocity"]) != 0.0:
+            out.append("parameter 'initial_velocity' must be 0 with initial_equilibrium "
+                       f"(static equilibrium is at rest), got {v['initial_velocity']}")
+        if not bool(v["initial_equilibrium"]) and not float(v["initial_gas_pressure"]) > 0.0:
+            out.append("parameter 'initial_gas_pressure' must be > 0 Pa, got "
+                       f"{v['initial_gas_pressure']}")
+        return out
+
+    def initialize(self, start_time: float) -> None:
+        """Initial state (equilibrium or as given); outputs filled."""
+        model = self._require_model()
+        v = self.values
+        pressure = None if bool(v["initial_equilibrium"]) else float(v["initial_gas_pressure"])
+        try:
+            model.initialize(float(v["rod.force"]), position=float(v["initial_position"]),
+                             velocity=float(v["initial_velocity"]), gas_pressure=pressure)
+        except ConfigurationError as err:
+            raise ConfigurationError(self.who, err.problems) from None
+        except ModelError as err:
+            raise ConfigurationError(self.who, [f"initial state: {err}"]) from None
+        self.time = float(start_time)
+        self.initial_energy = model.stored_energy()
+        self._update_outputs()
+
+    def advance(self, time: float, step: float) -> StepResult:
+        """Advance by ``step`` seconds with ``rod.force`` held; refuse at a limit."""
+        model = self._require_model()
+        saved = self.get_state()
+        try:
+            model.advance(time, step, float(self.values["rod.force"]))
+            self.time = time + step
+            self._update_outputs()
+        except (ModelError, IntegrationError, FloatingPointError, ValueError,
+                ZeroDivisionError, OverflowError) as err:
+            self.set_state(saved)
+            message = f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
+            logger.debug("%s", message)
+            return StepResult(False, message)
+        return StepResult(True, events=tuple(model.last_events))
+
+    def evaluate_outputs(self) -> None:
+        """Feedthrough outputs for the ``rod.force`` now set; the state is untouched."""
+        model = self._require_model()
+        held = model.force
+        model.force = float(self.values["rod.force"])
+        try:
+            self._update_outputs()
+        finally:
+            model.force = held
+
+    def ode(self) -> OdeView:
+        """The cylinder's hybrid ODE, for a monolithic model."""
+        return _HydraulicsOde(self)
+
+    # ---------------------------------------------------------------- state
+    def get_state(self) -> dict[str, Any]:
+        """Complete state: continuous state, modes, held input, gas reference."""
+        m = self._require_model()
+        return {
+            "x": [float(c) for c in m.state],
+            "force": float(m.force),
+            "contact": [bool(b) for b in m.contact],
+            "in_cushion": [bool(b) for b in m.in_cushion],
+            "contact_since": m.contact_since if math.isfinite(m.contact_since) else None,
+            "friction_mode": m.friction.get_mode(),
+            "held_position": float(m._held_position),
+            "mode_changes": int(m.mode_changes),
+            "external_work": float(m.external_work),
+            "gas_reference": [float(m.gas.reference_pressure), float(m.gas.reference_volume)],
+            "compliance": float(m.compliance),
+            "oil_constant": float(m.oil_constant),
+            "initial_position": float(m.initial_position),
+            "time": float(self.time),
+            "initial_energy": float(self.initial_energy),
+        }
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`."""
+        from .gas import PolytropicGas
+
+        m = self._require_model()
+        m.state = np.array(state["x"], dtype=float)
+        m.force = float(state["force"])
+        m.contact = [bool(b) for b in state["contact"]]
+        m.in_cushion = [bool(b) for b in state["in_cushion"]]
+        since = state["contact_since"]
+        m.contact_since = -math.inf if since is None else float(since)
+        m.friction.set_mode(list(state["friction_mode"]))
+        m._held_position = float(state["held_position"])
+        m.mode_changes = int(state["mode_changes"])
+        m.external_work = float(state["external_work"])
+        p0, v0 = state["gas_reference"]
+        m.gas = PolytropicGas(float(p0), float(v0), m.exponent)
+        m.compliance = float(state["compliance"])
+        m.oil_constant = float(state["oil_constant"])
+        m.initial_position = float(state["initial_position"])
+        self.time = float(state["time"])
+        self.initial_energy = float(state["initial_energy"])
+        self._update_outputs()
+
+    # -------------------------------------------------------------- helpers
+    def _require_model(self) -> HydraulicsModel:
+        if self.model is None:
+            raise RuntimeError(f"{self.who}: configure() first")
+        return self.model
+
+    def _update_outputs(self) -> None:
+        m = self._require_model()
+        r = m.report()
+        out = self.values
+        out["rod.position"] = r["position"]
+        out["rod.velocity"] = r["velocity"]
+        out["rod.displacement"] = r["position"] - m.initial_position
+        out["rod.acceleration"] = r["acceleration"]
+        out["rod.stiffness"] = r["stiffness"]
+        out["chamber.pressure"] = r["chamber_pressure"]
+        out["hydraulic_force"] = r["hydraulic_force"]
+        out["gas.pressure"] = r["gas_pressure"]
+        out["gas.volume"] = r["gas_volume"]
+        out["line.flow"] = r["flow"]
+        out["accumulator.oil_volume"] = r["oil_in_accumulator"]
+        out["stroke_used"] = r["position"] / m.cyl.stroke
+        out["seal.friction_force"] = r["friction_force"]
+        out["seal.stuck"] = bool(m.friction_on and m.friction.mode[0] == 0)
+        out["end_stop.force"] = r["stop_force"]
+        out["end_stop.contact"] = bool(any(m.contact))
+        out["stored_energy"] = r["stored_energy"]
+        out["dissipated_energy"] = m.dissipated_energy
+        out["external_work"] = float(m.external_work)
+        out["energy_balance"] = (r["stored_energy"] - self.initial_energy
+                                 + out["dissipated_energy"] - out["external_work"])
+        out["mode_changes"] = int(m.mode_changes)
+        if not all(math.isfinite(value) for value in r.values()):
+            raise FloatingPointError(f"{self.who}: non-finite outputs {r}")
+
+
+class _HydraulicsOde(OdeView):
+    """:class:`HydraulicsUnit` as a piece of a monolithic ODE.
+
+    The state is the model's, ``[x, v, (V_g, p_c, q), dissipated]``, followed
+    by the external work: in a monolithic model ``rod.force`` varies within a
+    step, so its work ``force * v`` is integrated rather than booked per step.
+    The unit's own step refinement (stop impacts, cushions) is not used here;
+    the monolithic solver chooses its steps. A limit still raises
+    :class:`~wire_fmu.core.hydraulics.HydraulicLimitError` from ``handle_events``.
+    """
+
+    def __init__(self, unit: HydraulicsUnit) -> None:
+        self.unit = unit
+        self.model = unit._require_model()
+
+    @property
+    def state(self) -> np.ndarray:
+        """``[model state, external work]`` (a copy)."""
+        return np.append(self.model.state, self.model.external_work)
+
+    def set_state(self, x: np.ndarray, t: float) -> None:
+        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        self.model.state = np.array(x[:-1], dtype=float)
+        self.model.external_work = float(x[-1])
+        self.unit.time = t
+        self.bind_inputs(t)
+        self.unit._update_outputs()
+
+    def bind_inputs(self, t: float) -> None:
+        """``rod.force`` in ``values`` is the force at ``t``."""
+        self.model.force = float(self.unit.values["rod.force"])
+
+    def publish(self, t: float, x: np.ndarray) -> None:
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        m = self.model
+        saved = m.state, m.external_work, self.unit.time
+        m.state, m.external_work, self.unit.time = np.asarray(x[:-1], dtype=float), float(x[-1]), t
+        try:
+            self.unit._update_outputs()
+        finally:
+            m.state, m.external_work, self.unit.time = saved
+
+    def rhs(self, t, x):
+        """Model derivative, then the power ``force * dx/dt`` into the rod port."""
+        derivative = self.model.rhs(t, x[:-1])
+        return np.append(derivative, self.model.force * derivative[0])
+
+    def guards(self, t, x):
+        """See :meth:`HydraulicsModel.guards`."""
+        return self.model.guards(t, x[:-1])
+
+    def guard_directions(self):
+        """See :meth:`HydraulicsModel.guard_directions`."""
+        return self.model.guard_directions()
+
+    def handle_events(self, t, x, fired):
+        """See :meth:`HydraulicsModel.handle_events`."""
+        return np.append(self.model.handle_events(t, x[:-1], fired), x[-1])
+
+    def project(self, x):
+        """See :meth:`HydraulicsModel.project`."""
+        return np.append(self.model.project(np.array(x[:-1], dtype=float)), x[-1])
+
+    def reconcile(self, t, x):
+        """The force jumped at ``t``: settle the seal's mode."""
+        self.bind_inputs(t)
+        self.model.state = self.model.settle(x[:-1])
+        return self.state
