@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["drilling_line", "drilling_block_train", "single_fall", "riser_tensioner",
-           "tensioner_line"]
+__all__ = ["drilling_line", "drilling_block_train", "heave_compensated_block_train",
+           "single_fall", "riser_tensioner", "tensioner_line"]
 
 GRAVITY = (0.0, -9.81, 0.0)
 
@@ -102,6 +102,30 @@ def drilling_block_train(
                                  "point": [(2 * n_lines) * radius + radius, 0.0, 0.0]}},
         "path": path,
     }
+
+
+def heave_compensated_block_train(n_lines: int = 10, **kwargs: Any) -> dict[str, Any]:
+    """A drilling block train whose crown block rides on compensator cylinders on a heaving deck.
+
+    Written in the earth frame: the deck (derrick, drawworks, dead-line
+    anchor) heaves through ``mover_b``; the crown block rides on the deck
+    on the rods of a crown-mounted passive heave compensator, through
+    ``mover_a`` (rod displacement relative to the deck, up); the travelling
+    block with the hook load hangs in the rope. Keyword arguments go to
+    :func:`drilling_block_train`.
+    """
+    reeving = drilling_block_train(n_lines, **kwargs)
+    reeving["name"] = f"{n_lines}-line block train with crown-mounted heave compensator"
+    reeving["bodies"]["deck"] = {"kind": "driven", "direction": [0.0, 1.0, 0.0],
+                                 "port": "mover_b"}
+    reeving["bodies"]["crown"] = {"kind": "driven", "direction": [0.0, 1.0, 0.0],
+                                  "port": "mover_a", "on": "deck"}
+    for name, sheave in reeving["sheaves"].items():
+        if name.startswith("crown"):
+            sheave["body"] = "crown"
+    reeving["anchors"]["deadline"]["body"] = "deck"
+    reeving["path"][0]["body"] = "deck"
+    return reeving
 
 
 def tensioner_line() -> dict[str, float]:

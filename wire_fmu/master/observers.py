@@ -78,10 +78,11 @@ class CsvRecorder:
             self._row(sim)
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Close the file and write the summary into the metadata."""
+        """Close the file and write the summary into the metadata (also after a failure)."""
         if self._file is not None:
             self._file.close()
             self._file = None
+        self.directory.mkdir(parents=True, exist_ok=True)
         self._write_metadata(sim, result)
 
     # -- internals ---------------------------------------------------------------

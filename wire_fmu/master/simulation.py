@@ -165,7 +165,13 @@ class Simulation:
             values.update(self.drivers.values(name, start, None))
             values.update(self.events.values(name))
             slave.initialize(start, values)
-        for name in self.algorithm.order:  # sources first: their outputs feed the next
+        # In initialisation mode, hand outputs to the inputs they feed, sources first,
+        # twice over so that feedback (an effort returned to a flow side) settles.
+        for _ in range(2):
+            for name in self.algorithm.order:
+                self._set_connected_from_latest(name)
+                self._push(name, start)
+        for name in self.algorithm.order:
             self._set_connected_from_latest(name)
             self.slaves[name].exit_initialization()
             self._push(name, start)

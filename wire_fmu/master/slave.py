@@ -9,8 +9,10 @@ the ones of status Warning or worse so a refused step can be explained).
 fmpy keeps the logger callback it is handed in one global of a native
 library for the whole process, so the callback objects are kept alive in
 :data:`_KEEP_ALIVE` for as long as the process lives, and so are the FMU
-binaries once loaded (see :meth:`Slave.terminate`). That list is the only
-module-level state of the master; it grows by two entries per instance.
+binaries once loaded (see :meth:`Slave.terminate`); and because fmpy sends
+every FMU's messages through the callback registered last, messages are
+routed to their instance by name through :data:`_ROUTES`. These two are the
+only module-level state of the master.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ logger = logging.getLogger(__name__)
 
 FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
 _KEEP_ALIVE: list[object] = []
+_ROUTES: dict[str, _Messages] = {}
 
 
 class StepRefusedError(RuntimeError):
@@ -53,18 +56,26 @@ class UnitFailedError(RuntimeError):
 
 @dataclass
 class _Messages:
-    """Log messages of one FMU instance (Warning or worse are kept)."""
+    """Log messages of one FMU instance (Warning or worse are kept).
+
+    fmpy sends every FMU's messages through the callback registered last, so
+    each message is routed by the instance name it carries.
+    """
 
     name: str
     kept: list[str] = field(default_factory=list)
 
+    def __post_init__(self) -> None:
+        _ROUTES[self.name] = self
+
     def __call__(self, env, instance, status, category, message) -> None:
         text = message.decode("utf-8", "replace") if message else ""
+        name = instance.decode("utf-8", "replace") if instance else self.name
         level = {0: logging.DEBUG, 1: logging.WARNING, 2: logging.WARNING}.get(status,
                                                                                 logging.ERROR)
-        logger.log(level, "%s [%s]: %s", self.name, FMI_STATUS.get(status, status), text)
+        logger.log(level, "%s [%s]: %s", name, FMI_STATUS.get(status, status), text)
         if status >= 1:
-            self.kept.append(text)
+            _ROUTES.get(name, self).kept.append(text)
 
 
 def _callbacks(messages: _Messages) -> fmi2CallbackFunctions:
@@ -97,6 +108,7 @@ class Slave:
         self.seconds: dict[str, float] = defaultdict(float)
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
+        self._fatal = False
 
     # -- description ---------------------------------------------------------
     @property
@@ -146,6 +158,10 @@ class Slave:
         if self._fmu is None:
             return
         fmu = self._fmu
+        if self._fatal:  # FMI 2.0: after fmi2Fatal no further call is allowed
+            _KEEP_ALIVE.append(fmu)
+            self._fmu = None
+            return
         for name, call in (("terminate", fmu.terminate),
                            ("freeInstance", lambda: fmu.fmi2FreeInstance(fmu.component))):
             try:
@@ -202,6 +218,7 @@ class Slave:
         try:
             self._call("doStep", currentCommunicationPoint=t, communicationStepSize=h)
         except FMICallException as exc:
+            self._fatal = self._fatal or exc.status == 4
             said = "; ".join(self.messages.kept[-3:]) or "no message"
             if exc.status == 2:
                 raise StepRefusedError(f"unit {self.name!r} refused the step at t = {t:.6g} s "
@@ -230,6 +247,7 @@ class Slave:
                 return self._fmu.instantiate(*args, **kwargs)
             return getattr(self._fmu, fn)(*args, **kwargs)
         except FMICallException as exc:
+            self._fatal = self._fatal or exc.status == 4
             if fn == "doStep":
                 raise
             said = "; ".join(self.messages.kept[-5:]) or "no message"

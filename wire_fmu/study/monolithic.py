@@ -116,12 +116,17 @@ class MonolithicModel:
     def initialize(self, t0: float = 0.0) -> np.ndarray:
         """Initialise the units in step order, as the master does; return the state."""
         self.events.fire_due(t0)
-        for name in self.order:
+        ready: set[str] = set()
+        for name in self.order:  # as the master: sources first, each from what is ready
             unit = self.units[name]
             unit.values.update(self.drivers.values(name, t0))
             unit.values.update(self.events.values(name))
-            self._feed(name)
+            self._feed(name, ready)
             unit.initialize(t0)
+            ready.add(name)
+        for name in self.order:  # once more with every partner's initial outputs
+            self._feed(name)
+            self.units[name].initialize(t0)
         for name in self.order:
             self._feed(name)
         start, g_start, dirs = 0, 0, []
@@ -141,11 +146,13 @@ class MonolithicModel:
         """The joint state vector."""
         return np.concatenate([self.views[n].state for n in self.order])
 
-    def _feed(self, name: str) -> None:
-        """Copy the current outputs of ``name``'s sources into its inputs."""
+    def _feed(self, name: str, only: set[str] | None = None) -> None:
+        """Copy the current outputs of ``name``'s sources (those in ``only``) into its inputs."""
         unit = self.units[name]
         for c in self.into.get(name, ()):
-            unit.values[c.target.variable] = self.units[c.source.unit].values[c.source.variable]
+            if only is None or c.source.unit in only:
+                unit.values[c.target.variable] = self.units[c.source.unit].values[
+                    c.source.variable]
 
     def _propagate(self, t: float, x: np.ndarray) -> None:
         """Outputs from states, inputs from outputs, in step order."""
