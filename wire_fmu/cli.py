@@ -7,8 +7,17 @@
     wire-fmu run SCENE [-o DIR]     run it: progress bar, summary table, CSV and PNG plots
     wire-fmu draw SCENE [-o DIR]    render each block train's reeving to a PNG
     wire-fmu build [-o DIR]         build our FMUs
+    wire-fmu study accuracy SCENE [--quick] [-o DIR]
+                                    work-precision study: error against cost per configuration
+    wire-fmu study effects SCENE [--quick] [-o DIR]
+                                    what leaving each effect out saves and changes
+    wire-fmu sweep SCENE SWEEP_SPEC [-o DIR] [--workers N] [--scheduler ADDRESS]
+                                    run a parameter sweep on Dask (docs/sweeps.md)
+    wire-fmu export SCENE --format ssp|osp [-o DIR]
+                                    write an SSP package or an OSP configuration
 
-SCENE is a shipped scene's name or a path to a scene file.
+SCENE is a shipped scene's name or a path to a scene file; check, run and
+export also take an SSP package (.ssp).
 """
 
 from __future__ import annotations
@@ -53,11 +62,9 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a scene; exit 1 listing every problem."""
-    from wire_fmu.master.run import find_scene
-    from wire_fmu.master.scene import load_scene
     from wire_fmu.master.validate import validate_scene
 
-    scene = load_scene(find_scene(args.scene))
+    scene = _load_any_scene(args.scene)
     validate_scene(scene, args.fmu_dir)
     _print(f"scene {scene.name!r}: no problems ({len(scene.units)} units, "
            f"{len(scene.bonds)} bonds, {len(scene.connections)} connections)")
@@ -115,6 +122,98 @@ def cmd_build(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """Run a parameter sweep; exit 1 unless every case finished."""
+    from wire_fmu.master.run import find_scene
+    from wire_fmu.master.scene import load_scene
+    from wire_fmu.sweep import load_sweep_spec, run_sweep
+
+    if not args.verbose:  # a local cluster's scheduler runs here and logs every event
+        import distributed  # noqa: F401 - sets its loggers' levels on import; then quieten
+
+        logging.getLogger("distributed").setLevel(logging.WARNING)
+    scene = load_scene(find_scene(args.scene))
+    spec = load_sweep_spec(args.spec)
+    out = args.output or Path("results") / "sweeps" / f"{scene.name}_{spec.name}"
+    try:
+        result = run_sweep(scene, spec, out, workers=args.workers, scheduler=args.scheduler,
+                           fmu_dir=args.fmu_dir, progress=not args.quiet,
+                           rerun_failed=args.rerun_failed)
+    except KeyboardInterrupt:
+        _print(f"\ninterrupted; finished cases are kept in {Path(out).resolve()}: run the same "
+               "command again to run only the rest")
+        return 130
+    counts = ", ".join(f"{n} {status}" for status, n in sorted(result.counts.items()))
+    _print(f"\nsweep {spec.name!r} of scene {scene.name!r}: {len(result.rows)} cases ({counts}); "
+           f"{result.executed} run now, {result.reused} from earlier, {result.wall_time:.3g} s")
+    _print(f"summary: {result.summary_path.resolve()}")
+    _print(f"time series: {(result.directory / 'cases').resolve()}/<case_id>/timeseries.csv")
+    for path in result.plots:
+        _print(f"plot: {path.resolve()}")
+    return 0 if result.complete else 1
+
+
+def _load_any_scene(name: str):
+    """A shipped scene, a scene file or an SSP package."""
+    from wire_fmu.master.run import find_scene, load_scene_file
+
+    return load_scene_file(find_scene(name))
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    """Export a scene as an SSP package or an OSP configuration (docs/interop.md)."""
+    from wire_fmu.interop import export_osp, export_ssp
+
+    scene = _load_any_scene(args.scene)
+    out = Path(args.output or Path("results") / "export")
+    if args.format == "ssp":
+        path = export_ssp(scene, out, fmu_dir=args.fmu_dir)
+    else:
+        path = export_osp(scene, out / f"{scene.name}_osp" if args.output is None else out,
+                          fmu_dir=args.fmu_dir)
+    _print(f"exported scene {scene.name!r} as {args.format.upper()}: {path.resolve()}")
+    return 0
+
+
+def cmd_study(args: argparse.Namespace) -> int:
+    """Run the accuracy or the effects study of a scene and say where its files are."""
+    from wire_fmu.study import accuracy, effects
+
+    out = args.output or Path("results") / Path(args.scene).stem / args.study
+    if args.study == "accuracy":
+        study = accuracy.run_accuracy_study(args.scene, out, quick=args.quick, grid=args.grid,
+                                            fmu_dir=args.fmu_dir, repeats=args.repeats)
+        _print(accuracy.summary_text(study))
+    else:
+        study = effects.run_effects_study(args.scene, out, quick=args.quick, fmu_dir=args.fmu_dir,
+                                          repeats=args.repeats)
+        _print(effects.summary_text(study))
+    _print(f"\nstudy took {study.elapsed:.0f} s")
+    for path in study.files.values():
+        _print(f"written: {path.resolve()}")
+    return 0
+
+
+def _study_parser(sub) -> None:
+    p = sub.add_parser("study", help="what accuracy and effects cost in time")
+    kinds = p.add_subparsers(dest="study", required=True)
+    for name, text in (("accuracy", "work-precision study over couplings, steps and solvers"),
+                       ("effects", "time saved and output change of leaving each effect out")):
+        q = kinds.add_parser(name, help=text)
+        q.add_argument("scene", help="a shipped scene's name or a scene file")
+        q.add_argument("-o", "--output", type=Path,
+                       help=f"output folder (default results/SCENE/{name})")
+        q.add_argument("--quick", action="store_true",
+                       help="a few configurations, short stop time (for CI)")
+        q.add_argument("--repeats", type=int, default=None,
+                       help="runs per configuration, the fastest counts")
+        if name == "accuracy":
+            q.add_argument("--grid", choices=("slices", "product"), default=None,
+                           help="slices (default): every coupling with the scene's solvers and "
+                                "every solver with the scene's coupling; product: all of them")
+        q.set_defaults(func=cmd_study)
+
+
 def _parser() -> argparse.ArgumentParser:
     from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 
@@ -136,9 +235,32 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("--stop-time", type=float, help="stop earlier (s), e.g. a quick look")
             p.add_argument("--step", type=float, help="macro step (s) instead of the scene's")
         p.set_defaults(func=func)
+    p = sub.add_parser("sweep", help="run a parameter sweep (Dask)")
+    p.add_argument("scene", help="a shipped scene's name or a scene file")
+    p.add_argument("spec", metavar="SWEEP_SPEC", type=Path, help="the sweep spec (TOML)")
+    p.add_argument("-o", "--output", type=Path,
+                   help="results folder; an existing one is resumed "
+                        "(default: results/sweeps/<scene>_<sweep>)")
+    p.add_argument("--workers", type=int, default=2,
+                   help="worker processes of the local cluster; 0 runs serially in this "
+                        "process (default: %(default)s)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="use an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--rerun-failed", action="store_true",
+                   help="also run again cases recorded as failed or stopped")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=cmd_sweep)
+    p = sub.add_parser("export", help="export a scene as SSP 1.0 or OSP (docs/interop.md)")
+    p.add_argument("scene", help="a shipped scene's name, a scene file or an .ssp package")
+    p.add_argument("--format", choices=("ssp", "osp"), required=True, help="what to write")
+    p.add_argument("-o", "--output", type=Path,
+                   help="ssp: a .ssp file or a folder for <scene>.ssp; osp: the configuration "
+                        "folder (default: results/export/)")
+    p.set_defaults(func=cmd_export)
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")
     p.set_defaults(func=cmd_build)
+    _study_parser(sub)
     return parser
 
 

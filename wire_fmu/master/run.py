@@ -20,7 +20,7 @@ from .simulation import RunResult, Simulation
 from .validate import validate_scene
 
 __all__ = ["SCENE_DIR", "shipped_scenes", "find_scene", "run_scene", "with_run_settings",
-           "Outcome"]
+           "Outcome", "load_scene_file"]
 
 logger = logging.getLogger(__name__)
 
@@ -50,6 +50,15 @@ def find_scene(name_or_path: str | Path) -> Path:
         return shipped[str(name_or_path)]
     raise SceneError(str(name_or_path), [
         f"not a shipped scene nor a file; shipped scenes: {', '.join(shipped) or 'none'}"])
+
+
+def load_scene_file(path: Path) -> Scene:
+    """A scene file (TOML) or an SSP package (``.ssp``, see :mod:`wire_fmu.interop.ssp_read`)."""
+    if Path(path).suffix.lower() == ".ssp":
+        from wire_fmu.interop.ssp_read import read_ssp
+
+        return read_ssp(Path(path))
+    return load_scene(path)
 
 
 @dataclass
@@ -106,7 +115,7 @@ def run_scene(
         Replace run settings of the scene, e.g. ``stop_time=5.0`` for a quick run.
     """
     if not isinstance(scene, Scene):
-        scene = load_scene(find_scene(scene))
+        scene = load_scene_file(find_scene(scene))
     if run_overrides:
         scene = with_run_settings(scene, **run_overrides)
     structure = validate_scene(scene, fmu_dir)
