@@ -112,6 +112,9 @@ def _event_entries(scene: Scene, structure: Structure) -> list[dict[str, Any]]:
         kind = "Integer" if var.type == "Enumeration" else var.type
         start = var.start if var.start is not None else {"Real": 0.0, "Integer": 0,
                                                          "Boolean": False}.get(kind, "")
+        given = scene.units[ref.unit].parameters  # the scene may set the input's start
+        if ref.variable in given:
+            start = given[ref.variable]
         if kind == "Boolean" and isinstance(start, str):
             start = start.strip().lower() in ("true", "1")
         out.append({"name": str(ref), "target": str(ref), "type": kind,

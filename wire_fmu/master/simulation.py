@@ -162,7 +162,8 @@ class Simulation:
             slave = self.slaves[name]
             slave.instantiate()
             values = unit_start_values(self.scene.units[name], slave)
-            values.update(self.drivers.values(name, start, None))
+            # the values the first step will hold, so nothing jumps at the first step
+            values.update(self.drivers.values(name, start, self.run_settings.step))
             values.update(self.events.values(name))
             slave.initialize(start, values)
         # In initialisation mode, hand outputs to the inputs they feed, sources first,
@@ -360,32 +361,43 @@ class Simulation:
         return result
 
     def _loop(self, result: RunResult) -> None:
-        stop = self.run_settings.stop_time
+        # Time is counted in integer nanoseconds, as libcosim does: no drift over long
+        # runs, event times hit exactly, and the same step sizes as libcosim's.
+        stop_ns = _ns(self.run_settings.stop_time)
+        now_ns = _ns(self.time)
         h = self.run_settings.step
-        while self.time < stop - 1e-12:
-            t = self.time
-            h = min(h, stop - t)
+        while now_ns < stop_ns:
+            next_ns = min(now_ns + max(1, _ns(h)), stop_ns)
             upcoming = self.events.next_time
-            if upcoming is not None and upcoming > t:
-                h = min(h, upcoming - t)
+            if upcoming is not None and now_ns < _ns(upcoming) < next_ns:
+                next_ns = _ns(upcoming)
+            t = now_ns / 1e9
+            h = next_ns / 1e9 - t
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps
             if not attempt.accepted:
                 result.rejected += 1
                 if h <= self.run_settings.min_step * (1 + 1e-9):
                     raise SimulationStoppedError(f"step refused at the minimum step "
-                                            f"{self.run_settings.min_step:g} s: "
-                                            f"{attempt.message}")
+                                                 f"{self.run_settings.min_step:g} s: "
+                                                 f"{attempt.message}")
                 h = max(self.run_settings.min_step, attempt.retry_step)
                 logger.debug("t = %.6g s: step rejected (%s), retrying with %.3g s", t,
                              attempt.message, h)
                 continue
             self._accept(t, h, attempt.new, attempt.residuals)
+            now_ns = next_ns
+            self.time = now_ns / 1e9
             result.steps += 1
             self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_step(self)
             h = self._next_step(h, attempt.residuals)
+
+
+def _ns(seconds: float) -> int:
+    """Seconds as integer nanoseconds."""
+    return int(round(seconds * 1e9))
 
 
 def new_h(h: float, error: float) -> float:
