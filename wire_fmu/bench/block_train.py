@@ -8,13 +8,10 @@ then the drum stops) in the core and through the built FMU; see
 
 from __future__ import annotations
 
-import argparse
 import json
 import logging
-import tempfile
-from pathlib import Path
 
-from wire_fmu.bench.common import ROOT, Case, measure, table
+from wire_fmu.bench.common import Case, command_line, run_cases
 from wire_fmu.core.block_train import BLOCK_TRAIN_EFFECTS
 from wire_fmu.core.block_train_unit import BlockTrainUnit
 from wire_fmu.core.reevings import drilling_block_train
@@ -54,23 +51,10 @@ def cases() -> list[Case]:
 
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
-    from wire_fmu.export.builder import build_fmu
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
-    args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_fmu(ROOT / "models" / "block_train.py", Path(tmp))
-        for case in cases():
-            rows.append(measure(fmu, case, args.steps))
-            logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,
-                        rows[-1].fmu_ms)
-    text = table(rows)
-    logger.info("\n10-line block train, ros2, max internal step 1 ms, communication step "
-                "%g s:\n%s", STEP, text)
+    args = command_line(__doc__.splitlines()[0], argv)
+    text = run_cases("block_train.py", cases(), args.steps,
+                     f"10-line block train, ros2, max internal step 1 ms, "
+                     f"communication step {STEP:g} s")
     if args.out:
         args.out.write_text(text + "\n")
 

@@ -14,15 +14,20 @@ over the steps (wall clock, ``time.perf_counter``) after a warm-up.
 
 from __future__ import annotations
 
+import argparse
+import logging
 import statistics
+import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from wire_fmu.core.interface import Unit
 
-__all__ = ["Case", "Row", "measure", "table", "ROOT"]
+__all__ = ["Case", "Row", "measure", "table", "ROOT", "run_cases", "command_line"]
+
+logger = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[2]
 WARM_UP = 5
@@ -176,3 +181,29 @@ def table(rows: list[Row]) -> str:
         lines.append(f"| {r.label} | {r.states} | {r.core_ms:.3f} | {r.fmu_ms:.3f} | "
                      f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |")
     return "\n".join(lines)
+
+
+def command_line(description: str, argv: list[str] | None) -> argparse.Namespace:
+    """Parse the options every unit benchmark takes and set up logging."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
+    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    return args
+
+
+def run_cases(script: str, cases: Sequence[Case], steps: int, title: str) -> str:
+    """Build ``models/<script>`` into a temporary folder, measure every case, log the table."""
+    from wire_fmu.export.builder import build_fmu
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        fmu = build_fmu(ROOT / "models" / script, Path(tmp))
+        for case in cases:
+            rows.append(measure(fmu, case, steps))
+            logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,
+                        rows[-1].fmu_ms)
+    text = table(rows)
+    logger.info("\n%s:\n%s", title, text)
+    return text

@@ -11,13 +11,10 @@ solver refines. See :mod:`wire_fmu.bench.common` for what is timed.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import math
-import tempfile
-from pathlib import Path
 
-from wire_fmu.bench.common import ROOT, Case, measure, table
+from wire_fmu.bench.common import Case, command_line, run_cases
 from wire_fmu.core.hydraulics import HYDRAULICS_EFFECTS
 from wire_fmu.core.hydraulics_unit import DEFAULT_ROD_FORCE, HydraulicsUnit
 
@@ -59,23 +56,10 @@ def cases() -> list[Case]:
 
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
-    from wire_fmu.export.builder import build_fmu
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
-    args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_fmu(ROOT / "models" / "hydraulics.py", Path(tmp))
-        for case in cases():
-            rows.append(measure(fmu, case, args.steps))
-            logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,
-                        rows[-1].fmu_ms)
-    text = table(rows)
-    logger.info("\nRiser-tensioner cylinder, ros2, max internal step 1 ms, communication "
-                "step %g s:\n%s", STEP, text)
+    args = command_line(__doc__.splitlines()[0], argv)
+    text = run_cases("hydraulics.py", cases(), args.steps,
+                     f"Riser-tensioner cylinder, ros2, max internal step 1 ms, "
+                     f"communication step {STEP:g} s")
     if args.out:
         args.out.write_text(text + "\n")
 

@@ -16,12 +16,9 @@ a second table gives their accuracy (rope paid out against Radau at rtol
 
 from __future__ import annotations
 
-import argparse
 import logging
-import tempfile
-from pathlib import Path
 
-from wire_fmu.bench.common import ROOT, Case, measure, table
+from wire_fmu.bench.common import Case, command_line, run_cases
 from wire_fmu.core.winch import WINCH_EFFECTS
 from wire_fmu.core.winch_unit import WinchUnit
 
@@ -101,23 +98,10 @@ def accuracy_table(steps: int) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
-    from wire_fmu.export.builder import build_fmu
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
-    args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_fmu(ROOT / "models" / "winch.py", Path(tmp))
-        for case in cases():
-            rows.append(measure(fmu, case, args.steps))
-            logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,
-                        rows[-1].fmu_ms)
-    text = table(rows)
-    logger.info("\nWinch (default drawworks drive train), max internal step 1 ms, communication "
-                "step %g s:\n%s", STEP, text)
+    args = command_line(__doc__.splitlines()[0], argv)
+    text = run_cases("winch.py", cases(), args.steps,
+                     f"Winch (default drawworks drive train), max internal step 1 ms, "
+                     f"communication step {STEP:g} s")
     accuracy = accuracy_table(args.steps)
     logger.info("\nAccuracy of the internal solvers on %s after %d steps:\n%s",
                 SOLVER_EFFECTS, args.steps, accuracy)

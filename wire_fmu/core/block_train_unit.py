@@ -31,7 +31,7 @@ import numpy as np
 from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
 from .errors import ConfigurationError
 from .hybrid import IntegrationError, SolverSettings
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
 from .reevings import drilling_block_train
 
@@ -278,7 +278,7 @@ class BlockTrainUnit(Unit):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
 
-class _BlockTrainOde(OdeView):
+class _BlockTrainOde(ModelOdeView):
     """:class:`BlockTrainUnit` as a piece of a monolithic ODE."""
 
     def __init__(self, unit: BlockTrainUnit) -> None:
@@ -309,26 +309,6 @@ class _BlockTrainOde(OdeView):
             self.unit._update_outputs()
         finally:
             self.model.state, self.unit.time = saved, saved_time
-
-    def rhs(self, t, x):
-        """See :meth:`BlockTrainModel.rhs`."""
-        return self.model.rhs(t, x)
-
-    def guards(self, t, x):
-        """See :meth:`BlockTrainModel.guards`."""
-        return self.model.guards(t, x)
-
-    def guard_directions(self):
-        """See :meth:`BlockTrainModel.guard_directions`."""
-        return self.model.guard_directions()
-
-    def handle_events(self, t, x, fired):
-        """See :meth:`BlockTrainModel.handle_events`."""
-        return self.model.handle_events(t, x, fired)
-
-    def project(self, x):
-        """See :meth:`BlockTrainModel.project`."""
-        return self.model.project(x)
 
     def reconcile(self, t, x):
         """Break a commanded segment, then settle contact and friction modes."""

@@ -39,6 +39,7 @@ __all__ = [
     "input_",
     "output",
     "OdeView",
+    "ModelOdeView",
 ]
 
 
@@ -363,6 +364,37 @@ class OdeView(ABC):
         The default changes nothing.
         """
         return x
+
+
+class ModelOdeView(OdeView):
+    """An :class:`OdeView` whose hybrid-system methods are those of ``self.model``.
+
+    For units whose model is itself a :class:`~wire_fmu.core.hybrid.HybridSystem`
+    over exactly the unit's state; subclasses add ``state``, ``set_state``,
+    ``bind_inputs``, ``publish`` (and ``reconcile`` where inputs can switch modes).
+    """
+
+    model: Any
+
+    def rhs(self, t: float, x: Any) -> Any:
+        """The model's state derivative."""
+        return self.model.rhs(t, x)
+
+    def guards(self, t: float, x: Any) -> Any:
+        """The model's guards."""
+        return self.model.guards(t, x)
+
+    def guard_directions(self) -> Any:
+        """The model's guard directions."""
+        return self.model.guard_directions()
+
+    def handle_events(self, t: float, x: Any, fired: list[int]) -> Any:
+        """The model's mode switches."""
+        return self.model.handle_events(t, x, fired)
+
+    def project(self, x: Any) -> Any:
+        """The model's invariants."""
+        return self.model.project(x)
 
 
 def is_finite(value: float) -> bool:

@@ -50,7 +50,7 @@ from .drive_train import DriveChain, default_drive_train, parse_drive_train
 from .drum import Drum
 from .errors import ConfigurationError, ModelError
 from .hybrid import IntegrationError, SolverSettings
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError
 from .winch import (
     RK4_STABILITY,
@@ -369,7 +369,7 @@ def _energy_solver_problems(method: str, effects: frozenset[str], chain: DriveCh
     return out
 
 
-class _WinchOde(OdeView):
+class _WinchOde(ModelOdeView):
     """:class:`WinchUnit` as a piece of a monolithic ODE.
 
     With ``drum_inertia`` this is the unit's own hybrid ODE. Without it the
@@ -411,26 +411,6 @@ class _WinchOde(OdeView):
             self.unit._update_outputs()
         finally:
             model.state, self.unit.time = saved, saved_time
-
-    def rhs(self, t, x):
-        """See :meth:`WinchModel.rhs` / :meth:`KinetostaticWinch.rhs`."""
-        return self.model.rhs(t, x)
-
-    def guards(self, t, x):
-        """Brake and layer guards of the model."""
-        return self.model.guards(t, x)
-
-    def guard_directions(self):
-        """All guards fire on a downward crossing."""
-        return self.model.guard_directions()
-
-    def handle_events(self, t, x, fired):
-        """Brake stick/slip and layer changes."""
-        return self.model.handle_events(t, x, fired)
-
-    def project(self, x):
-        """A held drum stays where it stuck."""
-        return self.model.project(x)
 
     def reconcile(self, t, x):
         """Inputs jumped: settle the brake's modes for them."""
