@@ -26,6 +26,9 @@ OUR_FMUS = {
     "BlockTrain": "block_train.py",
     "Winch": "winch.py",
     "Hydraulics": "hydraulics.py",
+    "ScissorJack": "scissor_jack.py",
+    "MultiMassDrive": "drive.py",
+    "MachineUnit": "machine_unit.py",
 }
 """Model name -> facade script in ``models/``."""
 

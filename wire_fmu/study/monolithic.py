@@ -39,6 +39,9 @@ CORE_UNITS = {
     "BlockTrain": "wire_fmu.core.block_train_unit:BlockTrainUnit",
     "Winch": "wire_fmu.core.winch_unit:WinchUnit",
     "Hydraulics": "wire_fmu.core.hydraulics_unit:HydraulicsUnit",
+    "ScissorJack": "wire_fmu.core.scissor_jack_unit:ScissorJackUnit",
+    "MultiMassDrive": "wire_fmu.core.drive_unit:DriveUnit",
+    "MachineUnit": "wire_fmu.core.machine_drive_unit:MachineDriveUnit",
 }
 """FMU model name -> core unit class (module:class)."""
 

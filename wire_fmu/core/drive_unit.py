@@ -1,0 +1,498 @@
+"""Paper 002's multi-mass elastic drive as a co-simulation unit.
+
+A chain or a tree of rotating masses joined by elastic shafts
+(:mod:`wire_fmu.core.drive_tree`), every quantity reduced to the motor
+shaft, with one or two motors and one load.
+
+Ports
+-----
+``motor``, ``motor2``
+    Input ``torque`` (N m): the electromagnetic torque, or with the effect
+    ``motor_characteristic`` the zero-speed torque ``a`` of ``M = a - b w``
+    (paper 004, eq. 6; ``b`` = ``motor_slope``). Outputs ``speed`` (rad/s),
+    ``angle`` (rad) and ``drive_torque`` (N m, the torque the motor develops).
+    ``motor2`` acts only on a drive with two motors (paper 002's Fig. 7).
+``load``
+    Input ``torque`` (N m, the load torque ``M_c``, positive opposing
+    positive rotation); outputs ``speed`` (rad/s) and ``angle`` (rad) of the
+    load mass, states with no direct feedthrough: a partner unit taking
+    ``load.speed`` and returning a torque closes a rotational bond. Power
+    into the drive through the load port: ``-torque * speed``.
+``mass_k``, ``shaft_k``
+    Speed of every mass (``mass_1`` .. ``mass_12``, the size of paper 002's
+    car-dumper drive) and torque in every shaft (``c`` twist plus ``beta``
+    twist rate, positive when it drives the shaft's second mass forward);
+    unused slots read 0.
+
+Parameters
+----------
+``drive`` (JSON, :func:`~wire_fmu.core.drive_tree.parse_drive`) and
+``masses_kept``: a chain may be reduced to fewer masses by paper 002's
+delta-star elimination (:meth:`~wire_fmu.core.drive_train.DriveChain.reduced`,
+interior masses smallest first; motor and load are kept). ``mode_k``
+outputs give the damped natural frequencies (Hz) and damping ratios of the
+model actually simulated, so a scene shows what the reduction kept.
+
+The equations are linear: ``J w' = -K theta - B w + torques``; the
+internal solver is ``rk4`` with steps refused when ``|lambda| h`` exceeds
+RK4's stability (the fastest eigenvalue of the state matrix), or any solver
+of :mod:`wire_fmu.core.hybrid`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .drive_tree import DriveTree, default_multimass_drive, parse_drive
+from .effects import Effect, EffectCatalogue
+from .errors import ConfigurationError
+from .hybrid import SOLVERS, IntegrationError, SolverSettings, make_solver
+from .interface import OdeView, StepResult, Unit, input_, output, parameter
+
+__all__ = ["DriveUnit", "DriveModel", "DRIVE_EFFECTS", "MAX_MASSES", "MODES_REPORTED"]
+
+MAX_MASSES = 12
+"""Masses a drive may have (paper 002's car-dumper drive has 12)."""
+
+MODES_REPORTED = 3
+"""Lowest oscillatory modes reported as outputs."""
+
+RK4_STABILITY = 2.5
+"""Largest ``|lambda| h`` accepted for ``rk4`` (its limit on the imaginary axis is 2.83)."""
+
+DRIVE_EFFECTS = EffectCatalogue("MultiMassDrive", (
+    Effect("motor_characteristic", "motor torque input",
+           "M = a - b omega with the input as a and b = motor_slope"),
+))
+
+_MOTOR_INPUTS = ("motor.torque", "motor2.torque")
+
+
+def _parameters():
+    return (
+        parameter("effects", "", "", "Effects to include, comma separated: "
+                  + ", ".join(DRIVE_EFFECTS.names), type=str),
+        parameter("drive", json.dumps(default_multimass_drive()), "", "Drive as JSON: masses "
+                  "(name, inertia, damping), shafts (name, from, to, stiffness, damping), "
+                  "motors, load; all reduced to the motor shaft (a four-mass estimated drive "
+                  "by default)", type=str),
+        parameter("masses_kept", 0, "", "Masses kept: 0 the full drive, 2.. a chain reduced "
+                  "by delta-star elimination (paper 002)", type=int),
+        parameter("motor_slope", 0.0, "N.m.s/rad", "Slope b of each motor's characteristic "
+                  "a - b omega (motor_characteristic)", min=0.0),
+        parameter("initial_speed", 0.0, "rad/s", "Speed of every mass at the start"),
+        parameter("solver", "rk4", "", "Internal solver: " + ", ".join(sorted(SOLVERS)),
+                  type=str),
+        parameter("solver_max_step", 5e-4, "s", "Largest internal step", min=0.0),
+        parameter("solver_rtol", 1e-8, "1", "Relative tolerance of adaptive solvers", min=0.0),
+        parameter("solver_atol", 1e-10, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+    )
+
+
+def _inputs():
+    return (
+        input_("motor.torque", 0.0, "N.m", "Torque of the (first) motor, or a of a - b omega "
+               "with motor_characteristic"),
+        input_("motor2.torque", 0.0, "N.m", "Torque of the second motor (two-motor drives)"),
+        input_("load.torque", 0.0, "N.m", "Load torque M_c on the load mass, positive "
+               "opposing positive rotation"),
+    )
+
+
+def _outputs():
+    outs = [
+        output("motor.speed", "rad/s", "Speed of the (first) motor's mass"),
+        output("motor.angle", "rad", "Angle of the (first) motor's mass"),
+        output("motor.drive_torque", "N.m", "Torque the (first) motor develops",
+               depends_on=("motor.torque",)),
+        output("motor2.speed", "rad/s", "Speed of the second motor's mass (0 if none)"),
+        output("motor2.drive_torque", "N.m", "Torque the second motor develops (0 if none)",
+               depends_on=("motor2.torque",)),
+        output("load.speed", "rad/s", "Speed of the load mass"),
+        output("load.angle", "rad", "Angle of the load mass"),
+    ]
+    outs += [output(f"mass_{k}.speed", "rad/s", f"Speed of mass {k} (0 if the drive has fewer)")
+             for k in range(1, MAX_MASSES + 1)]
+    outs += [output(f"shaft_{k}.torque", "N.m", f"Torque in shaft {k} (0 if the drive has "
+                    "fewer)") for k in range(1, MAX_MASSES)]
+    for k in range(1, MODES_REPORTED + 1):
+        outs += [output(f"mode_{k}.frequency", "Hz", f"Damped natural frequency of oscillatory "
+                        f"mode {k} of the simulated drive, motor characteristic included "
+                        "(0 if none)"),
+                 output(f"mode_{k}.damping_ratio", "1", f"Damping ratio of mode {k}")]
+    outs += [
+        output("stored_energy", "J", "Kinetic energy of the masses plus shaft strain energy"),
+        output("dissipated_energy", "J", "Energy dissipated by ground and shaft dampers"),
+        output("external_work", "J", "Work done on the drive by the motors and the load"),
+        output("energy_balance", "J",
+               "Ledger residual: stored change + dissipated - external work"),
+        output("mode_changes", "", "Mode events so far (always 0: the drive is smooth)",
+               type=int),
+    ]
+    return tuple(outs)
+
+
+class DriveModel:
+    """The drive's linear ODE as a hybrid system without modes.
+
+    State ``[theta (n), omega (n), dissipated, external work]`` (rad,
+    rad/s, J, J). Torques: ``motor`` (n_motors,), ``load`` (N m), held over a step.
+
+    Parameters
+    ----------
+    tree : DriveTree
+        The drive (already reduced if asked).
+    motor_slope : float
+        ``b`` of every motor, N m s/rad (0: torque inputs).
+    settings : SolverSettings
+        Internal solver.
+    """
+
+    def __init__(self, tree: DriveTree, motor_slope: float, settings: SolverSettings) -> None:
+        self.tree = tree
+        self.n = tree.n
+        self.inertia = np.asarray(tree.inertias, dtype=float)
+        self.stiffness = tree.stiffness_matrix()
+        self.damping = tree.damping_matrix()
+        self.motor_slope = motor_slope
+        self.motors = [m % self.n for m in tree.motors]
+        self.load = tree.load_index
+        self.commands = np.zeros(len(self.motors))
+        self.load_torque = 0.0
+        self.state = np.zeros(2 * self.n + 2)
+        self.solver = make_solver(settings)
+        self.modes = self._modes()
+
+    def motor_torques(self, omega: np.ndarray) -> np.ndarray:
+        """Torque each motor develops at the masses' speeds, N m."""
+        return self.commands - self.motor_slope * omega[self.motors]
+
+    def _torques(self, omega: np.ndarray) -> np.ndarray:
+        f = np.zeros(self.n)
+        f[self.motors] += self.motor_torques(omega)
+        f[self.load] -= self.load_torque
+        return f
+
+    def shaft_torques(self, x: np.ndarray) -> np.ndarray:
+        """Torque in each shaft (drives its second mass forward), N m."""
+        theta, omega = x[:self.n], x[self.n:2 * self.n]
+        return np.array([s.stiffness * (theta[s.a] - theta[s.b])
+                         + s.damping * (omega[s.a] - omega[s.b]) for s in self.tree.shafts])
+
+    # -- HybridSystem ---------------------------------------------------------
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[theta', omega', dissipated', external work']``."""
+        n = self.n
+        theta, omega = x[:n], x[n:2 * n]
+        external = self._torques(omega)
+        out = np.empty_like(x)
+        out[:n] = omega
+        out[n:2 * n] = (external - self.stiffness @ theta - self.damping @ omega) / self.inertia
+        out[2 * n] = float(omega @ self.damping @ omega)
+        out[2 * n + 1] = float(external @ omega)
+        return out
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """None: the drive has no modes."""
+        return np.zeros(0)
+
+    def guard_directions(self) -> np.ndarray:
+        """None."""
+        return np.zeros(0)
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """Never called."""
+        return x
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """No invariants."""
+        return x
+
+    # -- life cycle -------------------------------------------------------------
+    def initialize(self, speed: float) -> None:
+        """All masses at ``speed``, shafts twisted as in rigid acceleration (no ringing)."""
+        n = self.n
+        omega = np.full(n, speed)
+        f = self._torques(omega) - self.damping @ omega
+        acc = f.sum() / self.inertia.sum()
+        residual = f - self.inertia * acc  # what the shafts must carry
+        theta = np.zeros(n)
+        keep = [k for k in range(n) if k != self.load]
+        if keep:
+            theta[keep] = np.linalg.solve(self.stiffness[np.ix_(keep, keep)], residual[keep])
+        self.state = np.concatenate([theta, omega, [0.0, 0.0]])
+
+    def advance(self, t: float, h: float) -> None:
+        """Advance by ``h`` with the torques held."""
+        self.state, _ = self.solver.advance(self, t, self.state, t + h)
+
+    def stored_energy(self, x: np.ndarray | None = None) -> float:
+        """``omega^T J omega / 2 + theta^T K theta / 2``, J."""
+        x = self.state if x is None else x
+        theta, omega = x[:self.n], x[self.n:2 * self.n]
+        return 0.5 * float(self.inertia @ omega**2) + 0.5 * float(theta @ self.stiffness @ theta)
+
+    def state_matrix(self) -> np.ndarray:
+        """``A`` of the drive with each motor's characteristic slope, shape (2n, 2n)."""
+        a = self.tree.state_matrix()
+        for m in self.motors:
+            a[self.n + m, self.n + m] -= self.motor_slope / self.inertia[m]
+        return a
+
+    def fastest_rate(self) -> float:
+        """Largest ``|lambda|`` of :meth:`state_matrix`, 1/s."""
+        return float(np.max(np.abs(np.linalg.eigvals(self.state_matrix()))))
+
+    def _modes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Damped frequencies (Hz) and damping ratios of the oscillatory modes, ascending."""
+        lam = np.linalg.eigvals(self.state_matrix())
+        lam = lam[lam.imag > 1e-9 * max(1.0, float(np.max(np.abs(lam))))]
+        lam = lam[np.argsort(lam.imag)]
+        return lam.imag / (2.0 * math.pi), -lam.real / np.abs(lam)
+
+
+class DriveUnit(Unit):
+    """Multi-mass elastic drive, chain or tree, one or two motors (SPEC section 8, paper 002)."""
+
+    NAME = "MultiMassDrive"
+    DESCRIPTION = "Multi-mass elastic drive with delta-star reduction (paper 002), wire_fmu"
+    VARIABLES = _parameters() + _inputs() + _outputs()
+
+    def __init__(self, instance_name: str = "drive") -> None:
+        super().__init__(instance_name)
+        self.model: DriveModel | None = None
+        self.initial_energy = 0.0
+        self.time = 0.0
+
+    # ------------------------------------------------------------ life cycle
+    def configure(self) -> None:
+        """Parse the drive, reduce it, check the solver; list every problem at once."""
+        v = self.values
+        problems: list[str] = []
+        effects, effect_problems = DRIVE_EFFECTS.parse(v["effects"])
+        problems += [f"parameter 'effects': {p}" for p in effect_problems]
+        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
+                                  float(v["solver_rtol"]), float(v["solver_atol"]))
+        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
+                     for p in settings.problems()]
+        tree = self._tree(problems)
+        slope = float(v["motor_slope"]) if "motor_characteristic" in effects else 0.0
+        if not (slope >= 0.0 and math.isfinite(slope)):
+            problems.append(f"parameter 'motor_slope' must be >= 0 N.m.s/rad, got {slope}")
+        if not math.isfinite(float(v["initial_speed"])):
+            problems.append(f"parameter 'initial_speed' must be finite, got {v['initial_speed']}")
+        if problems:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
+        model = DriveModel(tree, slope, settings)
+        if settings.method == "rk4":
+            problems += _stability_problems(model, settings.max_step)
+        if problems:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
+        self.model = model
+
+    def initialize(self, start_time: float) -> None:
+        """Start at ``initial_speed`` with the shafts carrying their quasi-static torques."""
+        model = self._require_model()
+        self._bind(model)
+        model.initialize(float(self.values["initial_speed"]))
+        self.time = start_time
+        self.initial_energy = model.stored_energy()
+        self._update_outputs()
+
+    def advance(self, time: float, step: float) -> StepResult:
+        """Advance by ``step`` seconds with the torques held."""
+        model = self._require_model()
+        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
+        bad = [n for n in (*_MOTOR_INPUTS, "load.torque") if not math.isfinite(
+            float(self.values[n]))]
+        if bad:
+            return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
+        saved = self.get_state()
+        try:
+            self._bind(model)
+            model.advance(time, step)
+            self.time = time + step
+            self._update_outputs()
+        except (IntegrationError, FloatingPointError, ValueError) as err:
+            self.set_state(saved)
+            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
+        return StepResult(True)
+
+    def evaluate_outputs(self) -> None:
+        """The motors' torques for the commands now set; the state is untouched."""
+        model = self._require_model()
+        saved = (model.commands.copy(), model.load_torque)
+        try:
+            self._bind(model)
+            self._update_outputs()
+        finally:
+            model.commands, model.load_torque = saved
+
+    def ode(self) -> OdeView:
+        """The drive's ODE, for a monolithic model."""
+        return _DriveOde(self)
+
+    # ---------------------------------------------------------------- state
+    def get_state(self) -> dict[str, Any]:
+        """Continuous state, held inputs, time, ledger start and solver counters."""
+        m = self._require_model()
+        return {
+            "x": [float(c) for c in m.state],
+            "commands": [float(c) for c in m.commands],
+            "load_torque": float(m.load_torque),
+            "time": float(self.time),
+            "initial_energy": float(self.initial_energy),
+            "solver": {"rhs_calls": int(m.solver.rhs_calls), "steps": int(m.solver.steps)},
+        }
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`."""
+        m = self._require_model()
+        m.state = np.array(state["x"], dtype=float)
+        m.commands = np.array(state["commands"], dtype=float)
+        m.load_torque = float(state["load_torque"])
+        self.time = float(state["time"])
+        self.initial_energy = float(state["initial_energy"])
+        m.solver.rhs_calls = int(state["solver"]["rhs_calls"])
+        m.solver.steps = int(state["solver"]["steps"])
+        self._update_outputs()
+
+    # -------------------------------------------------------------- helpers
+    def _require_model(self) -> DriveModel:
+        if self.model is None:
+            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
+        return self.model
+
+    def _bind(self, model: DriveModel) -> None:
+        v = self.values
+        model.commands = np.array([float(v[name]) for name in _MOTOR_INPUTS[:len(model.motors)]])
+        model.load_torque = float(v["load.torque"])
+
+    def _tree(self, problems: list[str]) -> DriveTree | None:
+        try:
+            data = json.loads(self.values["drive"])
+        except (TypeError, ValueError) as err:
+            problems.append(f"parameter 'drive' is not valid JSON: {err}")
+            return None
+        tree, tree_problems = parse_drive(data)
+        problems += [f"parameter 'drive': {p}" for p in tree_problems]
+        if tree is None:
+            return None
+        if tree.n > MAX_MASSES:
+            problems.append(f"parameter 'drive': at most {MAX_MASSES} masses, got {tree.n}")
+        keep = int(self.values["masses_kept"])
+        if keep == 0 or keep >= tree.n:
+            return tree
+        if not tree.is_chain() or keep < 2:
+            what = "a branched drive" if not tree.is_chain() else f"{keep} masses"
+            problems.append(f"parameter 'masses_kept': delta-star reduction keeps 2..{tree.n} "
+                            f"masses of a chain (motor first, load last); got {what}")
+            return tree
+        if tree.motors != (0,) or tree.load_index != tree.n - 1:
+            problems.append("parameter 'masses_kept': a reduced chain needs its motor on the "
+                            "first mass and its load on the last")
+            return tree
+        return DriveTree.from_chain(tree.to_chain().reduced(keep))
+
+    def _update_outputs(self) -> None:
+        m = self._require_model()
+        x = m.state
+        n = m.n
+        omega = x[n:2 * n]
+        motor_torques = m.motor_torques(omega)
+        out = self.values
+        first = m.motors[0]
+        out["motor.speed"] = float(omega[first])
+        out["motor.angle"] = float(x[first])
+        out["motor.drive_torque"] = float(motor_torques[0])
+        second = len(m.motors) > 1
+        out["motor2.speed"] = float(omega[m.motors[1]]) if second else 0.0
+        out["motor2.drive_torque"] = float(motor_torques[1]) if second else 0.0
+        out["load.speed"] = float(omega[m.load])
+        out["load.angle"] = float(x[m.load])
+        for k in range(MAX_MASSES):
+            out[f"mass_{k + 1}.speed"] = float(omega[k]) if k < n else 0.0
+        shafts = m.shaft_torques(x)
+        for k in range(MAX_MASSES - 1):
+            out[f"shaft_{k + 1}.torque"] = float(shafts[k]) if k < shafts.size else 0.0
+        freqs, zetas = m.modes
+        for k in range(MODES_REPORTED):
+            out[f"mode_{k + 1}.frequency"] = float(freqs[k]) if k < freqs.size else 0.0
+            out[f"mode_{k + 1}.damping_ratio"] = float(zetas[k]) if k < zetas.size else 0.0
+        stored = m.stored_energy()
+        out["stored_energy"] = stored
+        out["dissipated_energy"] = float(x[2 * n])
+        out["external_work"] = float(x[2 * n + 1])
+        out["energy_balance"] = stored - self.initial_energy + float(x[2 * n]) - float(
+            x[2 * n + 1])
+        out["mode_changes"] = 0
+        if not np.all(np.isfinite(x)):
+            raise FloatingPointError(f"{self.instance_name}: non-finite state")
+
+
+def _stability_problems(model: DriveModel, max_step: float) -> list[str]:
+    """RK4 is stable for ``|lambda| h < 2.8``: refuse settings that cannot be."""
+    rate = model.fastest_rate()
+    if rate * max_step < RK4_STABILITY:
+        return []
+    return [f"parameter 'solver_max_step': rk4 with steps of {max_step:.3g} s is unstable for "
+            f"this drive (fastest eigenvalue {rate:.4g} 1/s; rk4 needs |lambda| h < "
+            f"{RK4_STABILITY}): set solver_max_step below {RK4_STABILITY / rate:.3g} s, reduce "
+            "the drive (masses_kept) or choose the L-stable 'ros2'"]
+
+
+class _DriveOde(OdeView):
+    """:class:`DriveUnit` as a piece of a monolithic ODE (torques read as instantaneous)."""
+
+    def __init__(self, unit: DriveUnit) -> None:
+        self.unit = unit
+        self.model = unit._require_model()
+
+    @property
+    def state(self) -> np.ndarray:
+        """Continuous state (a copy)."""
+        return self.model.state.copy()
+
+    def set_state(self, x: np.ndarray, t: float) -> None:
+        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        self.model.state = np.array(x, dtype=float)
+        self.unit.time = t
+        self.bind_inputs(t)
+        self.unit._update_outputs()
+
+    def bind_inputs(self, t: float) -> None:
+        """Torques in ``values`` are those at ``t``."""
+        self.unit._bind(self.model)
+
+    def publish(self, t: float, x: np.ndarray) -> None:
+        """Outputs of ``x`` into ``values`` (state left alone)."""
+        saved, self.model.state = self.model.state, np.array(x, dtype=float)
+        try:
+            self.unit._update_outputs()
+        finally:
+            self.model.state = saved
+
+    def rhs(self, t, x):
+        """See :meth:`DriveModel.rhs`."""
+        return self.model.rhs(t, x)
+
+    def guards(self, t, x):
+        """None."""
+        return self.model.guards(t, x)
+
+    def guard_directions(self):
+        """None."""
+        return self.model.guard_directions()
+
+    def handle_events(self, t, x, fired):
+        """Never called."""
+        return x
+
+    def project(self, x):
+        """No invariants."""
+        return x

@@ -1,0 +1,326 @@
+"""Paper 004's machine unit as a co-simulation unit, solvable by the paper's method or a reference.
+
+Ports
+-----
+``motor``
+    Input ``command`` (N m): ``a`` of the characteristic ``M_d = a - b w``
+    (``b`` = ``motor_slope``); output ``torque`` (N m, ``a - b w``).
+``load``
+    Input ``torque`` (N m, an extra resistance on the main shaft, positive
+    opposing positive rotation); outputs ``shaft.speed`` (rad/s) and
+    ``shaft.angle`` (rad) are states with no direct feedthrough, so a
+    partner taking the speed and returning a torque closes a rotational bond.
+``cycle``
+    Per revolution of the main shaft: ``period`` (s), ``omega_mean``,
+    ``omega_max``, ``omega_min`` (rad/s) and the coefficient of
+    non-uniformity ``delta = (omega_max - omega_min) / omega_mean``
+    (:class:`~wire_fmu.core.machine_drive.CycleStatistics`; extremes over the
+    communication points, updated by :meth:`MachineDriveUnit.advance` -- a
+    monolithic model, which has no communication points, leaves them at 0).
+``solver``
+    ``evaluations`` (torque evaluations so far: right-hand sides, or the
+    energy form's first-order steps and corrections) and ``steps``: the
+    cost of the solution, next to its accuracy.
+
+Solvers: ``energy`` -- paper 004's energy-form step with successive
+second-order refinement to tolerance; ``energy1`` -- its first-order step
+alone (:mod:`wire_fmu.core.machine_unit`); or any reference integrator of
+:mod:`wire_fmu.core.hybrid` (``radau`` at tight tolerance is the reference).
+The machine's laws are the JSON parameter ``machine``
+(:func:`~wire_fmu.core.machine_drive.parse_machine`), a crank press by default.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .errors import ConfigurationError
+from .hybrid import SOLVERS, IntegrationError, SolverSettings, make_solver
+from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .machine_drive import CycleStatistics, MachineDriveModel, crank_press, parse_machine
+from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError, make_energy_solver
+
+__all__ = ["MachineDriveUnit"]
+
+_SOLVER_NAMES = sorted(set(SOLVERS) | set(ENERGY_SOLVERS))
+
+
+def _parameters():
+    return (
+        parameter("machine", json.dumps(crank_press()), "", "Machine as JSON: inertia "
+                  "(crank_slider or fourier), resistance_angle and resistance_time (Fourier "
+                  "series), resistance_speed (polynomial); a crank press by default", type=str),
+        parameter("motor_slope", 2117.0, "N.m.s/rad", "Slope b of the motor characteristic "
+                  "a - b omega at the main shaft (7.5 kW, 1500 rpm, 3.3 % slip through 1:15; "
+                  "estimate)", min=0.0),
+        parameter("initial_speed", 10.0, "rad/s", "Main shaft speed at the start", min=0.0),
+        parameter("initial_angle", 0.0, "rad", "Main shaft angle at the start"),
+        parameter("solver", "energy", "", "Internal solver: " + ", ".join(_SOLVER_NAMES)
+                  + " (energy: paper 004 with refinement; energy1: its first-order step)",
+                  type=str),
+        parameter("solver_max_step", 5e-3, "s", "Largest internal step", min=0.0),
+        parameter("solver_rtol", 1e-8, "1", "Relative tolerance of adaptive solvers", min=0.0),
+        parameter("solver_atol", 1e-10, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+    )
+
+
+def _inputs():
+    return (
+        input_("motor.command", 22170.0, "N.m", "a of the motor characteristic a - b omega "
+               "(b omega_sync of the default motor: 2117 x 10.472)"),
+        input_("load.torque", 0.0, "N.m", "Extra load torque on the main shaft, positive "
+               "opposing positive rotation"),
+    )
+
+
+def _outputs():
+    return (
+        output("shaft.angle", "rad", "Main shaft angle"),
+        output("shaft.speed", "rad/s", "Main shaft speed"),
+        output("inertia", "kg.m2", "Reduced moment of inertia I(phi)"),
+        output("motor.torque", "N.m", "Motor torque a - b omega", depends_on=("motor.command",)),
+        output("resistance.angle_torque", "N.m", "Resistance of the angle M_c(phi)"),
+        output("resistance.speed_torque", "N.m", "Resistance of the speed M_c(omega)"),
+        output("resistance.time_torque", "N.m", "Resistance of time M_c(t) plus the load input",
+               depends_on=("load.torque",)),
+        output("cycle.count", "", "Revolutions of the main shaft completed", type=int),
+        output("cycle.period", "s", "Duration of the last revolution"),
+        output("cycle.omega_mean", "rad/s", "Mean speed of the last revolution, 2 pi / period"),
+        output("cycle.omega_max", "rad/s", "Highest speed in the last revolution"),
+        output("cycle.omega_min", "rad/s", "Lowest speed in the last revolution"),
+        output("cycle.delta", "1", "Coefficient of non-uniformity of the last revolution, "
+               "(omega_max - omega_min) / omega_mean"),
+        output("solver.evaluations", "", "Torque evaluations of the internal solver so far",
+               type=int),
+        output("solver.steps", "", "Internal steps so far", type=int),
+        output("stored_energy", "J", "Kinetic energy I(phi) omega^2 / 2"),
+        output("dissipated_energy", "J", "Work of the speed resistance M_c(omega)"),
+        output("external_work", "J", "Work of the motor minus that of M_c(phi), M_c(t) and the "
+               "load"),
+        output("energy_balance", "J",
+               "Ledger residual: stored change + dissipated - external work"),
+        output("mode_changes", "", "Mode events so far (always 0: the machine is smooth)",
+               type=int),
+    )
+
+
+class MachineDriveUnit(Unit):
+    """Machine unit with I(phi), motor a - b omega and resistances of phi, omega, t (paper 004)."""
+
+    NAME = "MachineUnit"
+    DESCRIPTION = "Machine unit in steady motion, paper 004's energy-form integrator, wire_fmu"
+    VARIABLES = _parameters() + _inputs() + _outputs()
+
+    def __init__(self, instance_name: str = "machine") -> None:
+        super().__init__(instance_name)
+        self.model: MachineDriveModel | None = None
+        self.solver = None
+        self.cycles = CycleStatistics()
+        self.initial_energy = 0.0
+        self.time = 0.0
+
+    # ------------------------------------------------------------ life cycle
+    def configure(self) -> None:
+        """Parse the machine and the solver; list every problem at once."""
+        v = self.values
+        problems: list[str] = []
+        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
+                                  float(v["solver_rtol"]), float(v["solver_atol"]))
+        for p in settings.problems():
+            if p.startswith("solver ") and settings.method in ENERGY_SOLVERS:
+                continue
+            if p.startswith("solver "):
+                problems.append(f"parameter 'solver': {settings.method!r} is unknown; choose "
+                                f"one of {_SOLVER_NAMES}")
+            else:
+                problems.append(f"parameter {p}")
+        spec = None
+        try:
+            spec, spec_problems = parse_machine(json.loads(v["machine"]))
+            problems += [f"parameter 'machine': {p}" for p in spec_problems]
+        except (TypeError, ValueError) as err:
+            problems.append(f"parameter 'machine' is not valid JSON: {err}")
+        slope = float(v["motor_slope"])
+        if not (slope >= 0.0 and math.isfinite(slope)):
+            problems.append(f"parameter 'motor_slope' must be >= 0 N.m.s/rad, got {slope}")
+        for name in ("initial_speed", "initial_angle"):
+            if not math.isfinite(float(v[name])):
+                problems.append(f"parameter {name!r} must be finite, got {v[name]}")
+        if problems:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
+        self.model = MachineDriveModel(spec, slope)
+        self.solver = (make_energy_solver(settings) if settings.method in ENERGY_SOLVERS
+                       else make_solver(settings))
+
+    def initialize(self, start_time: float) -> None:
+        """Start at ``initial_angle`` and ``initial_speed``."""
+        model = self._require_model()
+        self._bind(model)
+        model.state = np.array([float(self.values["initial_angle"]),
+                                float(self.values["initial_speed"]), 0.0, 0.0])
+        self.time = start_time
+        self.initial_energy = model.kinetic_energy()
+        self.cycles.start(start_time, model.state[0], model.state[1])
+        self._update_outputs()
+
+    def advance(self, time: float, step: float) -> StepResult:
+        """Advance by ``step`` seconds with the inputs held."""
+        model = self._require_model()
+        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
+        bad = [n for n in ("motor.command", "load.torque")
+               if not math.isfinite(float(self.values[n]))]
+        if bad:
+            return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
+        saved = self.get_state()
+        try:
+            self._bind(model)
+            x0 = model.state.copy()
+            model.state, _ = self.solver.advance(model, time, x0, time + step)
+            self.cycles.update(time, x0, time + step, model.state)
+            self.time = time + step
+            self._update_outputs()
+        except (IntegrationError, FloatingPointError, ValueError, ZeroDivisionError,
+                EnergyFormBreakdownError) as err:
+            self.set_state(saved)
+            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
+        return StepResult(True)
+
+    def evaluate_outputs(self) -> None:
+        """Motor and load torques for the inputs now set; the state is untouched."""
+        model = self._require_model()
+        saved = (model.command, model.load)
+        try:
+            self._bind(model)
+            self._update_outputs()
+        finally:
+            model.set_inputs(*saved)
+
+    def ode(self) -> OdeView:
+        """The machine's ODE, for a monolithic model."""
+        return _MachineOde(self)
+
+    # ---------------------------------------------------------------- state
+    def get_state(self) -> dict[str, Any]:
+        """Continuous state, held inputs, cycle statistics, solver counters."""
+        m = self._require_model()
+        counters = {"rhs_calls": int(self.solver.rhs_calls), "steps": int(self.solver.steps)}
+        if hasattr(self.solver, "fallbacks"):
+            counters["fallbacks"] = int(self.solver.fallbacks)
+            counters["torque_evaluations"] = int(self.solver.integrator.torque_evaluations)
+        return {
+            "x": [float(c) for c in m.state],
+            "inputs": [float(m.command), float(m.load)],
+            "cycles": self.cycles.get_state(),
+            "time": float(self.time),
+            "initial_energy": float(self.initial_energy),
+            "solver": counters,
+        }
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`."""
+        m = self._require_model()
+        m.state = np.array(state["x"], dtype=float)
+        m.set_inputs(*state["inputs"])
+        self.cycles.set_state(state["cycles"])
+        self.time = float(state["time"])
+        self.initial_energy = float(state["initial_energy"])
+        counters = state["solver"]
+        self.solver.rhs_calls = int(counters["rhs_calls"])
+        self.solver.steps = int(counters["steps"])
+        if "fallbacks" in counters:
+            self.solver.fallbacks = int(counters["fallbacks"])
+            self.solver.integrator.torque_evaluations = int(counters["torque_evaluations"])
+        self._update_outputs()
+
+    # -------------------------------------------------------------- helpers
+    def _require_model(self) -> MachineDriveModel:
+        if self.model is None:
+            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
+        return self.model
+
+    def _bind(self, model: MachineDriveModel) -> None:
+        model.set_inputs(float(self.values["motor.command"]), float(self.values["load.torque"]))
+
+    def _update_outputs(self, x: np.ndarray | None = None) -> None:
+        m = self._require_model()
+        x = m.state if x is None else x
+        phi, omega = float(x[0]), float(x[1])
+        unit = m.unit
+        out = self.values
+        out["shaft.angle"] = phi
+        out["shaft.speed"] = omega
+        out["inertia"] = unit.inertia(phi)
+        out["motor.torque"] = unit.driving_torque(omega)
+        out["resistance.angle_torque"] = unit.resistance_angle(phi)
+        out["resistance.speed_torque"] = unit.resistance_speed(omega)
+        out["resistance.time_torque"] = unit.resistance_time(self.time)
+        out["cycle.count"] = int(self.cycles.count)
+        for key in ("period", "omega_mean", "omega_max", "omega_min", "delta"):
+            out[f"cycle.{key}"] = float(self.cycles.last[key])
+        out["solver.evaluations"] = int(self.solver.rhs_calls)
+        out["solver.steps"] = int(self.solver.steps)
+        stored = m.kinetic_energy(x)
+        out["stored_energy"] = stored
+        out["dissipated_energy"] = float(x[2])
+        out["external_work"] = float(x[3])
+        out["energy_balance"] = stored - self.initial_energy + float(x[2]) - float(x[3])
+        out["mode_changes"] = 0
+        if not (math.isfinite(phi) and math.isfinite(omega) and math.isfinite(stored)):
+            raise FloatingPointError(f"{self.instance_name}: non-finite state")
+
+
+class _MachineOde(OdeView):
+    """:class:`MachineDriveUnit` as a piece of a monolithic ODE (inputs read as instantaneous)."""
+
+    def __init__(self, unit: MachineDriveUnit) -> None:
+        self.unit = unit
+        self.model = unit._require_model()
+
+    @property
+    def state(self) -> np.ndarray:
+        """Continuous state (a copy)."""
+        return self.model.state.copy()
+
+    def set_state(self, x: np.ndarray, t: float) -> None:
+        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        self.model.state = np.array(x, dtype=float)
+        self.unit.time = t
+        self.bind_inputs(t)
+        self.unit._update_outputs()
+
+    def bind_inputs(self, t: float) -> None:
+        """Inputs in ``values`` are those at ``t``."""
+        self.unit._bind(self.model)
+
+    def publish(self, t: float, x: np.ndarray) -> None:
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        saved, self.unit.time = self.unit.time, t
+        try:
+            self.unit._update_outputs(np.asarray(x, dtype=float))
+        finally:
+            self.unit.time = saved
+
+    def rhs(self, t, x):
+        """See :meth:`MachineDriveModel.rhs`."""
+        return self.model.rhs(t, x)
+
+    def guards(self, t, x):
+        """None."""
+        return self.model.guards(t, x)
+
+    def guard_directions(self):
+        """None."""
+        return self.model.guard_directions()
+
+    def handle_events(self, t, x, fired):
+        """Never called."""
+        return x
+
+    def project(self, x):
+        """No invariants."""
+        return x

@@ -1,0 +1,647 @@
+"""Paper 003's scissor jack: a screw-nut pair lifting a load through a rhombus of tie rods.
+
+Geometry and its kinematic reduction
+------------------------------------
+Four tie rods of length ``L`` form a rhombus: the bottom joint stands on
+the base, the top joint carries the shoe with the load, and the screw runs
+horizontally between the two side joints -- in a bearing at one, through
+the nut at the other. With the rods at angle ``theta`` to the horizontal
+the rhombus's diagonals are::
+
+    height  y = 2 L sin(theta)        width  w = 2 L cos(theta)
+
+Turning the handle (and the screw) by ``psi`` (rad) draws the side joints
+together by the screw travel ``s = h psi``, ``h`` the lead per radian, so
+``w = w0 - s`` and::
+
+    y(s)   = sqrt(4 L^2 - (w0 - s)^2)
+    dy/ds  = w / y = cot(theta)
+    d2y/ds2 = -4 L^2 / y^3
+
+The rods are massless; the screw and handle turn with inertia ``J_s`` and
+the load (mass ``m``, weight ``W``) moves with the shoe, so the jack is a
+one-degree-of-freedom machine in ``psi`` with the variable reduced inertia
+of paper 004, ``I(psi) = J_s + m (h cot theta)^2``. The screw's centre of
+mass moves with its bearing joint by ``s / 2`` horizontally (the paper's
+"horizontal displacement of the screw").
+
+Forces. Power through the massless linkage, ``F ds = F_v dy``, gives the
+axial force in the thread from the force the shoe needs,
+``F = (W + m y'') cot(theta)`` with ``y''`` the load's acceleration; the
+screw turns under the handle torque ``M``, the lead torque ``h F``
+(:meth:`ScrewThread.lead_torque`) and the thread friction ``M_f``::
+
+    J_s psi'' = M - h F + M_f,        |M_f| <= r_mean mu |F|
+
+Substituting ``y'' = (h cot theta) psi'' + h^2 y_ss psi'^2`` gives, while
+sliding in direction ``sigma``, the equation linear in ``psi''``::
+
+    (J_s + q m h^2 cot^2 theta) psi'' = M - q cot(theta) (W + m h^2 y_ss psi'^2)
+    q = h + sigma r_mean mu sign(F)
+
+-- identical to Lagrange's ``I psi'' + I' psi'^2 / 2 = M - W h cot(theta) + M_f``
+with ``M_f = -sigma r_mean mu |F|`` evaluated at the same acceleration. When
+``q < 0`` (lowering a self-locking thread) the coefficient can vanish for
+a light handle: the dry-friction law then has no or two solutions
+(Painlevé's paradox); :meth:`JackConfig.problems` refuses a handle too
+light for the jack's travel.
+
+Holding. At rest the force is static, ``F0 = W cot(theta)``, and the
+handle torque the thread holds lies in ``h F0 +- r_mean mu F0``: with the
+paper's numbers (``theta = 30 deg``, 2 mm per turn, ``r_mean = 0.01 m``,
+``mu = 0.1``) the jack holds the load until
+``M = (h + r_mean mu) W cot 30 deg = 6.850 N m`` -- the paper's "about
+7 N m" -- and, since ``h < r_mean mu``, holds it with no handle torque at
+all (self-locking; :meth:`JackConfig.breakaway_torques`).
+
+Thread friction models
+----------------------
+``none``
+    frictionless thread (the paper's section 2 experiment);
+``stick_slip``
+    exact dry friction with :class:`~wire_fmu.core.friction.StickSlip`: a
+    stuck thread does not move at all;
+``linear``, ``tanh``
+    paper 003's regularised torque (linear inside ``|psi'| < w1``,
+    saturated outside) or its ``tanh`` variant; stiff
+    (``lambda ~ M1 / (I w1)``) and creeping while held
+    (:meth:`ScrewThread.creep_speed`).
+
+The handle is driven either by a torque (dynamics as above) or by a speed
+(kinematically, as in the paper's section 2: "the handle is turned at
+2 rev/s, initial speeds consistent"); then ``M`` is the torque the drive
+must supply, and a change of the commanded speed is an impulse whose work
+``I (w_new^2 - w_old^2) / 2`` the drive supplies.
+
+Energy: stored ``I psi'^2 / 2 + W y`` (J), dissipated by the thread
+``-M_f psi'`` (W, >= 0), external work of the handle ``M psi'``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .errors import ModelError
+from .friction import GROUND, FrictionLink, StickSlip
+from .hybrid import SolverSettings, make_solver
+from .screw_nut import REGULARISATIONS, ScrewThread
+
+__all__ = [
+    "JackGeometry",
+    "JackConfig",
+    "JackInputs",
+    "JackReport",
+    "ScissorJackModel",
+    "FRICTION_MODELS",
+    "HANDLE_DRIVES",
+    "THREAD_FREE",
+    "THREAD_SLIDING",
+    "THREAD_STUCK",
+    "THREAD_CREEPING",
+]
+
+logger = logging.getLogger(__name__)
+
+FRICTION_MODELS = ("none", "stick_slip", "linear", "tanh")
+"""Thread friction models (module docstring)."""
+
+HANDLE_DRIVES = ("speed", "torque")
+"""How the handle is driven: kinematically by a speed, or by a torque."""
+
+THREAD_FREE, THREAD_SLIDING, THREAD_STUCK, THREAD_CREEPING = 0, 1, 2, 3
+_STATE_WORDS = {THREAD_FREE: "frictionless", THREAD_SLIDING: "sliding",
+                THREAD_STUCK: "stuck", THREAD_CREEPING: "creeping (regularised)"}
+
+
+# ============================================================== geometry
+@dataclass(frozen=True)
+class JackGeometry:
+    """The rhombus of tie rods.
+
+    Parameters
+    ----------
+    rod_length : float
+        ``L``, m (paper 003: 130 mm).
+    initial_height : float
+        Height of the shoe above the base joint at ``psi = 0``, m (paper: 130 mm).
+    min_height, max_height : float
+        Travel of the jack, m: steps beyond are refused (end of travel).
+    """
+
+    rod_length: float = 0.130
+    initial_height: float = 0.130
+    min_height: float = 0.04
+    max_height: float = 0.25
+
+    @property
+    def initial_width(self) -> float:
+        """``w0 = sqrt(4 L^2 - y0^2)``, m."""
+        return math.sqrt(4.0 * self.rod_length**2 - self.initial_height**2)
+
+    def height(self, travel: float) -> float:
+        """``y(s)``, m (nan outside the rhombus)."""
+        width = self.initial_width - travel
+        square = 4.0 * self.rod_length**2 - width * width
+        return math.sqrt(square) if square > 0.0 and width > 0.0 else math.nan
+
+    def slopes(self, travel: float) -> tuple[float, float, float]:
+        """``(y, dy/ds, d2y/ds2)`` at screw travel ``s`` (m, 1, 1/m)."""
+        width = self.initial_width - travel
+        y = self.height(travel)
+        return y, width / y, -4.0 * self.rod_length**2 / y**3
+
+    def rod_angle(self, travel: float) -> float:
+        """``theta``, rad."""
+        return math.atan2(self.height(travel), self.initial_width - travel)
+
+    def travel_at_height(self, height: float) -> float:
+        """Screw travel that puts the shoe at ``height`` (m), m."""
+        return self.initial_width - math.sqrt(4.0 * self.rod_length**2 - height * height)
+
+    def problems(self) -> list[str]:
+        """Every problem with the geometry, as sentences."""
+        out = []
+        two_l = 2.0 * self.rod_length
+        if not (self.rod_length > 0.0 and math.isfinite(self.rod_length)):
+            return [f"rod_length must be a positive number of metres, got {self.rod_length}"]
+        for name in ("min_height", "initial_height", "max_height"):
+            value = getattr(self, name)
+            if not (0.0 < value < two_l):
+                out.append(f"{name} must lie strictly between 0 and twice the rod length "
+                           f"({two_l:.6g} m), got {value}")
+        if not out and not self.min_height <= self.initial_height <= self.max_height:
+            out.append(f"initial_height {self.initial_height} m must lie within the travel "
+                       f"[{self.min_height}, {self.max_height}] m")
+        return out
+
+
+# ============================================================== configuration
+@dataclass(frozen=True)
+class JackConfig:
+    """Everything a :class:`ScissorJackModel` is built from.
+
+    Parameters
+    ----------
+    geometry : JackGeometry
+        Rods and travel.
+    thread : ScrewThread
+        Lead, mean radius and friction coefficient.
+    load_mass : float
+        Mass moving with the shoe, kg (paper: 306 kg).
+    load_weight : float
+        Weight acting on the shoe, N (paper: 3000 N).
+    handle_inertia : float
+        ``J_s`` of screw and handle about the screw axis, kg m^2.
+    friction : str
+        One of :data:`FRICTION_MODELS`.
+    speed_scale : float
+        ``w1`` of the regularised models, rad/s (paper: 1e-6).
+    drive : str
+        One of :data:`HANDLE_DRIVES`.
+    initial_speed : float
+        Handle speed at the start with a torque drive, rad/s.
+    """
+
+    geometry: JackGeometry
+    thread: ScrewThread
+    load_mass: float = 306.0
+    load_weight: float = 3000.0
+    handle_inertia: float = 5.0e-3
+    friction: str = "stick_slip"
+    speed_scale: float = 1.0e-6
+    drive: str = "torque"
+    initial_speed: float = 0.0
+
+    @property
+    def regularised(self) -> bool:
+        """Whether the thread friction is one of the paper's regularised forms."""
+        return self.friction in REGULARISATIONS
+
+    def static_force(self, travel: float) -> float:
+        """Axial force holding the load at rest, ``W cot(theta)``, N."""
+        _, slope, _ = self.geometry.slopes(travel)
+        return self.load_weight * slope
+
+    def breakaway_torques(self, travel: float) -> tuple[float, float]:
+        """Handle torques (N m) at which a stuck thread starts to lift / to lower.
+
+        ``(h + r mu) F0`` and ``(h - r mu) F0`` with ``F0 = W cot(theta)``;
+        a negative second value means the jack is self-locking (it holds the
+        load with no handle torque and must be driven down).
+        """
+        force = self.static_force(travel)
+        lead = self.thread.lead_torque(force)
+        capacity = self.thread.friction_capacity(force)
+        return lead + capacity, lead - capacity
+
+    def effective_inertia(self, travel: float, direction: float) -> float:
+        """``J_s + q m h^2 cot^2(theta)`` while sliding in ``direction``, kg m^2."""
+        _, slope, _ = self.geometry.slopes(travel)
+        h = self.thread.lead_per_radian
+        q = h + direction * self.thread.mean_radius * self.thread.friction
+        return self.handle_inertia + q * self.load_mass * h * slope * slope
+
+    def problems(self) -> list[str]:
+        """Every problem with the configuration, as sentences."""
+        out = self.geometry.problems() + self.thread.problems()
+        for name in ("load_mass", "load_weight", "handle_inertia", "speed_scale"):
+            value = getattr(self, name)
+            if not (value > 0.0 and math.isfinite(value)):
+                out.append(f"{name} must be a positive number, got {value}")
+        if self.friction not in FRICTION_MODELS:
+            out.append(f"thread friction model {self.friction!r} is unknown; choose one of "
+                       f"{', '.join(FRICTION_MODELS)}")
+        if self.drive not in HANDLE_DRIVES:
+            out.append(f"handle drive {self.drive!r} is unknown; choose one of "
+                       f"{', '.join(HANDLE_DRIVES)}")
+        if not math.isfinite(self.initial_speed):
+            out.append(f"initial handle speed must be finite, got {self.initial_speed}")
+        if out or self.friction == "none":
+            return out
+        lowest = self.geometry.travel_at_height(self.geometry.min_height)
+        if self.effective_inertia(lowest, -1.0) <= 0.0:
+            need = self.handle_inertia - self.effective_inertia(lowest, -1.0)
+            out.append(
+                f"handle_inertia {self.handle_inertia} kg m^2 is too light for lowering at "
+                f"min_height {self.geometry.min_height} m: the effective inertia while the "
+                f"thread slides down vanishes (Painleve's paradox of dry friction); use more "
+                f"than {need:.4g} kg m^2 or raise min_height")
+        return out
+
+
+@dataclass(frozen=True)
+class JackInputs:
+    """Handle commands held over a step.
+
+    Attributes
+    ----------
+    speed_command : float
+        Handle speed with a speed drive, rad/s (positive lifts).
+    torque_command : float
+        Handle torque with a torque drive, N m (positive lifts).
+    """
+
+    speed_command: float = 0.0
+    torque_command: float = 0.0
+
+    def problems(self) -> list[str]:
+        """Non-finite commands."""
+        return [f"input {name} is not finite ({value})" for name, value in (
+            ("handle.speed_command", self.speed_command),
+            ("handle.torque_command", self.torque_command)) if not math.isfinite(value)]
+
+
+@dataclass(frozen=True)
+class JackReport:
+    """Outputs of the jack at one instant (SI units)."""
+
+    handle_angle: float
+    handle_speed: float
+    handle_torque: float
+    travel: float
+    height: float
+    load_velocity: float
+    screw_displacement: float
+    rod_angle: float
+    axial_force: float
+    lead_torque: float
+    friction_torque: float
+    thread_state: int
+    stored_energy: float
+    dissipated_energy: float
+    external_work: float
+
+
+@dataclass(frozen=True)
+class _Forces:
+    """Handle acceleration (rad/s^2), axial force (N), thread friction and handle torque (N m)."""
+
+    acceleration: float
+    axial_force: float
+    friction_torque: float
+    handle_torque: float
+
+
+# ============================================================== the model
+class ScissorJackModel:
+    """The jack as a hybrid ODE in the handle angle (module docstring).
+
+    State ``[psi, psi', dissipated, external work]`` (rad, rad/s, J, J).
+    Modes: the thread's stick/slip mode (``stick_slip`` with a torque drive).
+
+    Parameters
+    ----------
+    config : JackConfig
+        The jack.
+    settings : SolverSettings
+        Internal solver of :mod:`wire_fmu.core.hybrid`.
+    """
+
+    def __init__(self, config: JackConfig, settings: SolverSettings) -> None:
+        self.config = config
+        self.h = config.thread.lead_per_radian
+        self.r_mu = config.thread.mean_radius * config.thread.friction
+        self.exact = config.friction == "stick_slip"
+        self.friction = StickSlip(np.array([config.handle_inertia]),
+                                  (FrictionLink("screw thread", 0, GROUND),))
+        self.inputs = JackInputs()
+        self.state = np.zeros(4)
+        self.solver = make_solver(settings)
+        self.mode_changes = 0
+        self.last_events: list[tuple[float, str]] = []
+        self._held_angle = 0.0
+
+    # ---------------------------------------------------------- kinematics
+    def travel(self, psi: float) -> float:
+        """Screw travel ``s = h psi``, m."""
+        return self.h * psi
+
+    def inertia(self, psi: float) -> float:
+        """``I(psi) = J_s + m (h cot theta)^2``, kg m^2."""
+        _, slope, _ = self.config.geometry.slopes(self.travel(psi))
+        return self.config.handle_inertia + self.config.load_mass * (self.h * slope) ** 2
+
+    def height(self, psi: float) -> float:
+        """Shoe height, m."""
+        return self.config.geometry.height(self.travel(psi))
+
+    # ---------------------------------------------------------- forces
+    def _axial_force(self, psi: float, omega: float, acceleration: float) -> float:
+        """``F = (W + m y'') cot(theta)``, N."""
+        _, slope, curvature = self.config.geometry.slopes(self.travel(psi))
+        load_acc = self.h * slope * acceleration + self.h**2 * curvature * omega * omega
+        return (self.config.load_weight + self.config.load_mass * load_acc) * slope
+
+    def _sliding(self, psi: float, omega: float, torque: float, shape: float) -> _Forces:
+        """Motion under handle ``torque`` with friction ``-shape r mu |F|`` (``|shape| <= 1``).
+
+        Solves the equation linear in ``psi''`` for each sign of ``F`` and
+        keeps the consistent one (module docstring).
+        """
+        cfg = self.config
+        _, slope, curvature = cfg.geometry.slopes(self.travel(psi))
+        static = cfg.load_weight + cfg.load_mass * self.h**2 * curvature * omega * omega
+        for sign in (1.0, -1.0):
+            q = self.h + shape * self.r_mu * sign
+            inertia = cfg.handle_inertia + q * cfg.load_mass * self.h * slope * slope
+            if inertia <= 0.0:
+                continue
+            acc = (torque - q * slope * static) / inertia
+            force = self._axial_force(psi, omega, acc)
+            if force * sign >= 0.0:
+                friction = -shape * self.r_mu * abs(force)
+                return _Forces(acc, force, friction, torque)
+        raise ModelError(
+            f"scissor jack: no consistent motion at psi = {psi:.6g} rad, speed {omega:.6g} "
+            f"rad/s, handle torque {torque:.6g} N m (dry friction without a solution: "
+            "Painleve's paradox); a heavier handle_inertia avoids it")
+
+    def _torque_driven(self, x: np.ndarray) -> _Forces:
+        """Acceleration and forces under the torque command in the current mode."""
+        psi, omega = float(x[0]), float(x[1])
+        torque = self.inputs.torque_command
+        friction = self.config.friction
+        if friction == "none":
+            return self._sliding(psi, omega, torque, 0.0)
+        if self.config.regularised:
+            shape, _ = REGULARISATIONS[friction]
+            return self._sliding(psi, omega, torque, shape(omega / self.config.speed_scale))
+        mode = int(self.friction.mode[0])
+        if mode != 0:
+            return self._sliding(psi, omega, torque, float(mode))
+        force = self.config.static_force(self.travel(psi))
+        holding = -(torque - self.h * force)
+        return _Forces(0.0, force, holding, torque)
+
+    def _speed_driven(self, x: np.ndarray) -> _Forces:
+        """Forces and the handle torque needed to turn at the held speed ``x[1]``."""
+        psi, omega = float(x[0]), float(x[1])
+        force = self._axial_force(psi, omega, 0.0)
+        friction = self.config.friction
+        if friction == "none":
+            resist = 0.0
+        elif self.config.regularised:
+            shape, _ = REGULARISATIONS[friction]
+            resist = -shape(omega / self.config.speed_scale) * self.r_mu * abs(force)
+        elif omega != 0.0:
+            resist = -math.copysign(self.r_mu * abs(force), omega)
+        else:  # held still by the drive: the thread holds what it can of the lead torque
+            capacity = self.r_mu * abs(force)
+            resist = max(-capacity, min(capacity, self.h * force))
+        return _Forces(0.0, force, resist, self.h * force - resist)
+
+    def forces(self, x: np.ndarray) -> _Forces:
+        """Acceleration, axial force, friction and handle torque at state ``x``."""
+        if self.config.drive == "speed":
+            return self._speed_driven(x)
+        return self._torque_driven(x)
+
+    def _capacity(self, psi: float) -> np.ndarray:
+        return np.array([self.r_mu * abs(self.config.static_force(self.travel(psi)))])
+
+    def _free_torque(self, x: np.ndarray) -> np.ndarray:
+        """Non-friction generalised torque for :class:`StickSlip` (at rest: static)."""
+        psi, omega = float(x[0]), float(x[1])
+        self.friction.masses[0] = self.inertia(psi)
+        _, slope, curvature = self.config.geometry.slopes(self.travel(psi))
+        centrifugal = self.config.load_mass * self.h**2 * slope * curvature * self.h * omega**2
+        gravity = self.config.load_weight * self.h * slope
+        return np.array([self.inputs.torque_command - gravity - centrifugal])
+
+    # ------------------------------------------------ HybridSystem protocol
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[psi', psi'', dissipated', external work']``."""
+        f = self.forces(x)
+        omega = float(x[1])
+        if self._stuck():
+            omega = 0.0
+        return np.array([omega, f.acceleration, -f.friction_torque * omega,
+                         f.handle_torque * omega])
+
+    def guard_directions(self) -> np.ndarray:
+        """The thread's stick/slip guard fires on a downward crossing."""
+        return -np.ones(1 if self._has_modes() else 0)
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """Holding margin (stuck) or direction times speed (sliding)."""
+        if not self._has_modes():
+            return np.zeros(0)
+        f = self.forces(x)
+        return self.friction.guards(np.array([x[1]]), np.array([f.friction_torque]),
+                                    self._capacity(float(x[0])))
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """The thread sticks or breaks away."""
+        return self._settle(t, x, fired)
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """A stuck thread stays exactly where it stuck, at rest."""
+        if self._stuck():
+            x[0] = self._held_angle
+            x[1] = 0.0
+        return x
+
+    # ---------------------------------------------------------- modes
+    def _has_modes(self) -> bool:
+        return self.exact and self.config.drive == "torque"
+
+    def _stuck(self) -> bool:
+        return self._has_modes() and int(self.friction.mode[0]) == 0
+
+    def thread_state(self, x: np.ndarray | None = None) -> int:
+        """0 frictionless, 1 sliding, 2 stuck, 3 creeping (regularised)."""
+        x = self.state if x is None else x
+        if self.config.friction == "none":
+            return THREAD_FREE
+        if self.config.regularised:
+            return THREAD_CREEPING if abs(x[1]) < self.config.speed_scale else THREAD_SLIDING
+        if self._has_modes():
+            return THREAD_STUCK if self._stuck() else THREAD_SLIDING
+        return THREAD_STUCK if x[1] == 0.0 else THREAD_SLIDING
+
+    def _settle(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """Make the thread's mode fit the inputs at ``(t, x)``; log a change."""
+        x = np.array(x, dtype=float)
+        if not self._has_modes():
+            return x
+        before = self.thread_state(x)
+        forces = self._free_torque(x)
+        x[1:2] = self.friction.switch(x[1:2], forces, self._capacity(float(x[0])), fired)
+        if self._stuck():
+            self._held_angle = float(x[0])
+        after = self.thread_state(x)
+        if after != before or fired:
+            self.mode_changes += 1
+            self._event(t, f"thread {_STATE_WORDS[after]} at handle torque "
+                           f"{self.inputs.torque_command:.6g} N m")
+        return self.project(x)
+
+    def _event(self, t: float, text: str) -> None:
+        self.last_events.append((t, text))
+        logger.debug("t = %.9g s: %s", t, text)
+
+    # ---------------------------------------------------------- life cycle
+    def initialize(self, t0: float, inputs: JackInputs) -> None:
+        """Start at ``psi = 0``: at rest (or ``initial_speed``), or at the commanded speed."""
+        self.inputs = inputs
+        speed = (inputs.speed_command if self.config.drive == "speed"
+                 else self.config.initial_speed)
+        x = np.array([0.0, speed, 0.0, 0.0])
+        self.mode_changes = 0
+        self.last_events = []
+        if self._has_modes():
+            self.friction.set_mode([int(np.sign(speed))])
+            self._held_angle = 0.0
+            x = self._settle(t0, x, [])
+        self.mode_changes = 0
+        self.last_events = []
+        self.state = x
+
+    def advance(self, t: float, h: float, inputs: JackInputs) -> int:
+        """Advance by ``h`` with ``inputs`` held; return the number of events.
+
+        Raises
+        ------
+        ModelError
+            The shoe would leave the jack's travel (the state is left as it was).
+        """
+        self.last_events = []
+        self.inputs = inputs
+        x = np.array(self.state, dtype=float)
+        if self.config.drive == "speed":
+            x = self._speed_jump(x, inputs.speed_command)
+        else:
+            x = self._settle(t, x, [])
+        x, events = self.solver.advance(self, t, x, t + h)
+        geometry = self.config.geometry
+        height = self.height(float(x[0]))
+        if not geometry.min_height <= height <= geometry.max_height:
+            raise ModelError(f"the shoe would reach {height:.6g} m, outside the jack's travel "
+                             f"[{geometry.min_height}, {geometry.max_height}] m (end of travel)")
+        self.state = x
+        return events
+
+    def _speed_jump(self, x: np.ndarray, command: float) -> np.ndarray:
+        """Adopt a new commanded speed; the drive supplies the kinetic-energy jump."""
+        if command != x[1]:
+            x[3] += 0.5 * self.inertia(float(x[0])) * (command * command - x[1] * x[1])
+            x[1] = command
+        return x
+
+    # ---------------------------------------------------------- outputs
+    def stored_energy(self, x: np.ndarray | None = None) -> float:
+        """Kinetic energy of handle and load plus ``W y``, J."""
+        x = self.state if x is None else x
+        psi, omega = float(x[0]), float(x[1])
+        return 0.5 * self.inertia(psi) * omega**2 + self.config.load_weight * self.height(psi)
+
+    def report(self, x: np.ndarray | None = None) -> JackReport:
+        """Outputs at state ``x`` (default: the current one) for the held inputs."""
+        x = self.state if x is None else np.asarray(x, dtype=float)
+        psi, omega = float(x[0]), float(x[1])
+        f = self.forces(x)
+        travel = self.travel(psi)
+        _, slope, _ = self.config.geometry.slopes(travel)
+        return JackReport(
+            handle_angle=psi,
+            handle_speed=omega,
+            handle_torque=f.handle_torque,
+            travel=travel,
+            height=self.height(psi),
+            load_velocity=self.h * slope * omega,
+            screw_displacement=0.5 * travel,
+            rod_angle=self.config.geometry.rod_angle(travel),
+            axial_force=f.axial_force,
+            lead_torque=self.h * f.axial_force,
+            friction_torque=f.friction_torque,
+            thread_state=self.thread_state(x),
+            stored_energy=self.stored_energy(x),
+            dissipated_energy=float(x[2]),
+            external_work=float(x[3]),
+        )
+
+    @contextmanager
+    def trial(self, inputs: JackInputs) -> Iterator[np.ndarray]:
+        """The state as it would start a step with ``inputs``; undone on exit."""
+        saved = (self.inputs, self.friction.get_mode(), self.mode_changes,
+                 list(self.last_events), self._held_angle, self.state.copy())
+        try:
+            self.inputs = inputs
+            x = np.array(self.state, dtype=float)
+            if self.config.drive == "speed":
+                x = self._speed_jump(x, inputs.speed_command)
+            else:
+                x = self._settle(0.0, x, [])
+            yield x
+        finally:
+            (self.inputs, mode, self.mode_changes, self.last_events, self._held_angle,
+             self.state) = saved
+            self.friction.set_mode(mode)
+
+    def get_state(self) -> dict[str, Any]:
+        """Complete model state as plain data."""
+        return {
+            "x": [float(c) for c in self.state],
+            "friction_mode": self.friction.get_mode(),
+            "held_angle": float(self._held_angle),
+            "mode_changes": int(self.mode_changes),
+            "inputs": [float(self.inputs.speed_command), float(self.inputs.torque_command)],
+            "solver": {"rhs_calls": int(self.solver.rhs_calls), "steps": int(self.solver.steps)},
+        }
+
+    def set_state(self, data: dict[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.state = np.array(data["x"], dtype=float)
+        self.friction.set_mode(list(data["friction_mode"]))
+        self._held_angle = float(data["held_angle"])
+        self.mode_changes = int(data["mode_changes"])
+        self.inputs = JackInputs(*data["inputs"])
+        self.solver.rhs_calls = int(data["solver"]["rhs_calls"])
+        self.solver.steps = int(data["solver"]["steps"])
