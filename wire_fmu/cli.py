@@ -182,11 +182,12 @@ def cmd_study(args: argparse.Namespace) -> int:
     out = args.output or Path("results") / Path(args.scene).stem / args.study
     if args.study == "accuracy":
         study = accuracy.run_accuracy_study(args.scene, out, quick=args.quick, grid=args.grid,
-                                            fmu_dir=args.fmu_dir, repeats=args.repeats)
+                                            fmu_dir=args.fmu_dir, repeats=args.repeats,
+                                            stop_time=args.stop_time)
         _print(accuracy.summary_text(study))
     else:
         study = effects.run_effects_study(args.scene, out, quick=args.quick, fmu_dir=args.fmu_dir,
-                                          repeats=args.repeats)
+                                          repeats=args.repeats, stop_time=args.stop_time)
         _print(effects.summary_text(study))
     _print(f"\nstudy took {study.elapsed:.0f} s")
     for path in study.files.values():
@@ -207,6 +208,9 @@ def _study_parser(sub) -> None:
                        help="a few configurations, short stop time (for CI)")
         q.add_argument("--repeats", type=int, default=None,
                        help="runs per configuration, the fastest counts")
+        q.add_argument("--stop-time", type=float, default=None,
+                       help="simulated seconds per run (default: [study] stop_time, else the "
+                            "scene's, at most 10 s; 1 s with --quick)")
         if name == "accuracy":
             q.add_argument("--grid", choices=("slices", "product"), default=None,
                            help="slices (default): every coupling with the scene's solvers and "
