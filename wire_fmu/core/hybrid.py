@@ -373,7 +373,10 @@ class ScipySolver:
         for i, direction in enumerate(directions):
 
             def event(t, x, i=i):
-                return guards(t, x)[i]
+                # our guards hold while >= 0 and fire when < 0; SciPy would also fire on
+                # a guard resting at exactly 0 (a released brake), so a zero counts as +0
+                g = guards(t, x)[i]
+                return g if g != 0.0 else 1e-300
 
             event.terminal = True
             event.direction = float(direction)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ctypes
 import logging
+import shutil
 import time
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
@@ -109,6 +110,7 @@ class Slave:
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
         self._fatal = False
+        self._unzipdir: str | None = None
 
     # -- description ---------------------------------------------------------
     @property
@@ -133,7 +135,9 @@ class Slave:
     def instantiate(self, unzipdir: str | None = None) -> None:
         """Load the binary and instantiate (logging on, into Python logging)."""
         md = self.model_description
-        self._fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir or extract(str(self.path)),
+        if unzipdir is None:
+            unzipdir = self._unzipdir = extract(str(self.path))
+        self._fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
                               modelIdentifier=md.coSimulation.modelIdentifier,
                               instanceName=self.name)
         self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
@@ -170,6 +174,9 @@ class Slave:
                 logger.debug("%s: %s failed during cleanup: %s", self.name, name, exc)
         _KEEP_ALIVE.append(fmu)  # keep the library (and its handle) alive
         self._fmu = None
+        if self._unzipdir:  # the loaded library stays mapped; its files can go
+            shutil.rmtree(self._unzipdir, ignore_errors=True)
+            self._unzipdir = None
 
     # -- values ------------------------------------------------------------------
     def set_many(self, values: dict[str, Any]) -> None:
