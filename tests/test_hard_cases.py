@@ -432,11 +432,7 @@ def break_scene(step: float, how: str) -> dict:
 
 @pytest.mark.parametrize("how", [
     "breaking_load",
-    pytest.param("commanded", marks=pytest.mark.xfail(strict=True, reason=(
-        "BlockTrainModel.advance breaks a commanded segment (input break_segment) without "
-        "counting a mode change, so rope.mode_changes does not move, the master keeps the "
-        "tension history and extrapolates across the break: the winch holds -T/2 "
-        "(-4905 N, a pushing rope) over the second step after the cut"))),
+    "commanded",
 ])
 def test_rope_break_leaves_zero_tension_free_fall_and_no_phantom_tension(
         fmus, tmp_path, how):
@@ -668,12 +664,7 @@ def unstable_internal_step(unit: str) -> dict:
 
 @pytest.mark.parametrize("unit", [
     "winch",
-    pytest.param("rope", marks=pytest.mark.xfail(strict=True, reason=(
-        "the BlockTrain has no stability check for its explicit solvers (the Winch refuses "
-        "rk4 steps beyond |lambda| h = 2.5 in configure): the stiff-span scene with rk4 at "
-        "|lambda| h = 3.6 'finished' with the tension at 982 kN against 10.8 kN and its "
-        "ledger 165 kJ open; at |lambda| h = 12 it validates and then stops on 'rope span 0 "
-        "has no unstretched rope left'"))),
+    "rope",
 ])
 def test_an_internal_step_that_cannot_be_stable_is_refused_before_the_run(
         fmus, tmp_path, unit):
@@ -681,7 +672,9 @@ def test_an_internal_step_that_cannot_be_stable_is_refused_before_the_run(
     is validated (through FMI), naming the unit, the parameter and a stable step.
 
     Mutation: the winch's RK4 stability check removed (WinchUnit._stability_problems
-    returning no problem); validation passed and no SceneError was raised.
+    returning no problem); validation passed and no SceneError was raised. Without the
+    BlockTrain's check (BlockTrainUnit._stability_problems) its stiff-span scene with rk4
+    at |lambda| h = 3.6 'finished' with 982 kN against 10.8 kN and its ledger 165 kJ open.
     """
     scene = master_scene(unstable_internal_step(unit), fmus, tmp_path)
     with pytest.raises(SceneError) as info:

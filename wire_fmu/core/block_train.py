@@ -696,8 +696,9 @@ class BlockTrainModel:
         # a jump of a position input does work on the rope at once: book it
         self.state[2 * self.n_coords + 1] += self._input_energy(t) - before
         self.mode_changes += int(changed)
-        if break_segment is not None:
+        if break_segment is not None and not self.broken[self.span_of_segment[break_segment]]:
             self._break_span(self.span_of_segment[break_segment], self.state, t)
+            self.mode_changes += 1  # a mode event: masters must not extrapolate across it
         self.state = self._settle_modes(t, self.state)  # new inputs may break a stuck link
         x, events = self.solver.advance(self, t, self.state, t + h)
         self.state = x

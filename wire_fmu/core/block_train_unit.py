@@ -30,7 +30,7 @@ import numpy as np
 
 from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
 from .errors import ConfigurationError
-from .hybrid import IntegrationError, SolverSettings
+from .hybrid import RK4_STABILITY, IntegrationError, SolverSettings, fastest_mode
 from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
 from .reevings import drilling_block_train
@@ -146,8 +146,11 @@ class BlockTrainUnit(Unit):
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
         try:
             self.model = BlockTrainModel(reeving, effects, settings)
+            problems = self._stability_problems()
         except ConfigurationError as err:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
+        if problems:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
 
     def initialize(self, start_time: float) -> None:
         """Rope stretched for equilibrium (or pretension); outputs filled."""
@@ -160,6 +163,21 @@ class BlockTrainUnit(Unit):
         self.time = start_time
         self.initial_energy = model.stored_energy(start_time)
         self._update_outputs()
+
+    def _stability_problems(self) -> list[str]:
+        """An rk4 step the stiffest mode of the initial state cannot be stable with."""
+        model = self._require_model()
+        if model.settings.method != "rk4":
+            return []
+        model.initialize(0.0, self._inputs(), equilibrium=bool(
+            self.values["initial_equilibrium"]), pretension=float(self.values["pretension"]))
+        rate = fastest_mode(model, 0.0, model.state)
+        if rate * model.settings.max_step < RK4_STABILITY:
+            return []
+        return [f"parameter 'solver_max_step' = {model.settings.max_step:g} s is unstable with "
+                f"solver 'rk4' for the stiffest mode (|lambda| = {rate:.4g} 1/s): set "
+                f"solver_max_step below {RK4_STABILITY / rate:.3g} s, or use solver 'ros2' "
+                "(L-stable)"]
 
     def advance(self, time: float, step: float) -> StepResult:
         """Advance by ``step`` seconds with the inputs held."""

@@ -114,6 +114,18 @@ class SolverSettings:
         return out
 
 
+RK4_STABILITY = 2.5
+"""``|lambda| h`` below which classical RK4 is stable (its limit is 2.78 on the real
+axis and 2.83 on the imaginary axis), with a margin."""
+
+
+def fastest_mode(system: HybridSystem, t: float, x: np.ndarray) -> float:
+    """Largest ``|lambda|`` (1/s) of the system's Jacobian at ``(t, x)`` (finite differences)."""
+    if x.size == 0:
+        return 0.0
+    return float(np.max(np.abs(np.linalg.eigvals(_finite_difference_jacobian(system, t, x)))))
+
+
 _MAX_EVENTS_PER_STEP = 10_000
 _MAX_LOCATE_ITERATIONS = 60
 

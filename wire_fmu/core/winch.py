@@ -74,7 +74,7 @@ from .drum import Drum
 from .effects import Effect, EffectCatalogue
 from .errors import ModelError
 from .friction import GROUND, FrictionLink, StickSlip
-from .hybrid import SolverSettings, make_solver
+from .hybrid import RK4_STABILITY, SolverSettings, make_solver
 from .machine_unit import ENERGY_SOLVERS, MachineUnit, StepWork, make_energy_solver
 
 __all__ = [
@@ -823,9 +823,6 @@ class KinetostaticWinch(_WinchBase):
         self.restore_held_inputs(data["inputs"])
 
 
-RK4_STABILITY = 2.5
-"""``|lambda| h`` below which classical RK4 is stable (its limit is 2.78 on the real
-axis and 2.83 on the imaginary axis), with a margin."""
 
 
 def fastest_rate(chain: DriveChain, motor_slope: float = 0.0) -> float:
