@@ -252,17 +252,23 @@ class Simulation:
     def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
         self.algorithm.sweep(self, t, h)
         new = self._read_all()
-        sweeps = 1
+        sweeps, changes = 1, []
         for _ in range(self.run_settings.iterations - 1):
             before = dict(self.held)
             self._restore(states)
             self.algorithm.sweep(self, t, h, fresh=new)
             new = self._read_all()
             sweeps += 1
-            change = max((abs(self.held[k] - before.get(k, 0.0)) /
-                          max(1.0, abs(self.held[k])) for k in self.held), default=0.0)
-            if change < self.run_settings.iteration_tolerance:
-                break
+            changes.append(max((abs(self.held[k] - before.get(k, 0.0)) /
+                                max(1.0, abs(self.held[k])) for k in self.held), default=0.0))
+            if changes[-1] < self.run_settings.iteration_tolerance:
+                return new, sweeps
+        if len(changes) >= 3 and changes[-1] > changes[0]:  # the fixed point runs away
+            raise SimulationStoppedError(
+                f"t = {t:.6g} s: the iteration over the step of {h:.3g} s diverges (input "
+                f"change {changes[0]:.3g} after the second sweep, {changes[-1]:.3g} after the "
+                f"last of {sweeps}): the coupling cannot be resolved at this step; use a "
+                "smaller step or adaptive steps")
         return new, sweeps
 
     def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
@@ -306,6 +312,12 @@ class Simulation:
                 self._free(states)
                 return _Attempt(False, residuals, sweeps, retry_step=new_h(h, error),
                                 message=f"bond energy residual {error:.3g} x tolerance")
+            if error > 1.0:
+                self._free(states)
+                raise SimulationStoppedError(
+                    f"t = {t:.6g} s: the bonds' energy residual is {error:.3g} times "
+                    f"energy_tolerance even at the minimum step {h:.3g} s: the coupling "
+                    "cannot meet the tolerance; lower min_step or raise energy_tolerance")
         if states is not None:
             self._free(states)
         return _Attempt(True, residuals, sweeps, new)
