@@ -30,10 +30,11 @@ import numpy as np
 
 from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
 from .errors import ConfigurationError
-from .hybrid import RK4_STABILITY, IntegrationError, SolverSettings, fastest_mode
+from .hybrid import RK4_STABILITY, IntegrationError, fastest_mode
 from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
 from .reevings import drilling_block_train
+from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["BlockTrainUnit"]
 
@@ -52,11 +53,7 @@ def _variables():
         parameter("effects", "", "",
                   "Effects to include, comma separated: " + ", ".join(BLOCK_TRAIN_EFFECTS.names),
                   type=str),
-        parameter("solver", "ros2", "", "Internal solver: rk4, ros2, radau, bdf, lsoda, rk45, "
-                  "dop853", type=str),
-        parameter("solver_max_step", 1e-3, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-6, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-9, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("ros2", 1e-3),
         parameter("initial_equilibrium", True, "",
                   "Start with every block hanging at rest where the reeving puts it", type=bool),
         parameter("pretension", 1.0e3, "N",
@@ -124,12 +121,8 @@ class BlockTrainUnit(Unit):
         problems: list[str] = []
         effects, effect_problems = BLOCK_TRAIN_EFFECTS.parse(v["effects"])
         problems += [f"parameter 'effects': {p}" for p in effect_problems]
-        settings = SolverSettings(
-            str(v["solver"]), float(v["solver_max_step"]), float(v["solver_rtol"]),
-            float(v["solver_atol"]),
-        )
-        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
-                     for p in settings.problems()]
+        settings, solver_problems = solver_settings(v)
+        problems += solver_problems
         if not (float(v["pretension"]) >= 0.0):
             problems.append(f"parameter 'pretension' must be >= 0 N, got {v['pretension']}")
         reeving = None

@@ -51,8 +51,9 @@ import numpy as np
 from .drive_tree import DriveTree, default_multimass_drive, parse_drive
 from .effects import Effect, EffectCatalogue
 from .errors import ConfigurationError
-from .hybrid import SOLVERS, IntegrationError, SolverSettings, make_solver
+from .hybrid import IntegrationError, SolverSettings, make_solver
 from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["DriveUnit", "DriveModel", "DRIVE_EFFECTS", "MAX_MASSES", "MODES_REPORTED"]
 
@@ -86,11 +87,7 @@ def _parameters():
         parameter("motor_slope", 0.0, "N.m.s/rad", "Slope b of each motor's characteristic "
                   "a - b omega (motor_characteristic)", min=0.0),
         parameter("initial_speed", 0.0, "rad/s", "Speed of every mass at the start"),
-        parameter("solver", "rk4", "", "Internal solver: " + ", ".join(sorted(SOLVERS)),
-                  type=str),
-        parameter("solver_max_step", 5e-4, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-8, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-10, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("rk4", 5e-4, rtol=1e-8, atol=1e-10),
     )
 
 
@@ -276,10 +273,8 @@ class DriveUnit(Unit):
         problems: list[str] = []
         effects, effect_problems = DRIVE_EFFECTS.parse(v["effects"])
         problems += [f"parameter 'effects': {p}" for p in effect_problems]
-        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
-                                  float(v["solver_rtol"]), float(v["solver_atol"]))
-        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
-                     for p in settings.problems()]
+        settings, solver_problems = solver_settings(v)
+        problems += solver_problems
         tree = self._tree(problems)
         slope = float(v["motor_slope"]) if "motor_characteristic" in effects else 0.0
         if not (slope >= 0.0 and math.isfinite(slope)):

@@ -28,6 +28,7 @@ time except through H itself.
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -100,11 +101,16 @@ class SolverSettings:
     atol: float = 1e-9
     event_time_tolerance: float = 1e-9
 
-    def problems(self) -> list[str]:
-        """Every problem with these settings, as sentences."""
+    def problems(self, known: Collection[str] = ()) -> list[str]:
+        """Every problem with these settings, as sentences.
+
+        ``known`` adds method names a unit offers beyond :data:`SOLVERS`
+        (paper 004's energy-form integrator in the winch and the machine unit).
+        """
         out = []
-        if self.method not in SOLVERS:
-            out.append(f"solver {self.method!r} is unknown; choose one of {sorted(SOLVERS)}")
+        names = set(SOLVERS) | set(known)
+        if self.method not in names:
+            out.append(f"solver {self.method!r} is unknown; choose one of {sorted(names)}")
         if not (self.max_step > 0 and math.isfinite(self.max_step)):
             out.append(f"solver_max_step must be a positive number of seconds, got {self.max_step}")
         if not (0 < self.rtol < 1):

@@ -96,7 +96,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigurationError, ModelError
-from .hybrid import IntegrationError, SolverSettings
+from .hybrid import IntegrationError
 from .hydraulic_line import HydraulicLine
 from .hydraulics import (
     HYDRAULICS_EFFECTS,
@@ -109,6 +109,7 @@ from .hydraulics import (
     SealSpec,
 )
 from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["HydraulicsUnit", "DEFAULT_ROD_FORCE"]
 
@@ -179,11 +180,7 @@ def _variables():
     params = (
         parameter("effects", "", "", "Effects to include, comma separated: "
                   + ", ".join(HYDRAULICS_EFFECTS.names), type=str),
-        parameter("solver", "ros2", "", "Internal solver: rk4, ros2, radau, bdf, lsoda, rk45, "
-                  "dop853", type=str),
-        parameter("solver_max_step", 1e-3, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-6, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-9, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("ros2", 1e-3),
         *_physical_parameters(),
         parameter("initial_equilibrium", True, "", "Start at rest in static equilibrium with "
                   "the initial rod.force", type=bool),
@@ -258,10 +255,8 @@ class HydraulicsUnit(Unit):
         problems: list[str] = []
         effects, effect_problems = HYDRAULICS_EFFECTS.parse(v["effects"])
         problems += [f"parameter 'effects': {p}" for p in effect_problems]
-        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
-                                  float(v["solver_rtol"]), float(v["solver_atol"]))
-        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
-                     for p in settings.problems()]
+        settings, solver_problems = solver_settings(v)
+        problems += solver_problems
         spec = self.spec()
         problems += spec.problems()
         problems += self._initial_problems()

@@ -40,14 +40,14 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigurationError
-from .hybrid import SOLVERS, IntegrationError, SolverSettings, make_solver
+from .hybrid import IntegrationError, make_solver
 from .interface import OdeView, StepResult, Unit, input_, output, parameter
 from .machine_drive import CycleStatistics, MachineDriveModel, crank_press, parse_machine
 from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError, make_energy_solver
+from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["MachineDriveUnit"]
 
-_SOLVER_NAMES = sorted(set(SOLVERS) | set(ENERGY_SOLVERS))
 
 
 def _parameters():
@@ -60,12 +60,9 @@ def _parameters():
                   "estimate)", min=0.0),
         parameter("initial_speed", 10.0, "rad/s", "Main shaft speed at the start", min=0.0),
         parameter("initial_angle", 0.0, "rad", "Main shaft angle at the start"),
-        parameter("solver", "energy", "", "Internal solver: " + ", ".join(_SOLVER_NAMES)
-                  + " (energy: paper 004 with refinement; energy1: its first-order step)",
-                  type=str),
-        parameter("solver_max_step", 5e-3, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-8, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-10, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("energy", 5e-3, rtol=1e-8, atol=1e-10, also=ENERGY_SOLVERS,
+                           note="energy: paper 004 with refinement; energy1: its first-order "
+                                "step"),
     )
 
 
@@ -129,16 +126,8 @@ class MachineDriveUnit(Unit):
         """Parse the machine and the solver; list every problem at once."""
         v = self.values
         problems: list[str] = []
-        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
-                                  float(v["solver_rtol"]), float(v["solver_atol"]))
-        for p in settings.problems():
-            if p.startswith("solver ") and settings.method in ENERGY_SOLVERS:
-                continue
-            if p.startswith("solver "):
-                problems.append(f"parameter 'solver': {settings.method!r} is unknown; choose "
-                                f"one of {_SOLVER_NAMES}")
-            else:
-                problems.append(f"parameter {p}")
+        settings, solver_problems = solver_settings(v, also=ENERGY_SOLVERS)
+        problems += solver_problems
         spec = None
         try:
             spec, spec_problems = parse_machine(json.loads(v["machine"]))

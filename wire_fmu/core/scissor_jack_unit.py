@@ -36,7 +36,7 @@ import numpy as np
 
 from .effects import Effect, EffectCatalogue
 from .errors import ConfigurationError, ModelError
-from .hybrid import SOLVERS, IntegrationError, SolverSettings
+from .hybrid import IntegrationError, SolverSettings
 from .interface import OdeView, StepResult, Unit, input_, output, parameter
 from .scissor_jack import (
     FRICTION_MODELS,
@@ -47,6 +47,7 @@ from .scissor_jack import (
     ScissorJackModel,
 )
 from .screw_nut import REGULARISATIONS, ScrewThread
+from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["ScissorJackUnit", "JACK_EFFECTS"]
 
@@ -92,11 +93,8 @@ def _parameters():
                   "at 0.14 m, 4.9e-3)", min=0.0),
         parameter("initial_handle_speed", 0.0, "rad/s", "Handle speed at the start with a "
                   "torque drive"),
-        parameter("solver", "rk4", "", "Internal solver: " + ", ".join(sorted(SOLVERS))
-                  + " (the regularised friction models are stiff: radau)", type=str),
-        parameter("solver_max_step", 2.0e-3, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-8, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-12, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("rk4", 2.0e-3, rtol=1e-8, atol=1e-12,
+                           note="the regularised friction models are stiff: radau"),
     )
 
 
@@ -251,11 +249,8 @@ class ScissorJackUnit(Unit):
                           drive, float(v["initial_handle_speed"]))
 
     def _settings(self, problems: list[str]) -> SolverSettings:
-        v = self.values
-        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
-                                  float(v["solver_rtol"]), float(v["solver_atol"]))
-        problems += [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
-                     for p in settings.problems()]
+        settings, solver_problems = solver_settings(self.values)
+        problems += solver_problems
         return settings
 
     def _update_outputs(self, x: np.ndarray | None = None) -> None:

@@ -52,6 +52,7 @@ from .errors import ConfigurationError, ModelError
 from .hybrid import IntegrationError, SolverSettings
 from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError
+from .solver_options import solver_parameters, solver_settings
 from .winch import (
     RK4_STABILITY,
     WINCH_EFFECTS,
@@ -69,18 +70,15 @@ __all__ = ["WinchUnit"]
 
 _FEEDTHROUGH = ("rope.tension", "brake.lever_force", "motor.command")
 
-_SOLVER_NAMES = "rk4, ros2, radau, bdf, lsoda, rk45, dop853, energy, energy1"
 
 
 def _parameters():
     return (
         parameter("effects", "", "", "Effects to include, comma separated: "
                   + ", ".join(WINCH_EFFECTS.names), type=str),
-        parameter("solver", "rk4", "", f"Internal solver: {_SOLVER_NAMES} (energy, energy1: "
-                  "paper 004's energy form, rigid drive train only)", type=str),
-        parameter("solver_max_step", 1e-3, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", 1e-6, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", 1e-9, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        *solver_parameters("rk4", 1e-3, also=ENERGY_SOLVERS,
+                           note="energy, energy1: paper 004's energy form, rigid drive train "
+                                "only"),
         parameter("drive_train", json.dumps(default_drive_train()), "",
                   "Drive train as JSON: masses (motor rotor .. drum) and shafts, each with its "
                   "speed ratio to the drum (estimated 1500-2000 hp drawworks by default)",
@@ -259,18 +257,8 @@ class WinchUnit(Unit):
                            float(v["motor.command"]), float(v["drum.speed_command"]))
 
     def _settings(self, problems: list[str]) -> SolverSettings:
-        v = self.values
-        settings = SolverSettings(str(v["solver"]), float(v["solver_max_step"]),
-                                  float(v["solver_rtol"]), float(v["solver_atol"]))
-        for p in settings.problems():
-            if p.startswith("solver ") and settings.method in ENERGY_SOLVERS:
-                continue  # hybrid.SOLVERS does not know paper 004's integrator
-            if p.startswith("solver "):
-                p = p.replace(str(sorted(_hybrid_solver_names())),
-                              str(sorted(_hybrid_solver_names() | set(ENERGY_SOLVERS))))
-                problems.append(f"parameter 'solver': {p}")
-            else:
-                problems.append(f"parameter {p}")
+        settings, solver_problems = solver_settings(self.values, also=ENERGY_SOLVERS)
+        problems += solver_problems
         return settings
 
     def _chain(self, effects: frozenset[str], problems: list[str]) -> DriveChain | None:
@@ -348,12 +336,6 @@ class WinchUnit(Unit):
                  report.brake_torque, report.stored_energy)
         if not all(math.isfinite(x) for x in reals):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
-
-
-def _hybrid_solver_names() -> set[str]:
-    from .hybrid import SOLVERS
-
-    return set(SOLVERS)
 
 
 def _energy_solver_problems(method: str, effects: frozenset[str], chain: DriveChain) -> list[str]:
