@@ -203,7 +203,7 @@ class BlockTrainUnit(Unit):
 
     def ode(self) -> OdeView:
         """The block train's hybrid ODE, for a monolithic model."""
-        return _BlockTrainOde(self)
+        return _BlockTrainOde(self, self._require_model())
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
@@ -292,34 +292,9 @@ class BlockTrainUnit(Unit):
 class _BlockTrainOde(ModelOdeView):
     """:class:`BlockTrainUnit` as a piece of a monolithic ODE."""
 
-    def __init__(self, unit: BlockTrainUnit) -> None:
-        self.unit = unit
-        self.model = unit._require_model()
-
-    @property
-    def state(self) -> np.ndarray:
-        """Continuous state ``[q, v, dissipated, external work]``."""
-        return self.model.state.copy()
-
-    def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
-        self.model.state = np.array(x, dtype=float)
-        self.unit.time = t
-        self.bind_inputs(t)
-        self.unit._update_outputs()
-
     def bind_inputs(self, t: float) -> None:
         """Inputs in ``values`` are the values at ``t``."""
         self.model.set_inputs(t, self.unit._inputs())
-
-    def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
-        saved, self.model.state = self.model.state, x
-        saved_time, self.unit.time = self.unit.time, t
-        try:
-            self.unit._update_outputs()
-        finally:
-            self.model.state, self.unit.time = saved, saved_time
 
     def reconcile(self, t, x):
         """Break a commanded segment, then settle contact and friction modes."""

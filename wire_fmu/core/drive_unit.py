@@ -52,7 +52,7 @@ from .drive_tree import DriveTree, default_multimass_drive, parse_drive
 from .effects import Effect, EffectCatalogue
 from .errors import ConfigurationError
 from .hybrid import IntegrationError, SolverSettings, make_solver
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["DriveUnit", "DriveModel", "DRIVE_EFFECTS", "MAX_MASSES", "MODES_REPORTED"]
@@ -330,7 +330,7 @@ class DriveUnit(Unit):
 
     def ode(self) -> OdeView:
         """The drive's ODE, for a monolithic model."""
-        return _DriveOde(self)
+        return _DriveOde(self, self._require_model())
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
@@ -441,48 +441,12 @@ def _stability_problems(model: DriveModel, max_step: float) -> list[str]:
             "the drive (masses_kept) or choose the L-stable 'ros2'"]
 
 
-class _DriveOde(OdeView):
+class _DriveOde(ModelOdeView):
     """:class:`DriveUnit` as a piece of a monolithic ODE (torques read as instantaneous)."""
-
-    def __init__(self, unit: DriveUnit) -> None:
-        self.unit = unit
-        self.model = unit._require_model()
-
-    @property
-    def state(self) -> np.ndarray:
-        """Continuous state (a copy)."""
-        return self.model.state.copy()
-
-    def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
-        self.model.state = np.array(x, dtype=float)
-        self.unit.time = t
-        self.bind_inputs(t)
-        self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
         """Torques in ``values`` are those at ``t``."""
         self.unit._bind(self.model)
-
-    def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` into ``values`` (state left alone)."""
-        saved, self.model.state = self.model.state, np.array(x, dtype=float)
-        try:
-            self.unit._update_outputs()
-        finally:
-            self.model.state = saved
-
-    def rhs(self, t, x):
-        """See :meth:`DriveModel.rhs`."""
-        return self.model.rhs(t, x)
-
-    def guards(self, t, x):
-        """None."""
-        return self.model.guards(t, x)
-
-    def guard_directions(self):
-        """None."""
-        return self.model.guard_directions()
 
     def handle_events(self, t, x, fired):
         """Never called."""

@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any, ClassVar
 
+import numpy as np
+
 __all__ = [
     "Causality",
     "Variability",
@@ -367,14 +369,39 @@ class OdeView(ABC):
 
 
 class ModelOdeView(OdeView):
-    """An :class:`OdeView` whose hybrid-system methods are those of ``self.model``.
+    """An :class:`OdeView` of a unit whose model is a hybrid system over the unit's state.
 
-    For units whose model is itself a :class:`~wire_fmu.core.hybrid.HybridSystem`
-    over exactly the unit's state; subclasses add ``state``, ``set_state``,
-    ``bind_inputs``, ``publish`` (and ``reconcile`` where inputs can switch modes).
+    The model keeps its continuous state in ``model.state``; the unit keeps
+    its time in ``unit.time`` and fills its outputs with
+    ``unit._update_outputs()``. The hybrid-system methods are the model's.
+    Subclasses add ``bind_inputs`` (and ``reconcile`` where inputs can switch
+    modes) and override what differs.
     """
 
-    model: Any
+    def __init__(self, unit: Any, model: Any) -> None:
+        self.unit = unit
+        self.model = model
+
+    @property
+    def state(self) -> Any:
+        """Continuous state (a copy)."""
+        return self.model.state.copy()
+
+    def set_state(self, x: Any, t: float) -> None:
+        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        self.model.state = np.array(x, dtype=float)
+        self.unit.time = t
+        self.bind_inputs(t)
+        self.unit._update_outputs()
+
+    def publish(self, t: float, x: Any) -> None:
+        """Outputs of ``x`` at ``t`` into ``values``; the state is left alone."""
+        saved, self.model.state = self.model.state, np.asarray(x, dtype=float)
+        saved_time, self.unit.time = self.unit.time, t
+        try:
+            self.unit._update_outputs()
+        finally:
+            self.model.state, self.unit.time = saved, saved_time
 
     def rhs(self, t: float, x: Any) -> Any:
         """The model's state derivative."""

@@ -41,7 +41,7 @@ import numpy as np
 
 from .errors import ConfigurationError
 from .hybrid import IntegrationError, make_solver
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .machine_drive import CycleStatistics, MachineDriveModel, crank_press, parse_machine
 from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError, make_energy_solver
 from .solver_options import solver_parameters, solver_settings
@@ -191,7 +191,7 @@ class MachineDriveUnit(Unit):
 
     def ode(self) -> OdeView:
         """The machine's ODE, for a monolithic model."""
-        return _MachineOde(self)
+        return _MachineOde(self, self._require_model())
 
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
@@ -263,48 +263,12 @@ class MachineDriveUnit(Unit):
             raise FloatingPointError(f"{self.instance_name}: non-finite state")
 
 
-class _MachineOde(OdeView):
+class _MachineOde(ModelOdeView):
     """:class:`MachineDriveUnit` as a piece of a monolithic ODE (inputs read as instantaneous)."""
-
-    def __init__(self, unit: MachineDriveUnit) -> None:
-        self.unit = unit
-        self.model = unit._require_model()
-
-    @property
-    def state(self) -> np.ndarray:
-        """Continuous state (a copy)."""
-        return self.model.state.copy()
-
-    def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
-        self.model.state = np.array(x, dtype=float)
-        self.unit.time = t
-        self.bind_inputs(t)
-        self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
         """Inputs in ``values`` are those at ``t``."""
         self.unit._bind(self.model)
-
-    def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
-        saved, self.unit.time = self.unit.time, t
-        try:
-            self.unit._update_outputs(np.asarray(x, dtype=float))
-        finally:
-            self.unit.time = saved
-
-    def rhs(self, t, x):
-        """See :meth:`MachineDriveModel.rhs`."""
-        return self.model.rhs(t, x)
-
-    def guards(self, t, x):
-        """None."""
-        return self.model.guards(t, x)
-
-    def guard_directions(self):
-        """None."""
-        return self.model.guard_directions()
 
     def handle_events(self, t, x, fired):
         """Never called."""

@@ -37,7 +37,7 @@ import numpy as np
 from .effects import Effect, EffectCatalogue
 from .errors import ConfigurationError, ModelError
 from .hybrid import IntegrationError, SolverSettings
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
+from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
 from .scissor_jack import (
     FRICTION_MODELS,
     HANDLE_DRIVES,
@@ -298,7 +298,7 @@ def _stability_problems(config: JackConfig, max_step: float) -> list[str]:
             f"choose 'radau' (or 'ros2'), or solver_max_step below {RK4_STABILITY / rate:.3g} s"]
 
 
-class _JackOde(OdeView):
+class _JackOde(ModelOdeView):
     """:class:`ScissorJackUnit` as a piece of a monolithic ODE.
 
     With a speed drive the commanded speed is read at each instant and held
@@ -307,21 +307,8 @@ class _JackOde(OdeView):
     """
 
     def __init__(self, unit: ScissorJackUnit) -> None:
-        self.unit = unit
-        self.model = unit._require_model()
+        super().__init__(unit, unit._require_model())
         self._speed_drive = self.model.config.drive == "speed"
-
-    @property
-    def state(self) -> np.ndarray:
-        """Continuous state (a copy)."""
-        return self.model.state.copy()
-
-    def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
-        self.model.state = np.array(x, dtype=float)
-        self.unit.time = t
-        self.bind_inputs(t)
-        self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
         """Inputs in ``values`` are the values at ``t``."""

@@ -361,21 +361,8 @@ class _WinchOde(ModelOdeView):
     """
 
     def __init__(self, unit: WinchUnit) -> None:
-        self.unit = unit
-        self.model = unit._require_model()
+        super().__init__(unit, unit._require_model())
         self._kinetostatic = isinstance(self.model, KinetostaticWinch)
-
-    @property
-    def state(self) -> np.ndarray:
-        """Continuous state (a copy)."""
-        return self.model.state.copy()
-
-    def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
-        self.model.state = np.array(x, dtype=float)
-        self.unit.time = t
-        self.bind_inputs(t)
-        self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
         """Inputs in ``values`` are the values at ``t``."""
