@@ -4,7 +4,8 @@
     streams the recorded variables to ``timeseries.csv`` as the run goes
     (one row per output interval, flushed every row, so a crash or Ctrl-C
     keeps everything up to that point), with energy channels: each bond's
-    accumulated energy residual and the sum of the units' ledger residuals.
+    accumulated energy residual (energy its coupling created), the energy it
+    carried, its power, and the sum of the units' ledger residuals.
     pandas reads it with ``pandas.read_csv``, fmpy with ``fmpy.util.read_csv``.
     ``metadata.json`` beside it gives units, descriptions, settings and, at
     the end, the summary (status, per-unit call counts and time).
@@ -61,8 +62,10 @@ class CsvRecorder:
         self.directory.mkdir(parents=True, exist_ok=True)
         self._plan = self._recorded(sim)
         self.columns = ["time"] + [f"{u}.{n}" for u, names in self._plan.items() for n in names]
-        self.columns += [f"bond.{b}.energy_residual" for b in sim.bond_residual]
-        self.columns += [f"bond.{b}.power" for b in sim.bond_residual]
+        bonds = list(sim.energy.bonds)
+        self.columns += [f"bond.{b}.energy_residual" for b in bonds]
+        self.columns += [f"bond.{b}.energy_carried" for b in bonds]
+        self.columns += [f"bond.{b}.power" for b in bonds]
         self._ledger_units = [u for u, s in sim.slaves.items() if "energy_balance" in s.variables]
         if self._ledger_units:
             self.columns.append(LEDGER_CHANNEL)
@@ -114,8 +117,10 @@ class CsvRecorder:
             values += [got[n] for n in names]
             if unit in self._ledger_units:
                 ledger += float(got["energy_balance"])
-        values += [sim.bond_residual[b] for b in sim.bond_residual]
-        values += [sim.bond_power[b] for b in sim.bond_residual]
+        bonds = sim.energy.bonds
+        values += [bond.created for bond in bonds.values()]
+        values += [bond.carried for bond in bonds.values()]
+        values += [sim.bond_power[b] for b in bonds]
         if self._ledger_units:
             values.append(ledger)
         self._writer.writerow([_cell(v) for v in values])
@@ -146,6 +151,7 @@ class CsvRecorder:
                 None,
                 "steps": result.steps, "rejected_steps": result.rejected,
                 "sweeps": result.iterations, "bond_energy_residual": result.bond_residual,
+                "bond_energy_carried": result.bond_carried,
                 "units": {u: {"calls": dict(s.calls), "seconds": dict(s.seconds)}
                           for u, s in sim.slaves.items()},
             }
@@ -211,7 +217,9 @@ def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
                         f"{result.iterations} sweeps"),
     ]
     for name, value in result.bond_residual.items():
-        rows.append((f"bond {name} energy residual", f"{value:.4g} J"))
+        carried = result.bond_carried.get(name, 0.0)
+        rows.append((f"bond {name} energy residual",
+                     f"{value:.4g} J created of {carried:.4g} J carried"))
     for unit, slave in sim.slaves.items():
         steps = slave.calls.get("doStep", 0)
         secs = sum(slave.seconds.values())

@@ -19,7 +19,9 @@ Format::
     iterations = 1            # > 1: iterate each step with rollback
     iteration_tolerance = 1e-6
     adaptive = false          # macro step from the bonds' energy residual
-    energy_tolerance = 10.0   # J per step, with adaptive
+    energy_tolerance = 10.0   # J per step, with adaptive; the energy guard's floor
+    energy_guard = 0.1        # stop once a bond's coupling created this share of
+                              # the energy it carried (inf: off); see energy_guard.py
     min_step = 1e-4
     max_step = 0.05
 
@@ -78,6 +80,8 @@ from pathlib import Path
 from typing import Any
 
 from wire_fmu.core.errors import ConfigurationError
+
+from .energy_guard import DEFAULT_SHARE
 
 __all__ = [
     "VarRef",
@@ -234,6 +238,7 @@ class RunSettings:
     iteration_tolerance: float = 1e-6
     adaptive: bool = False
     energy_tolerance: float = 10.0
+    energy_guard: float = DEFAULT_SHARE
     min_step: float = 1e-5
     max_step: float | None = None
     order: tuple[str, ...] = ()
@@ -524,6 +529,10 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
     for key in ("stop_time", "step", "iteration_tolerance", "energy_tolerance", "min_step"):
         if not _positive(getattr(s, key)):
             problems.append(f"run.{key} must be a positive number, got {getattr(s, key)!r}")
+    guard = s.energy_guard
+    if not (isinstance(guard, int | float) and not isinstance(guard, bool) and guard > 0):
+        problems.append(f"run.energy_guard must be a positive number (inf turns the guard "
+                        f"off), got {guard!r}")
     for key in ("output_interval", "max_step"):
         value = getattr(s, key)
         if value is not None and not _positive(value):

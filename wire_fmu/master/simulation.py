@@ -15,11 +15,19 @@ observers (which read: recorder, progress, energy monitor). One macro step:
    the step; a rejected (or refused) step is rolled back and retried shorter;
 5. accepted: histories advance (a unit whose ``mode_changes`` output moved
    has its outgoing histories reset, so nothing extrapolates across a rope
-   break or a stick/slip switch), observers are told.
+   break or a stick/slip switch), observers are told;
+6. the energy guard (:mod:`~wire_fmu.master.energy_guard`) stops the run,
+   with a message, once a bond's coupling has created more energy than its
+   share of what the bond carried: with any settings, a macro step too large
+   for the dynamics across a bond is never a silent blow-up.
 
 Energy residual of a bond over a step (SPEC section 15): the flow side got
-``e_held * mean(flow)`` while the effort side gave ``mean(effort) * f_held``;
-their difference times ``h`` is energy the coupling created or destroyed.
+``e_held * dx`` (``dx`` its displacement: exact from a position link, else
+``h * mean(flow)``) while the effort side gave ``mean(effort) * f_held * h``
+and, with a position link, ``e1 * (dx - f_held * h)`` more when its position
+input is set to the source's new value at the next step (the jump its own
+integration of ``f_held`` missed). Their difference is energy the coupling
+created (positive) or destroyed.
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from .algorithms import make_algorithm, step_order
+from .energy_guard import EnergyGuard
 from .extrapolation import History, held_value
 from .manipulators import DriverSet, ScheduledEvents
 from .scene import Bond, Connection, Scene
@@ -95,6 +104,7 @@ class RunResult:
     rejected: int = 0
     iterations: int = 0
     bond_residual: dict[str, float] = field(default_factory=dict)
+    bond_carried: dict[str, float] = field(default_factory=dict)
 
 
 class Simulation:
@@ -121,12 +131,18 @@ class Simulation:
         self.drivers = DriverSet(scene.drivers, scene.base_dir)
         self.events = ScheduledEvents(scene.events)
         self.algorithm = make_algorithm(scene.run.algorithm, self._order(structure))
-        self.bond_residual = {b.name: 0.0 for b in scene.bonds}
+        self.energy = EnergyGuard((b.name for b in scene.bonds), scene.run.energy_guard,
+                                  scene.run.energy_tolerance)
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
         self.held: dict[str, float] = {}
         self.mode_counts: dict[str, int] = {}
         self.result = RunResult("not started")
         self._error_prev = 1.0
+
+    @property
+    def bond_residual(self) -> dict[str, float]:
+        """Energy each bond's coupling has created since the start, J."""
+        return {name: bond.created for name, bond in self.energy.bonds.items()}
 
     # -- structure -------------------------------------------------------------
     def _build_links(self) -> None:
@@ -280,12 +296,18 @@ class Simulation:
 
     def _bond_residual(self, bond: Bond, new: dict[str, float], h: float) -> float:
         e_key, f_key = str(bond.effort.source), str(bond.flow.source)
-        e0, f0 = self.histories[e_key].latest, self.histories[f_key].latest
-        e1, f1 = new[e_key], new[f_key]
+        e0, e1 = self.histories[e_key].latest, new[e_key]
+        f_held = self.held.get(str(bond.flow.target), self.histories[f_key].latest)
         e_held = self.held.get(str(bond.effort.target), e0)
-        f_held = self.held.get(str(bond.flow.target), f0)
-        self.bond_power[bond.name] = e_held * 0.5 * (f0 + f1)
-        return h * (e_held * 0.5 * (f0 + f1) - 0.5 * (e0 + e1) * f_held)
+        if bond.position is None:  # the flow side's displacement, by the trapezoidal rule
+            moved, jump = 0.5 * (self.histories[f_key].latest + new[f_key]) * h, 0.0
+        else:  # exactly; the effort side's position input will jump by what it missed
+            p_key = str(bond.position.source)
+            moved = new[p_key] - self.histories[p_key].latest
+            jump = moved - f_held * h
+        self.bond_power[bond.name] = e_held * moved / h
+        # received by the flow side - given by the effort side over the step and the jump
+        return e_held * moved - 0.5 * (e0 + e1) * f_held * h - e1 * jump
 
     def _attempt(self, t: float, h: float) -> _Attempt:
         """Take one macro step, rolling back when it is refused or rejected."""
@@ -325,14 +347,17 @@ class Simulation:
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
         for key, value in new.items():
             self.histories[key].push(t + h, value)
-        for name, r in residuals.items():
-            self.bond_residual[name] += r
+        switched = set()
         for name, before in self.mode_counts.items():
             now = int(self.slaves[name].get([MODE_OUTPUT])[MODE_OUTPUT])
             if now != before:
+                switched.add(name)
                 self.mode_counts[name] = now
                 for key in self.source_keys.get(name, ()):
                     self.histories[key].reset()
+        across = {b.name for b in self.scene.bonds
+                  if {b.effort.source.unit, b.flow.source.unit} & switched}
+        self.energy.book(residuals, self.bond_power, h, across_events=across)
         self.time = t + h
 
     def _next_step(self, h: float, residuals) -> float:
@@ -364,7 +389,8 @@ class Simulation:
             logger.error("%s", exc)
         finally:
             result.end_time, result.wall_time = self.time, time.perf_counter() - wall
-            result.bond_residual = dict(self.bond_residual)
+            result.bond_residual = self.bond_residual
+            result.bond_carried = {n: b.carried for n, b in self.energy.bonds.items()}
             self.result = result
             for obs in self.observers:
                 obs.on_end(self, result)
@@ -404,7 +430,20 @@ class Simulation:
             self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_step(self)
+            blow_up = self.energy.blow_up(self.time, h, self._remedies())
+            if blow_up:
+                raise SimulationStoppedError(blow_up)
             h = self._next_step(h, attempt.residuals)
+
+
+    def _remedies(self) -> list[str]:
+        s = self.run_settings
+        remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
+        if s.iterations == 1:
+            remedies.append("iterations > 1")
+        if not s.adaptive:
+            remedies.append("adaptive = true")
+        return remedies
 
 
 def _ns(seconds: float) -> int:
