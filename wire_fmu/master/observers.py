@@ -26,9 +26,13 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .simulation import RunResult, Simulation
 
-__all__ = ["CsvRecorder", "Progress", "summary_rows", "LEDGER_CHANNEL"]
+__all__ = ["CsvRecorder", "Progress", "summary_rows", "BOND_CHANNELS", "LEDGER_CHANNEL"]
 
 logger = logging.getLogger(__name__)
+
+BOND_CHANNELS = ("energy_residual", "energy_carried", "power")
+"""Per bond ``bond.<name>.<channel>``: energy its coupling created (J), energy it carried (J),
+power it transmitted (W)."""
 
 LEDGER_CHANNEL = "energy.units_balance"
 """Sum of the units' ``energy_balance`` outputs, J (each unit's own ledger)."""
@@ -62,10 +66,8 @@ class CsvRecorder:
         self.directory.mkdir(parents=True, exist_ok=True)
         self._plan = self._recorded(sim)
         self.columns = ["time"] + [f"{u}.{n}" for u, names in self._plan.items() for n in names]
-        bonds = list(sim.energy.bonds)
-        self.columns += [f"bond.{b}.energy_residual" for b in bonds]
-        self.columns += [f"bond.{b}.energy_carried" for b in bonds]
-        self.columns += [f"bond.{b}.power" for b in bonds]
+        self.columns += [f"bond.{b}.{channel}" for channel in BOND_CHANNELS
+                         for b in sim.energy.bonds]
         self._ledger_units = [u for u, s in sim.slaves.items() if "energy_balance" in s.variables]
         if self._ledger_units:
             self.columns.append(LEDGER_CHANNEL)

@@ -17,9 +17,9 @@ observers (which read: recorder, progress, energy monitor). One macro step:
    has its outgoing histories reset, so nothing extrapolates across a rope
    break or a stick/slip switch), observers are told;
 6. the energy guard (:mod:`~wire_fmu.master.energy_guard`) stops the run,
-   with a message, once a bond's coupling has created more energy than its
-   share of what the bond carried: with any settings, a macro step too large
-   for the dynamics across a bond is never a silent blow-up.
+   with a message, once the energy a bond's coupling created and destroyed
+   passes a share of what the bond carried: with any settings, a macro step
+   too large for the dynamics across a bond is never a silent blow-up.
 
 Energy residual of a bond over a step (SPEC section 15): the flow side got
 ``e_held * dx`` (``dx`` its displacement: exact from a position link, else
@@ -435,8 +435,8 @@ class Simulation:
                 raise SimulationStoppedError(blow_up)
             h = self._next_step(h, attempt.residuals)
 
-
     def _remedies(self) -> list[str]:
+        """What the energy guard's message suggests, given the run settings."""
         s = self.run_settings
         remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
         if s.iterations == 1:

@@ -21,7 +21,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from wire_fmu.master.observers import LEDGER_CHANNEL
+from wire_fmu.master.observers import BOND_CHANNELS, LEDGER_CHANNEL
 from wire_fmu.master.run import with_run_settings
 from wire_fmu.master.scene import DriverSpec, RunSettings, Scene, UnitSpec, VarRef
 from wire_fmu.master.validate import Structure
@@ -208,7 +208,7 @@ def _column_problem(scene: Scene, structure: Structure | None, figure: Figure) -
     where = f"figure {figure.name!r} ({figure.expression})"
     column = figure.column
     parts = column.split(".")
-    if parts[0] == "bond" and len(parts) == 3 and parts[2] in ("energy_residual", "power"):
+    if parts[0] == "bond" and len(parts) == 3 and parts[2] in BOND_CHANNELS:
         bonds = [b.name for b in scene.bonds]
         return None if parts[1] in bonds else f"{where}: the scene has no bond {parts[1]!r}"
     if column == LEDGER_CHANNEL:

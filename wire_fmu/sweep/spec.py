@@ -62,7 +62,7 @@ Key figure functions, over every recorded sample of the column:
 (max - min), ``final`` (the last recorded value), ``mean`` (time-weighted,
 trapezoidal, over the recorded span). The column is a recorded output
 ``unit.variable`` (the sweep makes sure it is recorded), a bond channel
-``bond.<name>.energy_residual`` / ``bond.<name>.power`` or
+``bond.<name>.energy_residual`` / ``.energy_carried`` / ``.power`` or
 ``energy.units_balance``.
 """
 
