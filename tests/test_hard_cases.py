@@ -33,7 +33,7 @@ from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results
 from wire_fmu.master.run import find_scene, run_scene, with_run_settings
 from wire_fmu.master.scene import SceneError, load_scene
-from wire_fmu.master.simulation import Simulation
+from wire_fmu.master.simulation import RunResult, Simulation
 from wire_fmu.master.validate import validate_scene
 
 from .hard_case_helpers import (
@@ -740,6 +740,49 @@ def test_far_too_large_macro_step_is_never_a_silent_blow_up(
     assert 0.5 * expected.min() <= tension.min(), summary
     assert tension.max() <= 1.5 * expected.max(), summary
     assert abs(residual) < 1.0, summary
+
+
+def shipped_run(name: str, fmus, directory: Path, **run_settings) -> tuple[RunResult, dict]:
+    """A shipped scene on our built FMUs with some run settings replaced; its result and table."""
+    scene = load_scene(find_scene(name))
+    units = {n: replace(u, fmu=str(fmus[u.fmu])) for n, u in scene.units.items()}
+    scene = with_run_settings(replace(scene, units=units), **run_settings)
+    recorder = CsvRecorder(directory, scene.run.output_interval)
+    result = Simulation(scene, validate_scene(scene), [recorder]).run()
+    return result, read_results(recorder.csv_path)
+
+
+RISER_BAND = (3.2e5, 4.0e5)  # N: the riser tension of the scene's own run, with margin
+
+
+def test_shipped_riser_tensioner_blow_up_is_stopped_soon_after_it_shows(fmus, tmp_path):
+    """The riser tensioner with Jacobi coupling and constant hold at 8 ms, four times its
+    step: unguarded, the rod-on-wire mode grows until the riser tension leaves its
+    physical band (the scene's own run: 345-364 kN) near 6.2 s and then swings between
+    slack and 1.4 MN; guarded, the run stops within 0.25 s of the tension leaving the
+    band, naming the bond, with every row before kept. At the scene's own settings the
+    guard lets it finish.
+
+    Mutation: the guard removed (EnergyGuard.blow_up returning None): the guarded run
+    'finished' at 12 s: the status assertion failed.
+    """
+    jacobi = {"algorithm": "jacobi", "extrapolation": "constant", "step": 0.008,
+              "stop_time": 12.0}
+    _, unguarded = shipped_run("riser_tensioner", fmus, tmp_path / "unguarded",
+                               energy_guard=math.inf, **jacobi)
+    tension = unguarded["rope.path_end.tension"]
+    outside = np.flatnonzero((tension < RISER_BAND[0]) | (tension > RISER_BAND[1]))
+    assert outside.size and tension.min() == 0.0 and tension.max() > 1e6  # a blow-up
+    leaves = unguarded["time"][outside[0]]
+    result, columns = shipped_run("riser_tensioner", fmus, tmp_path / "guarded", **jacobi)
+    assert result.status == "stopped"
+    assert "the coupling blows up" in result.message and "bond 'rod'" in result.message
+    assert leaves <= result.end_time <= leaves + 0.25
+    assert columns["time"][-1] == pytest.approx(result.end_time)
+    np.testing.assert_array_equal(columns["rope.path_end.tension"],
+                                  tension[:len(columns["time"])])  # the same run, cut short
+    own, _ = shipped_run("riser_tensioner", fmus, tmp_path / "own", stop_time=12.0)
+    assert own.status == "finished", own.message
 
 
 # ============================================================= 8. algebraic loop
