@@ -154,6 +154,7 @@ class CsvRecorder:
                 "steps": result.steps, "rejected_steps": result.rejected,
                 "sweeps": result.iterations, "bond_energy_residual": result.bond_residual,
                 "bond_energy_carried": result.bond_carried,
+                "bond_energy_error": result.bond_error,
                 "units": {u: {"calls": dict(s.calls), "seconds": dict(s.seconds)}
                           for u, s in sim.slaves.items()},
             }
@@ -219,9 +220,10 @@ def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
                         f"{result.iterations} sweeps"),
     ]
     for name, value in result.bond_residual.items():
-        carried = result.bond_carried.get(name, 0.0)
+        error, carried = result.bond_error.get(name, 0.0), result.bond_carried.get(name, 0.0)
         rows.append((f"bond {name} energy residual",
-                     f"{value:.4g} J created of {carried:.4g} J carried"))
+                     f"{value:+.4g} J net, {error:.4g} J created or destroyed, "
+                     f"of {carried:.4g} J carried"))
     for unit, slave in sim.slaves.items():
         steps = slave.calls.get("doStep", 0)
         secs = sum(slave.seconds.values())

@@ -105,6 +105,7 @@ class RunResult:
     iterations: int = 0
     bond_residual: dict[str, float] = field(default_factory=dict)
     bond_carried: dict[str, float] = field(default_factory=dict)
+    bond_error: dict[str, float] = field(default_factory=dict)
 
 
 class Simulation:
@@ -391,6 +392,7 @@ class Simulation:
             result.end_time, result.wall_time = self.time, time.perf_counter() - wall
             result.bond_residual = self.bond_residual
             result.bond_carried = {n: b.carried for n, b in self.energy.bonds.items()}
+            result.bond_error = {n: b.error for n, b in self.energy.bonds.items()}
             self.result = result
             for obs in self.observers:
                 obs.on_end(self, result)
