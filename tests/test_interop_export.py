@@ -9,6 +9,7 @@ run to bit-identical results.
 from __future__ import annotations
 
 import json
+import math
 import zipfile
 from pathlib import Path
 
@@ -132,6 +133,20 @@ def test_ssp_round_trip_restores_the_scene_and_runs_bit_identically(fmus, ssp, t
     names_back, again = run_ours(back)
     assert names_back == names
     np.testing.assert_array_equal(again, ours)
+
+
+def test_the_energy_guard_turned_off_survives_the_round_trip(fmus, tmp_path):
+    scene = two_mass_scene(fmus, tmp_path, energy_guard=math.inf)
+    package = export_ssp(scene, tmp_path / "ssp", fmu_dir=fmus["osc"].parent)
+    annotation = _ssd(package).find(f".//{{{NS['wf']}}}Scene").text
+    meta = json.loads(annotation, parse_constant=_no_constant)  # strict JSON: no Infinity
+    assert meta["run"]["energy_guard"] == "inf"
+    back = read_ssp(package, extract_to=tmp_path / "x")
+    assert math.isinf(back.run.energy_guard) and back.run == scene.run
+
+
+def _no_constant(name: str):
+    raise ValueError(f"not JSON: {name}")
 
 
 def test_a_plain_ssp_without_our_annotations_runs_as_plain_connections(fmus, ssp, tmp_path):

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -211,6 +212,8 @@ def _metadata(scene: Scene) -> dict[str, Any]:
     """What our reader restores: everything SSP has no element for."""
     run = {k: getattr(scene.run, k) for k in scene.run.__dataclass_fields__}
     run["order"] = list(run["order"])
+    if math.isinf(run["energy_guard"]):  # JSON has no infinity; the reader turns it back
+        run["energy_guard"] = "inf"
     return {
         "format": "wire_fmu.scene/1",
         "name": scene.name,

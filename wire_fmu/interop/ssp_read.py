@@ -33,6 +33,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 import tempfile
 import zipfile
 from pathlib import Path
@@ -224,7 +225,10 @@ def _connections(system: etree._Element, units: dict[str, dict[str, Any]], skip:
 
 def _run_settings(root: etree._Element, meta: dict[str, Any] | None) -> dict[str, Any]:
     if meta is not None:
-        return {k: v for k, v in meta["run"].items() if v is not None}
+        run = {k: v for k, v in meta["run"].items() if v is not None}
+        if run.get("energy_guard") == "inf":  # the guard turned off (JSON has no infinity)
+            run["energy_guard"] = math.inf
+        return run
     run: dict[str, Any] = {}
     experiment = root.find(_q("ssd", "DefaultExperiment"))
     if experiment is not None:
