@@ -167,13 +167,16 @@ def rope_forces(
     tension = np.where(on, trial, 0.0)
     # A slack spring may still be stretched while its damper unloads it (zero
     # total force): its strain energy is still there and drains through the
-    # damper, at the rate the stretch falls.
+    # damper, at the rate the stretch falls. A slack spring whose stretch grows
+    # is one just past engaging (an event is located just past its root): that
+    # energy is the location's error, left to the ledger, never a negative loss.
     relaxing = ~on & (stretch > 0.0)
     energy = np.where(on | relaxing, 0.5 * t_el * stretch, 0.0)
     strain_rate = t_el * np.asarray(length_rate) - t_el * (1.0 + 0.5 * eps) * np.asarray(
         unstretched_rate
     )
-    loss = np.where(on, t_d * small_l * eps_rate, np.where(relaxing, -strain_rate, 0.0))
+    loss = np.where(on, t_d * small_l * eps_rate,
+                    np.where(relaxing, np.maximum(-strain_rate, 0.0), 0.0))
     return RopeForces(
         tension,
         tension,
