@@ -115,9 +115,6 @@ class BlockTrainModel:
         Internal solver for :meth:`advance`.
     """
 
-    ledger_states = 2
-    """Trailing states that are energy ledgers (dissipated energy and external work), J."""
-
     GEOMETRY_STEP = 1e-6  # m, central differences of lengths w.r.t. body motion
 
     def __init__(self, reeving: Reeving, effects: frozenset[str], solver: SolverSettings) -> None:

@@ -150,9 +150,6 @@ class DriveModel:
         Internal solver.
     """
 
-    ledger_states = 2
-    """Trailing states that are energy ledgers (dissipated energy and external work), J."""
-
     def __init__(self, tree: DriveTree, motor_slope: float, settings: SolverSettings) -> None:
         self.tree = tree
         self.n = tree.n

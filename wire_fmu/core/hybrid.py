@@ -39,7 +39,6 @@ __all__ = [
     "HybridSystem",
     "SolverSettings",
     "IntegrationError",
-    "ledger_states",
     "SOLVERS",
     "make_solver",
 ]
@@ -52,13 +51,6 @@ class HybridSystem(Protocol):
     ``-1`` fires when the guard goes from ``>= 0`` to ``< 0`` (leaving a
     mode), ``0`` fires on any change of sign (a kink such as a rope going
     slack, located for accuracy).
-
-    A model may also have an integer attribute ``ledger_states``: that many
-    trailing states are energy ledgers (dissipated energy, external work),
-    integrals of powers that no derivative depends on. A linearly implicit
-    solver then integrates them by quadrature of their powers instead of
-    through its Jacobian, so a dissipated energy whose power is never
-    negative never decreases (see :func:`ledger_states`).
     """
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -80,11 +72,6 @@ class HybridSystem(Protocol):
     def project(self, x: np.ndarray) -> np.ndarray:
         """Enforce the current mode's algebraic invariants on ``x`` (exactly)."""
         ...
-
-
-def ledger_states(system: HybridSystem) -> int:
-    """How many trailing states of ``system`` are energy ledgers (0 when it does not say)."""
-    return int(getattr(system, "ledger_states", 0))
 
 
 class IntegrationError(RuntimeError):
@@ -299,13 +286,6 @@ class ROS2(_FixedStepSolver):
         self._jac = _finite_difference_jacobian(system, t, x)
         self.rhs_calls += x.size + 1
         self._inverse_h = None
-        ledgers = ledger_states(system)
-        if ledgers:
-            # Nothing depends on a ledger, so its column is zero and the other states
-            # step as before (to round-off); with its row zero too, a ledger advances
-            # by h (P(x) + P(x + h k1)) / 2: never down while its power P is never
-            # negative, and still second order.
-            self._jac[-ledgers:, :] = 0.0
 
     def _w_inverse(self, h: float) -> np.ndarray:
         """``(I - g h J)^-1``, kept while ``h`` and the Jacobian stay.

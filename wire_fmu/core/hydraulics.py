@@ -551,9 +551,6 @@ class HydraulicsModel:
         Internal solver used by :meth:`advance`.
     """
 
-    ledger_states = 1
-    """Trailing states that are energy ledgers (dissipated energy), J."""
-
     def __init__(self, spec: HydraulicsSpec, effects: frozenset[str],
                  solver: SolverSettings) -> None:
         self.spec = spec

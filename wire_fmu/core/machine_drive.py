@@ -383,9 +383,6 @@ class MachineDriveModel:
         ``b``, N m s/rad.
     """
 
-    ledger_states = 2
-    """Trailing states that are energy ledgers (dissipated energy and external work), J."""
-
     def __init__(self, spec: MachineSpec, motor_slope: float) -> None:
         self.spec = spec
         self.b = motor_slope

@@ -344,9 +344,6 @@ class ScissorJackModel:
         Internal solver of :mod:`wire_fmu.core.hybrid`.
     """
 
-    ledger_states = 2
-    """Trailing states that are energy ledgers (dissipated energy and external work), J."""
-
     def __init__(self, config: JackConfig, settings: SolverSettings) -> None:
         self.config = config
         self.h = config.thread.lead_per_radian

@@ -324,9 +324,6 @@ class WinchModel(_WinchBase):
         rigid drive train (one mass).
     """
 
-    ledger_states = 2
-    """Trailing states that are energy ledgers (dissipated energy and external work), J."""
-
     def __init__(self, config: WinchConfig, solver: SolverSettings) -> None:
         super().__init__(config)
         chain = config.chain
