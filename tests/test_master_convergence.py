@@ -11,6 +11,7 @@ system's matrix. Observed convergence orders must match the theory:
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -230,3 +231,32 @@ def test_energy_guard_lets_a_stable_coupling_finish(fmus, tmp_path, algorithm, e
     assert result.status == "finished", result.message
     assert abs(result.bond_residual["spring"]) < 2e-2 * E0
     assert abs(pair_energy(columns)[-1] - E0) < 2e-2 * E0
+
+
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid:RuntimeWarning")
+@pytest.mark.parametrize("run_settings", [{}, {"iterations": 3}])
+def test_a_unit_that_overflows_stops_the_run_before_anything_non_finite_is_kept(
+        fmus, tmp_path, run_settings):
+    """Unit a made explosive (a 1e6 rad/s spring under one RK4 step per 10 ms, no position
+    limit) and the energy guard off: its outputs overflow to inf and NaN. Explicitly the
+    run stops at the step that produced them, naming them; with rollback the step is
+    retried shorter first, and it stops at the minimum step. No connected output is ever
+    recorded non-finite (derived ones, products of 1e160-sized states, overflow earlier:
+    catching that garbage long before is the energy guard's job).
+
+    Mutation: the check removed (Simulation._attempt accepting any value): the explicit
+    run 'finished' with NaN rows: the status assertion failed.
+    """
+    data = scene_data(fmus, step=0.01, energy_guard=math.inf, **run_settings)
+    data["units"]["a"]["parameters"].update(stiffness=1e12, substeps=1, max_position=math.inf)
+    scene = parse_scene(data, base_dir=tmp_path)
+    recorder = CsvRecorder(tmp_path / "explosive")
+    result = Simulation(scene, validate_scene(scene, through_fmi=False), [recorder]).run()
+    assert result.status == "stopped"
+    assert re.search(r"a\.(position|velocity) = (nan|inf|-inf)", result.message), result.message
+    if run_settings:
+        assert result.rejected > 0 and "minimum step" in result.message
+    columns = read_results(recorder.csv_path)
+    for name in ("a.position", "b.position"):
+        assert np.all(np.isfinite(columns[name])), name
+    assert columns["time"][-1] == pytest.approx(result.end_time)

@@ -326,6 +326,16 @@ class Simulation:
             self._restore(states)
             self._free(states)
             return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
+        bad = ", ".join(f"{key} = {value!r}" for key, value in new.items()
+                        if not math.isfinite(value))
+        if bad:  # never accepted, never recorded
+            message = f"t = {t:.6g} s: after the step of {h:.3g} s, {bad}"
+            if states is None:
+                raise SimulationStoppedError(f"{message}: not finite; the run stops here, "
+                                             "everything before is kept; try a smaller step")
+            self._restore(states)
+            self._free(states)
+            return _Attempt(False, {}, sweeps, retry_step=new_h(h, 4.0), message=message)
         residuals = self.bond_residuals(new, h)
         if self.run_settings.adaptive:
             error = max((abs(r) for r in residuals.values()), default=0.0)
