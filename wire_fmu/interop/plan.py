@@ -208,12 +208,15 @@ def portable_driver_spec(spec: dict[str, Any], base_dir: Path) -> dict[str, Any]
     return {"kind": "ramp", "points": points}
 
 
+def _portable(value: Any) -> Any:
+    """A run setting as strict JSON: infinity (``energy_guard = inf``) as ``"inf"``."""
+    return "inf" if isinstance(value, float) and value == math.inf else value
+
+
 def _metadata(scene: Scene) -> dict[str, Any]:
     """What our reader restores: everything SSP has no element for."""
-    run = {k: getattr(scene.run, k) for k in scene.run.__dataclass_fields__}
+    run = {k: _portable(getattr(scene.run, k)) for k in scene.run.__dataclass_fields__}
     run["order"] = list(run["order"])
-    if math.isinf(run["energy_guard"]):  # JSON has no infinity; the reader turns it back
-        run["energy_guard"] = "inf"
     return {
         "format": "wire_fmu.scene/1",
         "name": scene.name,

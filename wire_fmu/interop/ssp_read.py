@@ -225,10 +225,9 @@ def _connections(system: etree._Element, units: dict[str, dict[str, Any]], skip:
 
 def _run_settings(root: etree._Element, meta: dict[str, Any] | None) -> dict[str, Any]:
     if meta is not None:
-        run = {k: v for k, v in meta["run"].items() if v is not None}
-        if run.get("energy_guard") == "inf":  # the guard turned off (JSON has no infinity)
-            run["energy_guard"] = math.inf
-        return run
+        # infinity travels as "inf" (strict JSON has none): energy_guard = inf, off
+        return {k: math.inf if v == "inf" else v for k, v in meta["run"].items()
+                if v is not None}
     run: dict[str, Any] = {}
     experiment = root.find(_q("ssd", "DefaultExperiment"))
     if experiment is not None:

@@ -86,11 +86,15 @@ class EnergyGuard:
         (``inf``: never stop).
     floor : float
         Energy error below which no bond is called unstable, J.
+    remedies : sequence of str
+        What the user could change, for the stop message.
     """
 
-    def __init__(self, bonds: Iterable[str], share: float, floor: float) -> None:
+    def __init__(self, bonds: Iterable[str], share: float, floor: float,
+                 remedies: Sequence[str] = ("a smaller step",)) -> None:
         self.share = share
         self.floor = floor
+        self.remedies = tuple(remedies)
         self.bonds = {name: BondEnergy() for name in bonds}
 
     def book(self, residuals: Mapping[str, float], powers: Mapping[str, float],
@@ -113,8 +117,7 @@ class EnergyGuard:
         """Energy error at which bond ``name`` stops the run now, J."""
         return max(self.share * self.bonds[name].carried, self.floor)
 
-    def blow_up(self, t: float, h: float, remedies: Sequence[str] = ("a smaller step",)
-                ) -> str | None:
+    def blow_up(self, t: float, h: float) -> str | None:
         """The stop message if some bond's coupling energy error is too large, else None.
 
         Parameters
@@ -123,8 +126,6 @@ class EnergyGuard:
             Time reached, s.
         h : float
             The macro step just taken, s.
-        remedies : sequence of str
-            What the user could change, for the message.
         """
         if math.isinf(self.share):
             return None
@@ -136,7 +137,7 @@ class EnergyGuard:
         return (f"t = {t:.6g} s: the coupling blows up at the macro step {h:.3g} s: {details} "
                 f"(limit: energy_guard = {self.share:g} of the carried energy, at least "
                 f"energy_tolerance {self.floor:g} J). The dynamics coupled across the bond "
-                f"are too fast for this step: use {' or '.join(remedies)}")
+                f"are too fast for this step: use {' or '.join(self.remedies)}")
 
 
 def _describe(name: str, bond: BondEnergy) -> str:

@@ -529,10 +529,9 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
     for key in ("stop_time", "step", "iteration_tolerance", "energy_tolerance", "min_step"):
         if not _positive(getattr(s, key)):
             problems.append(f"run.{key} must be a positive number, got {getattr(s, key)!r}")
-    guard = s.energy_guard
-    if not (isinstance(guard, int | float) and not isinstance(guard, bool) and guard > 0):
+    if not (_positive(s.energy_guard) or s.energy_guard == math.inf):
         problems.append(f"run.energy_guard must be a positive number (inf turns the guard "
-                        f"off), got {guard!r}")
+                        f"off), got {s.energy_guard!r}")
     for key in ("output_interval", "max_step"):
         value = getattr(s, key)
         if value is not None and not _positive(value):

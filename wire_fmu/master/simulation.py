@@ -43,7 +43,7 @@ from .algorithms import make_algorithm, step_order
 from .energy_guard import EnergyGuard
 from .extrapolation import History, held_value
 from .manipulators import DriverSet, ScheduledEvents
-from .scene import Bond, Connection, Scene
+from .scene import Bond, Connection, RunSettings, Scene
 from .slave import Slave, StepRefusedError, UnitFailedError
 from .validate import Structure, unit_start_values
 
@@ -133,7 +133,7 @@ class Simulation:
         self.events = ScheduledEvents(scene.events)
         self.algorithm = make_algorithm(scene.run.algorithm, self._order(structure))
         self.energy = EnergyGuard((b.name for b in scene.bonds), scene.run.energy_guard,
-                                  scene.run.energy_tolerance)
+                                  scene.run.energy_tolerance, _remedies(scene.run))
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
         self.held: dict[str, float] = {}
         self.mode_counts: dict[str, int] = {}
@@ -326,9 +326,9 @@ class Simulation:
             self._restore(states)
             self._free(states)
             return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
-        bad = ", ".join(f"{key} = {value!r}" for key, value in new.items()
-                        if not math.isfinite(value))
-        if bad:  # never accepted, never recorded
+        if not all(map(math.isfinite, new.values())):  # never accepted, never recorded
+            bad = ", ".join(f"{key} = {value!r}" for key, value in new.items()
+                            if not math.isfinite(value))
             message = f"t = {t:.6g} s: after the step of {h:.3g} s, {bad}"
             if states is None:
                 raise SimulationStoppedError(f"{message}: not finite; the run stops here, "
@@ -367,7 +367,7 @@ class Simulation:
                 for key in self.source_keys.get(name, ()):
                     self.histories[key].reset()
         across = {b.name for b in self.scene.bonds
-                  if {b.effort.source.unit, b.flow.source.unit} & switched}
+                  if b.effort.source.unit in switched or b.flow.source.unit in switched}
         self.energy.book(residuals, self.bond_power, h, across_events=across)
         self.time = t + h
 
@@ -442,20 +442,21 @@ class Simulation:
             self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_step(self)
-            blow_up = self.energy.blow_up(self.time, h, self._remedies())
+            blow_up = self.energy.blow_up(self.time, h)
             if blow_up:
                 raise SimulationStoppedError(blow_up)
             h = self._next_step(h, attempt.residuals)
 
-    def _remedies(self) -> list[str]:
-        """What the energy guard's message suggests, given the run settings."""
-        s = self.run_settings
-        remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
-        if s.iterations == 1:
-            remedies.append("iterations > 1")
-        if not s.adaptive:
-            remedies.append("adaptive = true")
-        return remedies
+
+
+def _remedies(s: RunSettings) -> list[str]:
+    """What the energy guard's message suggests, given the run settings."""
+    remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
+    if s.iterations == 1:
+        remedies.append("iterations > 1")
+    if not s.adaptive:
+        remedies.append("adaptive = true")
+    return remedies
 
 
 def _ns(seconds: float) -> int:
