@@ -140,12 +140,13 @@ def _bindings(element: etree._Element, folder: Path, problems: list[str]) -> dic
             sets = binding.findall(f"{_q('ssd', 'ParameterValues')}/{_q('ssv', 'ParameterSet')}")
         for parameter_set in sets:
             for name, value in _parameter_values(parameter_set).items():
-                out[name[len(prefix):] if prefix and name.startswith(prefix) else name] = value
+                out[name[len(prefix) :] if prefix and name.startswith(prefix) else name] = value
     return out
 
 
-def _components(system: etree._Element, folder: Path, problems: list[str]
-                ) -> dict[str, dict[str, Any]]:
+def _components(
+    system: etree._Element, folder: Path, problems: list[str]
+) -> dict[str, dict[str, Any]]:
     units: dict[str, dict[str, Any]] = {}
     elements = system.find(_q("ssd", "Elements"))
     for element in elements if elements is not None else ():
@@ -153,16 +154,20 @@ def _components(system: etree._Element, folder: Path, problems: list[str]
             continue
         name = element.get("name")
         if element.tag != _q("ssd", "Component"):
-            problems.append(f"element {name!r}: only FMU components are supported "
-                            f"(found {etree.QName(element).localname})")
+            problems.append(
+                f"element {name!r}: only FMU components are supported "
+                f"(found {etree.QName(element).localname})"
+            )
             continue
         if element.get("type", _FMU_TYPE) != _FMU_TYPE:
             problems.append(f"component {name!r}: type {element.get('type')!r} is not an FMU")
             continue
         source = element.get("source", "")
-        source = source[len("file:"):] if source.startswith("file:") else source
-        units[name] = {"fmu": str((folder / source).resolve()),
-                       "parameters": _bindings(element, folder, problems)}
+        source = source[len("file:") :] if source.startswith("file:") else source
+        units[name] = {
+            "fmu": str((folder / source).resolve()),
+            "parameters": _bindings(element, folder, problems),
+        }
     for key, value in _bindings(system, folder, problems).items():
         unit, _, variable = key.partition(".")
         if unit in units and variable:
@@ -183,42 +188,51 @@ def _causalities(units: dict[str, dict[str, Any]]) -> dict[str, dict[str, str]]:
     return out
 
 
-def _link(connection: etree._Element, causality: dict[str, dict[str, str]]
-          ) -> tuple[str, str] | None:
+def _link(
+    connection: etree._Element, causality: dict[str, dict[str, str]]
+) -> tuple[str, str] | None:
     start = (connection.get("startElement"), connection.get("startConnector"))
     end = (connection.get("endElement"), connection.get("endConnector"))
     if start[0] is None or end[0] is None:
         return None
-    if causality.get(start[0], {}).get(start[1]) == "input" and \
-            causality.get(end[0], {}).get(end[1]) in ("output", "calculatedParameter"):
+    if causality.get(start[0], {}).get(start[1]) == "input" and causality.get(end[0], {}).get(
+        end[1]
+    ) in ("output", "calculatedParameter"):
         start, end = end, start
     return f"{start[0]}.{start[1]}", f"{end[0]}.{end[1]}"
 
 
-def _connections(system: etree._Element, units: dict[str, dict[str, Any]], skip: str | None,
-                 problems: list[str]) -> tuple[list[dict], list[dict]]:
+def _connections(
+    system: etree._Element, units: dict[str, dict[str, Any]], skip: str | None, problems: list[str]
+) -> tuple[list[dict], list[dict]]:
     causality = _causalities(units)
     plain, bonds = [], {}
     path = f"{_q('ssd', 'Connections')}/{_q('ssd', 'Connection')}"
     for connection in system.iterfind(path):
-        if skip is not None and skip in (connection.get("startElement"),
-                                         connection.get("endElement")):
+        if skip is not None and skip in (
+            connection.get("startElement"),
+            connection.get("endElement"),
+        ):
             continue
         link = _link(connection, causality)
         where = f"connection {connection.get('startElement')}.{connection.get('startConnector')}"
         if link is None:
             problems.append(f"{where}: connections to system connectors are not supported")
             continue
-        if any(child.tag.startswith(f"{{{NS['ssc']}}}") for child in connection
-               if isinstance(child.tag, str)):
+        if any(
+            child.tag.startswith(f"{{{NS['ssc']}}}")
+            for child in connection
+            if isinstance(child.tag, str)
+        ):
             problems.append(f"{where}: transformations on connections are not supported")
             continue
         mark = _annotation(connection, BOND_ANNOTATION)
         if mark is None:
             plain.append({"from": link[0], "to": link[1]})
             continue
-        bond = bonds.setdefault(mark.get("name"), {"name": mark.get("name"),
-                                                   "kind": mark.get("kind")})
+        bond = bonds.setdefault(
+            mark.get("name"), {"name": mark.get("name"), "kind": mark.get("kind")}
+        )
         bond[mark.get("role")] = f"{link[0]} -> {link[1]}"
     return plain, list(bonds.values())
 
@@ -226,8 +240,7 @@ def _connections(system: etree._Element, units: dict[str, dict[str, Any]], skip:
 def _run_settings(root: etree._Element, meta: dict[str, Any] | None) -> dict[str, Any]:
     if meta is not None:
         # infinity travels as "inf" (strict JSON has none): energy_guard = inf, off
-        return {k: math.inf if v == "inf" else v for k, v in meta["run"].items()
-                if v is not None}
+        return {k: math.inf if v == "inf" else v for k, v in meta["run"].items() if v is not None}
     run: dict[str, Any] = {}
     experiment = root.find(_q("ssd", "DefaultExperiment"))
     if experiment is not None:
@@ -244,16 +257,23 @@ def _run_settings(root: etree._Element, meta: dict[str, Any] | None) -> dict[str
 def _restore(data: dict[str, Any], meta: dict[str, Any]) -> None:
     """Put back what SSP has no element for, from our annotation."""
     data["description"] = meta.get("description", "")
-    data["drivers"] = [{"target": d["target"], **({"rate_target": d["rate_target"]}
-                                                    if d["rate_target"] else {}),
-                        **({"label": d["label"]} if d["label"] else {}), **d["spec"]}
-                       for d in meta.get("drivers", [])]
-    data["events"] = [{"time": e["time"], "label": e["label"], "set": e["set"]}
-                      for e in meta.get("events", [])]
-    data["outputs"] = {"variables": meta["outputs"] if meta.get("outputs") is not None
-                       else "all"}
-    data["plots"] = [{"title": p["title"], "ylabel": p["ylabel"], "variables": p["variables"]}
-                     for p in meta.get("plots", [])]
+    data["drivers"] = [
+        {
+            "target": d["target"],
+            **({"rate_target": d["rate_target"]} if d["rate_target"] else {}),
+            **({"label": d["label"]} if d["label"] else {}),
+            **d["spec"],
+        }
+        for d in meta.get("drivers", [])
+    ]
+    data["events"] = [
+        {"time": e["time"], "label": e["label"], "set": e["set"]} for e in meta.get("events", [])
+    ]
+    data["outputs"] = {"variables": meta["outputs"] if meta.get("outputs") is not None else "all"}
+    data["plots"] = [
+        {"title": p["title"], "ylabel": p["ylabel"], "variables": p["variables"]}
+        for p in meta.get("plots", [])
+    ]
     for name, effects in meta.get("effects", {}).items():
         if name in data["units"]:
             data["units"][name]["effects"] = effects
@@ -275,10 +295,14 @@ def ssp_scene_data(folder: Path) -> tuple[dict[str, Any], list[str]]:
     units = _components(system, folder, problems)
     units.pop(skip, None)
     plain, bonds = _connections(system, units, skip, problems)
-    data: dict[str, Any] = {"name": root.get("name") or system.get("name") or "ssp",
-                            "description": system.get("description", ""),
-                            "run": _run_settings(root, meta), "units": units,
-                            "connections": plain, "bonds": bonds}
+    data: dict[str, Any] = {
+        "name": root.get("name") or system.get("name") or "ssp",
+        "description": system.get("description", ""),
+        "run": _run_settings(root, meta),
+        "units": units,
+        "connections": plain,
+        "bonds": bonds,
+    }
     if meta is not None:
         data["name"] = meta.get("name", data["name"])
         _restore(data, meta)
@@ -305,6 +329,11 @@ def read_ssp(path: Path, *, extract_to: Path | None = None) -> Scene:
     data, problems = ssp_scene_data(folder)
     if problems:
         raise SceneError(str(path), problems)
-    logger.info("read %s: %d units, %d bonds, %d connections", path.name, len(data["units"]),
-                len(data["bonds"]), len(data["connections"]))
+    logger.info(
+        "read %s: %d units, %d bonds, %d connections",
+        path.name,
+        len(data["units"]),
+        len(data["bonds"]),
+        len(data["connections"]),
+    )
     return parse_scene(data, base_dir=folder, source=path)

@@ -422,9 +422,7 @@ def pierson_moskowitz_spectrum(
     w = np.asarray(omega, dtype=float)
     wp = _TWO_PI / peak_period
     ratio = w / wp
-    return (
-        5.0 / 16.0 * significant_height**2 * wp**4 * w**-5.0 * np.exp(-1.25 * ratio**-4.0)
-    )
+    return 5.0 / 16.0 * significant_height**2 * wp**4 * w**-5.0 * np.exp(-1.25 * ratio**-4.0)
 
 
 def jonswap_spectrum(
@@ -608,7 +606,9 @@ def _ramp_points(r: _Reader) -> tuple[np.ndarray, np.ndarray] | None:
     ok_shape = isinstance(raw, list | tuple) and len(raw) >= 2
     rows = raw if ok_shape else []
     good = all(
-        isinstance(p, list | tuple) and len(p) == 2 and all(_is_number(x) for x in p)
+        isinstance(p, list | tuple)
+        and len(p) == 2
+        and all(_is_number(x) for x in p)
         and all(math.isfinite(x) for x in p)
         for p in rows
     )
@@ -670,8 +670,11 @@ def _build_sine(r: _Reader, ctx: _Context) -> Driver | None:
 def _cutoff(r: _Reader) -> tuple[float, float]:
     raw = r.spec.get("cutoff", [0.5, 4.0])
     ok = (
-        isinstance(raw, list | tuple) and len(raw) == 2 and all(_is_number(x) for x in raw)
-        and 0.0 < raw[0] < 1.0 < raw[1] and math.isfinite(raw[1])
+        isinstance(raw, list | tuple)
+        and len(raw) == 2
+        and all(_is_number(x) for x in raw)
+        and 0.0 < raw[0] < 1.0 < raw[1]
+        and math.isfinite(raw[1])
     )
     if not ok:
         r.add(
@@ -711,8 +714,14 @@ def _build_sea_state(r: _Reader, ctx: _Context) -> Driver | None:
     if r.problems:
         return None
     return SeaStateDriver.from_spectrum(
-        spectrum, peak_period, components=components, seed=seed, cutoff=cutoff,
-        heave_rao=rao, start_time=start, ramp_time=ramp,
+        spectrum,
+        peak_period,
+        components=components,
+        seed=seed,
+        cutoff=cutoff,
+        heave_rao=rao,
+        start_time=start,
+        ramp_time=ramp,
     )
 
 
@@ -826,8 +835,17 @@ DRIVER_KINDS: Mapping[str, DriverKind] = MappingProxyType(
             DriverKind(
                 "sea_state",
                 "irregular heave from a JONSWAP or Pierson-Moskowitz wave spectrum",
-                ("significant_height", "peak_period", "spectrum", "gamma", "components",
-                 "seed", "cutoff", "heave_rao", *_FADE_KEYS),
+                (
+                    "significant_height",
+                    "peak_period",
+                    "spectrum",
+                    "gamma",
+                    "components",
+                    "seed",
+                    "cutoff",
+                    "heave_rao",
+                    *_FADE_KEYS,
+                ),
                 _build_sea_state,
             ),
             DriverKind(

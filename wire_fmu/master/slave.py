@@ -72,8 +72,9 @@ class _Messages:
     def __call__(self, env, instance, status, category, message) -> None:
         text = message.decode("utf-8", "replace") if message else ""
         name = instance.decode("utf-8", "replace") if instance else self.name
-        level = {0: logging.DEBUG, 1: logging.WARNING, 2: logging.WARNING}.get(status,
-                                                                                logging.ERROR)
+        level = {0: logging.DEBUG, 1: logging.WARNING, 2: logging.WARNING}.get(
+            status, logging.ERROR
+        )
         logger.log(level, "%s [%s]: %s", name, FMI_STATUS.get(status, status), text)
         if status >= 1:
             _ROUTES.get(name, self).kept.append(text)
@@ -137,9 +138,12 @@ class Slave:
         md = self.model_description
         if unzipdir is None:
             unzipdir = self._unzipdir = extract(str(self.path))
-        self._fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                              modelIdentifier=md.coSimulation.modelIdentifier,
-                              instanceName=self.name)
+        self._fmu = FMU2Slave(
+            guid=md.guid,
+            unzipDirectory=unzipdir,
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName=self.name,
+        )
         self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
 
     def initialize(self, start_time: float, values: dict[str, Any], inputs_first=None) -> None:
@@ -166,8 +170,10 @@ class Slave:
             _KEEP_ALIVE.append(fmu)
             self._fmu = None
             return
-        for name, call in (("terminate", fmu.terminate),
-                           ("freeInstance", lambda: fmu.fmi2FreeInstance(fmu.component))):
+        for name, call in (
+            ("terminate", fmu.terminate),
+            ("freeInstance", lambda: fmu.fmi2FreeInstance(fmu.component)),
+        ):
             try:
                 call()
             except Exception as exc:  # noqa: BLE001 - cleaning up, report and go on
@@ -228,10 +234,13 @@ class Slave:
             self._fatal = self._fatal or exc.status == 4
             said = "; ".join(self.messages.kept[-3:]) or "no message"
             if exc.status == 2:
-                raise StepRefusedError(f"unit {self.name!r} refused the step at t = {t:.6g} s "
-                                  f"(h = {h:.3g} s): {said}") from None
-            raise UnitFailedError(f"unit {self.name!r} failed at t = {t:.6g} s with "
-                             f"{FMI_STATUS.get(exc.status, exc.status)}: {said}") from None
+                raise StepRefusedError(
+                    f"unit {self.name!r} refused the step at t = {t:.6g} s (h = {h:.3g} s): {said}"
+                ) from None
+            raise UnitFailedError(
+                f"unit {self.name!r} failed at t = {t:.6g} s with "
+                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}"
+            ) from None
 
     def get_state(self) -> object:
         """Save the FMU state (for rollback)."""
@@ -258,8 +267,10 @@ class Slave:
             if fn == "doStep":
                 raise
             said = "; ".join(self.messages.kept[-5:]) or "no message"
-            raise UnitFailedError(f"unit {self.name!r}: {fn} failed with "
-                             f"{FMI_STATUS.get(exc.status, exc.status)}: {said}") from None
+            raise UnitFailedError(
+                f"unit {self.name!r}: {fn} failed with "
+                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}"
+            ) from None
         finally:
             self.calls[fn] += 1
             self.seconds[fn] += time.perf_counter() - start
