@@ -47,10 +47,17 @@ Conventions
   The default band [0.5, 4] omega_p loses about 0.3-0.5 % of m0 (the tail
   above 4 omega_p); a constant ``heave_rao`` scales the wave elevation to
   vessel heave.
-* ``table``: a comma-separated file with a header row naming the columns
-  (names are stripped of spaces; a UTF-8 byte-order mark is ignored), then
-  at least two data rows; blank lines and lines starting with ``#`` are
-  skipped; the time column must be strictly increasing.
+* ``table``: a comma-separated UTF-8 text file (a regular file of at most
+  :data:`MAX_TABLE_BYTES`) with a header row naming the columns (names are
+  stripped of spaces; a UTF-8 byte-order mark is ignored), then at least
+  two data rows; blank lines and lines starting with ``#`` are skipped; the
+  time column must be strictly increasing. A file that is not such a table
+  is reported without quoting it (the first line of a file pointed at by
+  mistake may be a secret): the column names are listed only when the rows
+  under them are all numbers, and a bad cell is quoted only if it is short.
+* Every number must be finite and so must what the driver computes from it
+  (slopes, angular frequencies, wave amplitudes); values quoted in problems
+  are shortened, so a huge array in a scene gives a short message.
 
 Every driver's :meth:`~Driver.value` and :meth:`~Driver.rate` also accept an
 array of times (s) and then return an array; a float gives a float.
@@ -60,8 +67,12 @@ from __future__ import annotations
 
 import csv
 import difflib
+import io
 import logging
 import math
+import os
+import re
+import stat
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -83,6 +94,7 @@ __all__ = [
     "pierson_moskowitz_spectrum",
     "jonswap_spectrum",
     "SPECTRA",
+    "MAX_TABLE_BYTES",
 ]
 
 logger = logging.getLogger(__name__)
@@ -91,6 +103,13 @@ _TWO_PI = 2.0 * math.pi
 _CHUNK = 4096  # rows of (time x component) evaluated at once for long time arrays
 _MAX_COMPONENTS = 20_000  # wave components a sea state may ask for (cost per call ~ n)
 _MAX_REPORTED_ROWS = 5  # bad CSV rows reported one by one, the rest counted
+_SHOWN = 60  # characters of a spec value quoted in a problem
+_MAX_HINT_WORD = 100  # longer words get no "did you mean" (difflib is quadratic)
+_MAX_CELL_SHOWN = 20  # a bad CSV cell longer than this is described, not quoted
+_MAX_HEADER_SHOWN = (2, 50, 32)  # column names listed: min and max count, max length
+_COLUMN_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_ .()\[\]/%-]*")  # a name we may quote
+MAX_TABLE_BYTES = 64 << 20
+"""Largest CSV file a ``table`` driver reads, bytes (64 MiB, about two million rows)."""
 
 
 # ----------------------------------------------------------------------- protocol
@@ -471,12 +490,35 @@ SPECTRA: Mapping[str, str] = MappingProxyType(
 
 
 def _close_hint(word: str, choices: Collection[str]) -> str:
+    if len(word) > _MAX_HINT_WORD:
+        return ""
     close = difflib.get_close_matches(word, list(choices), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def _is_number(x: Any) -> bool:
     return isinstance(x, int | float) and not isinstance(x, bool)
+
+
+def _real(x: Any) -> float | None:
+    """``x`` as a finite float; None if it is no finite number (or an int too large)."""
+    if not _is_number(x):
+        return None
+    try:
+        value = float(x)
+    except OverflowError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _show(value: Any) -> str:
+    """``repr(value)`` for a problem, shortened (a spec may hold a huge array)."""
+    if isinstance(value, str) and len(value) > 10_000:
+        return f"a text of {len(value)} characters"
+    if isinstance(value, list | tuple | dict) and len(value) > 10_000:
+        return f"a {type(value).__name__} of {len(value)} items"
+    text = repr(value)
+    return text if len(text) <= _SHOWN else f"{text[: _SHOWN - 5]} ..."
 
 
 class _Reader:
@@ -512,29 +554,30 @@ class _Reader:
             return default
         raw = self.spec[key]
         suffix = f" {unit}" if unit else ""
-        if not _is_number(raw) or not math.isfinite(raw):
+        value = _real(raw)
+        if value is None:
             in_unit = f" in {unit}" if unit else ""
-            self.add(f"'{key}' must be a finite number{in_unit}, got {raw!r}")
+            self.add(f"'{key}' must be a finite number{in_unit}, got {_show(raw)}")
             return math.nan
-        if positive and not raw > 0:
-            self.add(f"'{key}' must be > 0{suffix}, got {raw!r}")
+        if positive and not value > 0:
+            self.add(f"'{key}' must be > 0{suffix}, got {_show(raw)}")
             return math.nan
-        if minimum is not None and raw < minimum:
-            self.add(f"'{key}' must be >= {minimum:g}{suffix}, got {raw!r}")
+        if minimum is not None and value < minimum:
+            self.add(f"'{key}' must be >= {minimum:g}{suffix}, got {_show(raw)}")
             return math.nan
-        return float(raw)
+        return value
 
     def integer(self, key: str, default: int, *, minimum: int, maximum: int | None = None) -> int:
         """An integer in [``minimum``, ``maximum``] (``default`` after a problem)."""
         raw = self.spec.get(key, default)
         if not isinstance(raw, int) or isinstance(raw, bool):
-            self.add(f"'{key}' must be an integer, got {raw!r}")
+            self.add(f"'{key}' must be an integer, got {_show(raw)}")
             return default
         if raw < minimum:
-            self.add(f"'{key}' must be an integer >= {minimum}, got {raw!r}")
+            self.add(f"'{key}' must be an integer >= {minimum}, got {_show(raw)}")
             return default
         if maximum is not None and raw > maximum:
-            self.add(f"'{key}' must be an integer <= {maximum}, got {raw!r}")
+            self.add(f"'{key}' must be an integer <= {maximum}, got {_show(raw)}")
             return default
         return raw
 
@@ -543,7 +586,7 @@ class _Reader:
         raw = self.spec.get(key, default)
         if not isinstance(raw, str) or raw not in choices:
             hint = _close_hint(raw, choices) if isinstance(raw, str) else ""
-            self.add(f"'{key}' must be one of {', '.join(choices)}, got {raw!r}{hint}")
+            self.add(f"'{key}' must be one of {', '.join(choices)}, got {_show(raw)}{hint}")
             return default
         return raw
 
@@ -554,7 +597,7 @@ class _Reader:
             self.add(f"'{key}' is required")
             return ""
         if not isinstance(raw, str) or not raw.strip():
-            self.add(f"'{key}' must be a non-empty string, got {raw!r}")
+            self.add(f"'{key}' must be a non-empty string, got {_show(raw)}")
             return ""
         return raw
 
@@ -564,9 +607,24 @@ class _Reader:
             if key not in allowed:
                 hint = _close_hint(str(key), allowed)
                 self.add(
-                    f"unknown key {key!r} for kind {self.spec['kind']!r}{hint}; "
+                    f"unknown key {_show(key)} for kind {self.spec['kind']!r}{hint}; "
                     f"known keys: {', '.join(sorted(allowed))}"
                 )
+
+
+def _finite_slopes(times: np.ndarray, values: np.ndarray, label: str, r: _Reader) -> bool:
+    """Check every segment's slope is finite (no overflow); report the first offence."""
+    with np.errstate(all="ignore"):
+        slopes = np.diff(values) / np.diff(times)
+    bad = np.flatnonzero(~np.isfinite(slopes))
+    if bad.size == 0:
+        return True
+    k = int(bad[0])
+    r.add(
+        f"{label}: the slope between entries {k} and {k + 1} (t = {times[k]:g} s and "
+        f"{times[k + 1]:g} s) is too large to represent"
+    )
+    return False
 
 
 def _increasing(times: np.ndarray, label: str, r: _Reader) -> bool:
@@ -606,21 +664,19 @@ def _ramp_points(r: _Reader) -> tuple[np.ndarray, np.ndarray] | None:
     ok_shape = isinstance(raw, list | tuple) and len(raw) >= 2
     rows = raw if ok_shape else []
     good = all(
-        isinstance(p, list | tuple)
-        and len(p) == 2
-        and all(_is_number(x) for x in p)
-        and all(math.isfinite(x) for x in p)
+        isinstance(p, list | tuple) and len(p) == 2 and all(_real(x) is not None for x in p)
         for p in rows
     )
     if not ok_shape or not good:
         r.add(
             "'points' must be a list of at least two [time (s), value] pairs of finite numbers, "
-            f"got {raw!r}"
+            f"got {_show(raw)}"
         )
         return None
     times = np.array([p[0] for p in rows], dtype=float)
     values = np.array([p[1] for p in rows], dtype=float)
-    return (times, values) if _increasing(times, "'points' times", r) else None
+    ok = _increasing(times, "'points' times", r) and _finite_slopes(times, values, "'points'", r)
+    return (times, values) if ok else None
 
 
 def _ramp_short(r: _Reader) -> tuple[np.ndarray, np.ndarray] | None:
@@ -633,7 +689,8 @@ def _ramp_short(r: _Reader) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     if not all(math.isfinite(x) for x in (t0, t1, v0, v1)):
         return None
-    return np.array([t0, t1]), np.array([v0, v1])
+    times, values = np.array([t0, t1]), np.array([v0, v1])
+    return (times, values) if _finite_slopes(times, values, "the ramp", r) else None
 
 
 def _build_ramp(r: _Reader, ctx: _Context) -> Driver | None:
@@ -657,7 +714,7 @@ def _build_sine(r: _Reader, ctx: _Context) -> Driver | None:
     else:
         r.add("'period' (s) or 'frequency' (Hz) is required")
         omega = math.nan
-    return SineDriver(
+    driver = SineDriver(
         amplitude,
         omega,
         math.radians(r.number("phase_deg", 0.0, unit="deg")),
@@ -665,6 +722,15 @@ def _build_sine(r: _Reader, ctx: _Context) -> Driver | None:
         r.number("start_time", 0.0, unit="s"),
         r.number("ramp_time", 0.0, unit="s", minimum=0.0),
     )
+    if r.problems:
+        return None
+    if not math.isfinite(omega):
+        r.add("the angular frequency (from 'period' or 'frequency') is too large to represent")
+    elif not (
+        math.isfinite(amplitude * omega) and math.isfinite(abs(amplitude) + abs(driver.offset))
+    ):
+        r.add("'amplitude' is too large: the signal or its rate cannot be represented")
+    return None if r.problems else driver
 
 
 def _cutoff(r: _Reader) -> tuple[float, float]:
@@ -672,14 +738,13 @@ def _cutoff(r: _Reader) -> tuple[float, float]:
     ok = (
         isinstance(raw, list | tuple)
         and len(raw) == 2
-        and all(_is_number(x) for x in raw)
+        and all(_real(x) is not None for x in raw)
         and 0.0 < raw[0] < 1.0 < raw[1]
-        and math.isfinite(raw[1])
     )
     if not ok:
         r.add(
             "'cutoff' must be [low, high] in multiples of the peak frequency with "
-            f"0 < low < 1 < high, got {raw!r}"
+            f"0 < low < 1 < high, got {_show(raw)}"
         )
         return (0.5, 4.0)
     return (float(raw[0]), float(raw[1]))
@@ -713,31 +778,143 @@ def _build_sea_state(r: _Reader, ctx: _Context) -> Driver | None:
     ramp = r.number("ramp_time", 0.0, unit="s", minimum=0.0)
     if r.problems:
         return None
-    return SeaStateDriver.from_spectrum(
-        spectrum,
-        peak_period,
-        components=components,
-        seed=seed,
-        cutoff=cutoff,
-        heave_rao=rao,
-        start_time=start,
-        ramp_time=ramp,
-    )
+    with np.errstate(all="ignore"):  # overflow is checked for below, not warned about
+        try:
+            driver = SeaStateDriver.from_spectrum(
+                spectrum,
+                peak_period,
+                components=components,
+                seed=seed,
+                cutoff=cutoff,
+                heave_rao=rao,
+                start_time=start,
+                ramp_time=ramp,
+            )
+        except (OverflowError, ZeroDivisionError, ValueError):  # Python floats raise
+            driver = None
+        if driver is not None:
+            scale = abs(rao) * np.sum(driver.amplitudes * (1.0 + driver.angular_frequencies))
+    if driver is None or not (np.all(np.isfinite(driver.amplitudes)) and np.isfinite(scale)):
+        r.add(
+            "'significant_height', 'peak_period' and 'heave_rao' give wave components too "
+            "large to represent"
+        )
+        return None
+    return driver
+
+
+_EXPECTED_TABLE = "a CSV text file with a header row naming the columns, then rows of numbers"
+
+
+def _shown_path(path: Path) -> str:
+    """The table file's path for a problem (shortened if absurdly long)."""
+    text = str(path)
+    return text if len(text) <= 200 else f"{text[:100]}...{text[-60:]}"
+
+
+def _file_kind(mode: int) -> str:
+    for test, kind in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISFIFO, "a pipe"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return kind
+    return "not a regular file"
+
+
+def _read_table_bytes(path: Path, shown: str, r: _Reader) -> bytes | None:
+    """The bytes of a regular file of at most :data:`MAX_TABLE_BYTES` (None after a problem).
+
+    Opened without blocking (a pipe does not hang the read) and checked on
+    the open descriptor, so what is checked is what is read.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(path, flags)
+    except (OSError, ValueError) as exc:  # ValueError: a NUL character in the name
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        r.add(f"cannot read table file '{shown}': {reason}")
+        return None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            r.add(f"table file '{shown}' is {_file_kind(info.st_mode)}; expected {_EXPECTED_TABLE}")
+            return None
+        if info.st_size > MAX_TABLE_BYTES:
+            r.add(
+                f"table file '{shown}' is {info.st_size / 2**20:.0f} MiB, more than the "
+                f"{MAX_TABLE_BYTES >> 20} MiB a table may have"
+            )
+            return None
+        with os.fdopen(os.dup(fd), "rb") as handle:
+            data = handle.read(MAX_TABLE_BYTES + 1)
+    except OSError as exc:
+        r.add(f"cannot read table file '{shown}': {exc.strerror or type(exc).__name__}")
+        return None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_TABLE_BYTES:  # it grew while we looked
+        r.add(f"table file '{shown}' is more than the {MAX_TABLE_BYTES >> 20} MiB a table may have")
+        return None
+    return data
 
 
 def _csv_rows(path: Path, r: _Reader) -> list[list[str]] | None:
-    """Non-empty, non-comment rows of a CSV file (None after a problem)."""
+    """Non-empty, non-comment rows of a CSV file (None after a problem).
+
+    No problem quotes the file: it may not be a table at all.
+    """
+    shown = _shown_path(path)
+    data = _read_table_bytes(path, shown, r)
+    if data is None:
+        return None
     try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            rows = [row for row in csv.reader(handle) if any(c.strip() for c in row)]
-    except OSError as exc:
-        r.add(f"cannot read table file '{path}': {exc.strerror or exc}")
+        if b"\0" in data:
+            raise UnicodeError("NUL byte")
+        text = data.decode("utf-8-sig")
+    except UnicodeError:
+        r.add(
+            f"table file '{shown}' is not UTF-8 text (a binary file?); expected {_EXPECTED_TABLE}"
+        )
+        return None
+    try:
+        rows = [
+            row for row in csv.reader(io.StringIO(text, newline="")) if any(c.strip() for c in row)
+        ]
+    except csv.Error as exc:
+        r.add(f"table file '{shown}' is not a CSV table ({exc}); expected {_EXPECTED_TABLE}")
         return None
     rows = [row for row in rows if not row[0].lstrip().startswith("#")]
     if len(rows) < 3:
-        r.add(f"table file '{path}' needs a header row and at least two data rows")
+        r.add(f"table file '{shown}' needs a header row and at least two data rows")
         return None
     return rows
+
+
+def _numeric_table(rows: list[list[str]]) -> bool:
+    """Whether the rows under the header are all numbers, as many as the header names.
+
+    Only then is the first row taken for column names that may be quoted in
+    a problem: the first line of any other file may be a secret.
+    """
+    header = rows[0]
+    least, most, longest = _MAX_HEADER_SHOWN
+    if not least <= len(header) <= most or any(
+        len(c) > longest or not _COLUMN_NAME.fullmatch(c) for c in header
+    ):
+        return False
+    for row in rows[1:]:
+        if len(row) != len(header):
+            return False
+        for cell in row:
+            try:
+                float(cell)
+            except ValueError:
+                return False
+    return True
 
 
 def _csv_column(rows: list[list[str]], index: int, name: str, path: Path, r: _Reader):
@@ -750,12 +927,20 @@ def _csv_column(rows: list[list[str]], index: int, name: str, path: Path, r: _Re
                 raise ValueError
             values.append(x)
         except (IndexError, ValueError):
-            cell = row[index] if index < len(row) else "missing"
-            bad.append(f"data row {line - 1} ({cell!r})")
+            if index >= len(row):
+                cell = "missing"
+            elif len(row[index]) > _MAX_CELL_SHOWN:
+                cell = f"a {len(row[index])}-character value"
+            else:
+                cell = repr(row[index])
+            bad.append(f"data row {line - 1} ({cell})")
     if bad:
         more = f" and {len(bad) - _MAX_REPORTED_ROWS} more" if len(bad) > _MAX_REPORTED_ROWS else ""
         shown = "; ".join(bad[:_MAX_REPORTED_ROWS])
-        r.add(f"table file '{path}': column {name!r} is not a finite number in {shown}{more}")
+        r.add(
+            f"table file '{_shown_path(path)}': column {name!r} is not a finite number in "
+            f"{shown}{more}"
+        )
         return None
     return np.array(values)
 
@@ -771,18 +956,33 @@ def _build_table(r: _Reader, ctx: _Context) -> Driver | None:
     if rows is None:
         return None
     header = [c.strip() for c in rows[0]]
-    columns = []
-    for name in (time_name, value_name):
-        if name not in header:
-            r.add(
-                f"table file '{path}' has no column {name!r}{_close_hint(name, header)}; "
-                f"columns: {', '.join(header)}"
-            )
-        else:
-            columns.append(_csv_column(rows, header.index(name), name, path, r))
-    if len(columns) < 2 or any(c is None for c in columns):
+    shown = _shown_path(path)
+    missing = [name for name in (time_name, value_name) if name not in header]
+    if missing:
+        listed = _numeric_table([header, *rows[1:]])
+        for name in missing:
+            if listed:
+                r.add(
+                    f"table file '{shown}' has no column {_show(name)}{_close_hint(name, header)}; "
+                    f"columns: {', '.join(header)}"
+                )
+            else:
+                r.add(
+                    f"table file '{shown}' has no column {_show(name)} (its first row is not "
+                    f"quoted: the file does not look like a numeric table); expected "
+                    f"{_EXPECTED_TABLE}"
+                )
         return None
-    if not _increasing(columns[0], f"table file '{path}' column {time_name!r}", r):
+    columns = [
+        _csv_column(rows, header.index(name), name, path, r) for name in (time_name, value_name)
+    ]
+    if any(c is None for c in columns):
+        return None
+    label = f"table file '{shown}' column {time_name!r}"
+    if not (
+        _increasing(columns[0], label, r)
+        and _finite_slopes(columns[0], columns[1], f"table file '{shown}'", r)
+    ):
         return None
     logger.debug("table driver: %d rows from %s", len(columns[0]), path)
     return PiecewiseLinearDriver(columns[0], columns[1], source=str(path))
@@ -868,7 +1068,7 @@ def _kind_of(spec: Mapping[str, Any], r: _Reader) -> DriverKind | None:
         return None
     if not isinstance(kind, str) or kind not in DRIVER_KINDS:
         hint = _close_hint(kind, DRIVER_KINDS) if isinstance(kind, str) else ""
-        r.add(f"unknown kind {kind!r}{hint}; known kinds: {known}")
+        r.add(f"unknown kind {_show(kind)}{hint}; known kinds: {known}")
         return None
     return DRIVER_KINDS[kind]
 
@@ -904,7 +1104,7 @@ def make_driver(
         Bad input never raises.
     """
     if not isinstance(spec, Mapping):
-        return None, [f"{where}: a driver must be a table with a 'kind', got {spec!r}"]
+        return None, [f"{where}: a driver must be a table with a 'kind', got {_show(spec)}"]
     r = _Reader({k: v for k, v in spec.items() if k not in ignore}, where)
     kind = _kind_of(r.spec, r)
     if kind is None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import ctypes
 import logging
-import shutil
+import os
 import time
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fmpy import calloc, extract, free, read_model_description
+from fmpy import calloc, free, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (
     FMU2Slave,
@@ -37,6 +37,8 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
 )
 from fmpy.logging import addLoggerProxy
+
+from .archive import ArchiveLimits, extract_temporary, remove_extracted
 
 __all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS"]
 
@@ -133,18 +135,57 @@ class Slave:
         return self.variables[name].valueReference
 
     # -- life cycle ------------------------------------------------------------
-    def instantiate(self, unzipdir: str | None = None) -> None:
-        """Load the binary and instantiate (logging on, into Python logging)."""
+    def instantiate(
+        self, unzipdir: str | None = None, *, limits: ArchiveLimits | None = None
+    ) -> None:
+        """Load the binary and instantiate (logging on, into Python logging).
+
+        Parameters
+        ----------
+        unzipdir : str, optional
+            A folder the FMU is already extracted to (left alone). Without it
+            the FMU is extracted safely (:mod:`wire_fmu.master.archive`) into
+            a private temporary folder, removed by :meth:`terminate`, or at
+            once if instantiation fails.
+        limits : ArchiveLimits, optional
+            Bounds on the extracted size and member count (default 1 GiB,
+            10,000 members).
+
+        Raises
+        ------
+        ArchiveError
+            If the FMU cannot be extracted safely (not a zip, too large, a
+            member outside the folder); it names the FMU and the problem.
+        """
         md = self.model_description
         if unzipdir is None:
-            unzipdir = self._unzipdir = extract(str(self.path))
-        self._fmu = FMU2Slave(
-            guid=md.guid,
-            unzipDirectory=unzipdir,
-            modelIdentifier=md.coSimulation.modelIdentifier,
-            instanceName=self.name,
-        )
-        self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
+            self._remove_unzipdir()  # left by an earlier instantiation that was not terminated
+            self._unzipdir = str(
+                extract_temporary(self.path, what="FMU", prefix="wire_fmu_fmu_", limits=limits)
+            )
+            unzipdir = self._unzipdir
+        cwd = os.getcwd()
+        try:
+            self._fmu = FMU2Slave(
+                guid=md.guid,
+                unzipDirectory=unzipdir,
+                modelIdentifier=md.coSimulation.modelIdentifier,
+                instanceName=self.name,
+            )
+            self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
+        except BaseException:
+            try:  # fmpy leaves the working directory in the binary's folder if loading fails
+                os.chdir(cwd)
+            except OSError as exc:
+                logger.debug("%s: cannot return to %s: %s", self.name, cwd, exc)
+            self._remove_unzipdir()
+            raise
+
+    def _remove_unzipdir(self) -> None:
+        """Remove the folder this instance extracted its FMU to, if any."""
+        if self._unzipdir:
+            remove_extracted(self._unzipdir)
+            self._unzipdir = None
 
     def initialize(self, start_time: float, values: dict[str, Any], inputs_first=None) -> None:
         """Set ``values`` (parameters, start inputs), then enter initialisation mode."""
@@ -164,11 +205,13 @@ class Slave:
         objects it created crashes the process at exit.
         """
         if self._fmu is None:
+            self._remove_unzipdir()
             return
         fmu = self._fmu
         if self._fatal:  # FMI 2.0: after fmi2Fatal no further call is allowed
             _KEEP_ALIVE.append(fmu)
             self._fmu = None
+            self._remove_unzipdir()
             return
         for name, call in (
             ("terminate", fmu.terminate),
@@ -180,9 +223,7 @@ class Slave:
                 logger.debug("%s: %s failed during cleanup: %s", self.name, name, exc)
         _KEEP_ALIVE.append(fmu)  # keep the library (and its handle) alive
         self._fmu = None
-        if self._unzipdir:  # the loaded library stays mapped; its files can go
-            shutil.rmtree(self._unzipdir, ignore_errors=True)
-            self._unzipdir = None
+        self._remove_unzipdir()  # the loaded library stays mapped; its files can go
 
     # -- values ------------------------------------------------------------------
     def set_many(self, values: dict[str, Any]) -> None:
