@@ -204,7 +204,7 @@ def _read_xml(path: Path, label: str, problems: list[str]) -> etree._Element | N
     try:
         return etree.fromstring(data, _parser())
     except etree.XMLSyntaxError as err:
-        problems.append(f"{label}: not well-formed XML ({err.msg}, line {err.lineno})")
+        problems.append(f"{label}: not well-formed XML ({err.msg})")
     except (etree.LxmlError, ValueError) as err:  # UnicodeDecodeError is a ValueError
         problems.append(f"{label}: not readable XML ({type(err).__name__}: {err})")
     return None
@@ -491,7 +491,8 @@ def _connections(
         where += f"{connection.get('endConnector')})"
         missing = [a for a in ("startConnector", "endConnector") if not connection.get(a)]
         if missing:
-            problems.append(f"{where}: {' and '.join(repr(a) for a in missing)} required")
+            verb = "is" if len(missing) == 1 else "are"
+            problems.append(f"{where}: {' and '.join(repr(a) for a in missing)} {verb} required")
             continue
         link = _link(connection, causality)
         if link is None:
