@@ -46,6 +46,7 @@ import lzma
 import os
 import shutil
 import stat
+import struct
 import tempfile
 import time
 import zipfile
@@ -206,18 +207,18 @@ def _end_record(handle: IO[bytes]) -> tuple[int, int] | None:
     millions of members is refused first. None if the record is unreadable
     (``zipfile`` then reports the archive as broken).
     """
+    # private to zipfile, but in every CPython since 2.x; without it zipfile's checks remain
     end_record = getattr(zipfile, "_EndRecData", None)
-    if end_record is None:  # pragma: no cover - present in every CPython since 2.x
+    entries, size = getattr(zipfile, "_ECD_ENTRIES_TOTAL", 4), getattr(zipfile, "_ECD_SIZE", 5)
+    if end_record is None:  # pragma: no cover
         return None
     try:
         record = end_record(handle)
-    except (OSError, ValueError, EOFError):
+        return (int(record[entries]), int(record[size])) if record else None
+    except (OSError, ValueError, EOFError, IndexError, TypeError, struct.error):
         return None
     finally:
         handle.seek(0)
-    if not record:
-        return None
-    return int(record[zipfile._ECD_ENTRIES_TOTAL]), int(record[zipfile._ECD_SIZE])
 
 
 def _open_zip(handle: IO[bytes], limits: ArchiveLimits, where: str) -> zipfile.ZipFile:
