@@ -224,12 +224,14 @@ def test_do_step_before_initialisation_is_refused():
 def test_configuration_error_is_logged_with_every_problem(caplog):
     facade = make(mass=-1.0, stiffness=-2.0)
     facade.setup_experiment(0.0)
-    with caplog.at_level(logging.ERROR), pytest.raises(ConfigurationError):
+    with caplog.at_level(logging.DEBUG), pytest.raises(ConfigurationError):
         facade.enter_initialization_mode()
     (message,) = log_entries(facade, Fmi2Status.error)
     assert "fmi2EnterInitializationMode" in message and "2 problems" in message
     assert "mass = -1.0 must be > 0" in message and "stiffness = -2.0 must be >= 0" in message
-    assert any("stiffness = -2.0" in r.getMessage() for r in caplog.records)
+    # mirrored to the Python logger at debug level only: the master says it once
+    mirrored = [r for r in caplog.records if "stiffness = -2.0" in r.getMessage()]
+    assert mirrored and all(r.levelno == logging.DEBUG for r in mirrored)
 
 
 def test_refused_step_is_logged_as_discard_before_returning_false():
@@ -240,18 +242,23 @@ def test_refused_step_is_logged_as_discard_before_returning_false():
     assert facade.unit.values["position"] == 0.1  # state at the start of the step
 
 
-def test_unexpected_exception_is_logged_with_its_traceback(monkeypatch):
+def test_unexpected_exception_is_one_error_line_and_a_debug_traceback(monkeypatch, caplog):
     facade = initialised(make())
 
     def broken(time, step):
         return 1 / 0
 
     monkeypatch.setattr(facade.unit, "advance", broken)
-    with pytest.raises(ZeroDivisionError):
+    with caplog.at_level("DEBUG", logger="wire_fmu.export.facade"), pytest.raises(
+        ZeroDivisionError
+    ):
         facade.do_step(0.0, 0.01)
-    (message,) = log_entries(facade, Fmi2Status.fatal)
-    assert "fmi2DoStep failed unexpectedly" in message
-    assert "Traceback" in message and "ZeroDivisionError" in message and "broken" in message
+    (message,) = log_entries(facade, Fmi2Status.error)
+    assert "fmi2DoStep failed unexpectedly: ZeroDivisionError" in message
+    assert "Traceback" not in message and "\n" not in message
+    assert not log_entries(facade, Fmi2Status.fatal)
+    debug = [r.getMessage() for r in caplog.records if r.levelname == "DEBUG"]
+    assert any("Traceback" in m and "broken" in m for m in debug)
 
 
 def test_feedthrough_output_follows_a_new_input_without_a_step():

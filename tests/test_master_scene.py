@@ -15,7 +15,7 @@ from fmi_test_tools import FACADES  # noqa: E402
 
 from wire_fmu.cli import main  # noqa: E402
 from wire_fmu.export.builder import build_fmu  # noqa: E402
-from wire_fmu.master.scene import SceneError, parse_scene  # noqa: E402
+from wire_fmu.master.scene import SceneError, parse_scene, read_scene_data  # noqa: E402
 from wire_fmu.master.validate import validate_scene  # noqa: E402
 
 
@@ -77,16 +77,16 @@ def broken_scene(fmus) -> dict:
 
 
 def test_structure_problems_are_all_listed_naming_unit_and_variable(fmus, tmp_path):
-    scene = parse_scene(broken_scene(fmus), base_dir=tmp_path)
-    with pytest.raises(SceneError) as info:
-        validate_scene(scene, through_fmi=False)
+    scene, found = read_scene_data(broken_scene(fmus), base_dir=tmp_path)
+    with pytest.raises(SceneError) as info:  # the data's problems and the structure's, at once
+        validate_scene(scene, through_fmi=False, problems=found)
     text = str(info.value)
     expected = [
         "input b.flange.velocity is fed twice",
         "input a.force is fed twice",  # by the bond and by the driver
         "a.velocity: is an output, expected an input",
         "unit 'a' has no variable 'nothing'",
-        "there is no unit 'ghost'",
+        "names no unit 'ghost'",
         "a.position has unit m but a flow of a translational bond is in m/s",
         "unit mismatch, m feeds m/s",
         "algebraic loop through direct feedthrough",

@@ -242,7 +242,7 @@ def test_refused_and_blown_up_configurations_are_recorded(tmp_path):
         f"monolithic / {own}"}
     refused = [r for r in study.rows if r.solver == bogus.label]
     assert len(refused) == 2
-    assert all(r.status == "stopped" and "no_such_solver" in r.message for r in refused)
+    assert all(r.status == "failed" and "no_such_solver" in r.message for r in refused)
     blown = [r for r in study.rows if r.solver == own and r.algorithm != "monolithic"]
     assert [r.status for r in blown] == ["diverged", "diverged"]
     assert all(r.error > 1.0 for r in blown)

@@ -18,6 +18,10 @@
 
 SCENE is a shipped scene's name or a path to a scene file; check, run and
 export also take an SSP package (.ssp).
+
+Exit status: 0 done (a run finished); 1 a problem (every one is listed), or a
+run that ended ``stopped`` or ``failed``; 130 interrupted by Ctrl-C. No command
+prints a traceback unless ``--verbose`` is given.
 """
 
 from __future__ import annotations
@@ -61,13 +65,14 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Validate a scene; exit 1 listing every problem."""
-    from wire_fmu.master.validate import validate_scene
+    """Validate a scene and initialise its units as a run would; exit 1 listing every problem."""
+    from wire_fmu.master.run import check_scene
 
-    scene = _load_any_scene(args.scene)
-    validate_scene(scene, args.fmu_dir)
-    _print(f"scene {scene.name!r}: no problems ({len(scene.units)} units, "
-           f"{len(scene.bonds)} bonds, {len(scene.connections)} connections)")
+    scene = check_scene(args.scene, args.fmu_dir)
+    _print(
+        f"scene {scene.name!r}: no problems ({len(scene.units)} units, "
+        f"{len(scene.bonds)} bonds, {len(scene.connections)} connections)"
+    )
     return 0
 
 
@@ -76,15 +81,24 @@ def cmd_run(args: argparse.Namespace) -> int:
     from wire_fmu.master.observers import summary_rows
     from wire_fmu.master.run import run_scene
 
-    outcome = run_scene(args.scene, args.output, progress=not args.quiet, fmu_dir=args.fmu_dir,
-                        stop_time=args.stop_time, step=args.step)
+    outcome = run_scene(
+        args.scene,
+        args.output,
+        progress=not args.quiet,
+        fmu_dir=args.fmu_dir,
+        stop_time=args.stop_time,
+        step=args.step,
+    )
     _print(f"\nscene {outcome.scene.name!r}")
     _print(_table(summary_rows(outcome.simulation, outcome.result)))
     _print(f"\nresults: {outcome.csv_path.resolve()}")
     _print(f"metadata: {(outcome.directory / 'metadata.json').resolve()}")
     for path in outcome.plots:
         _print(f"plot: {path.resolve()}")
-    return 0 if outcome.result.status == "finished" else 1
+    status = outcome.result.status
+    if status != "finished":
+        _print(f"\nrun {status}: {outcome.result.message}")
+    return EXIT_INTERRUPTED if status == "interrupted" else 0 if status == "finished" else 1
 
 
 def cmd_draw(args: argparse.Namespace) -> int:
@@ -136,16 +150,27 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     spec = load_sweep_spec(args.spec)
     out = args.output or Path("results") / "sweeps" / f"{scene.name}_{spec.name}"
     try:
-        result = run_sweep(scene, spec, out, workers=args.workers, scheduler=args.scheduler,
-                           fmu_dir=args.fmu_dir, progress=not args.quiet,
-                           rerun_failed=args.rerun_failed)
+        result = run_sweep(
+            scene,
+            spec,
+            out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            fmu_dir=args.fmu_dir,
+            progress=not args.quiet,
+            rerun_failed=args.rerun_failed,
+        )
     except KeyboardInterrupt:
-        _print(f"\ninterrupted; finished cases are kept in {Path(out).resolve()}: run the same "
-               "command again to run only the rest")
-        return 130
+        _print(
+            f"\ninterrupted; finished cases are kept in {Path(out).resolve()}: run the same "
+            "command again to run only the rest"
+        )
+        return EXIT_INTERRUPTED
     counts = ", ".join(f"{n} {status}" for status, n in sorted(result.counts.items()))
-    _print(f"\nsweep {spec.name!r} of scene {scene.name!r}: {len(result.rows)} cases ({counts}); "
-           f"{result.executed} run now, {result.reused} from earlier, {result.wall_time:.3g} s")
+    _print(
+        f"\nsweep {spec.name!r} of scene {scene.name!r}: {len(result.rows)} cases ({counts}); "
+        f"{result.executed} run now, {result.reused} from earlier, {result.wall_time:.3g} s"
+    )
     _print(f"summary: {result.summary_path.resolve()}")
     _print(f"time series: {(result.directory / 'cases').resolve()}/<case_id>/timeseries.csv")
     for path in result.plots:
@@ -169,8 +194,9 @@ def cmd_export(args: argparse.Namespace) -> int:
     if args.format == "ssp":
         path = export_ssp(scene, out, fmu_dir=args.fmu_dir)
     else:
-        path = export_osp(scene, out / f"{scene.name}_osp" if args.output is None else out,
-                          fmu_dir=args.fmu_dir)
+        path = export_osp(
+            scene, out / f"{scene.name}_osp" if args.output is None else out, fmu_dir=args.fmu_dir
+        )
     _print(f"exported scene {scene.name!r} as {args.format.upper()}: {path.resolve()}")
     return 0
 
@@ -181,13 +207,25 @@ def cmd_study(args: argparse.Namespace) -> int:
 
     out = args.output or Path("results") / Path(args.scene).stem / args.study
     if args.study == "accuracy":
-        study = accuracy.run_accuracy_study(args.scene, out, quick=args.quick, grid=args.grid,
-                                            fmu_dir=args.fmu_dir, repeats=args.repeats,
-                                            stop_time=args.stop_time)
+        study = accuracy.run_accuracy_study(
+            args.scene,
+            out,
+            quick=args.quick,
+            grid=args.grid,
+            fmu_dir=args.fmu_dir,
+            repeats=args.repeats,
+            stop_time=args.stop_time,
+        )
         _print(accuracy.summary_text(study))
     else:
-        study = effects.run_effects_study(args.scene, out, quick=args.quick, fmu_dir=args.fmu_dir,
-                                          repeats=args.repeats, stop_time=args.stop_time)
+        study = effects.run_effects_study(
+            args.scene,
+            out,
+            quick=args.quick,
+            fmu_dir=args.fmu_dir,
+            repeats=args.repeats,
+            stop_time=args.stop_time,
+        )
         _print(effects.summary_text(study))
     _print(f"\nstudy took {study.elapsed:.0f} s")
     for path in study.files.values():
@@ -198,23 +236,36 @@ def cmd_study(args: argparse.Namespace) -> int:
 def _study_parser(sub) -> None:
     p = sub.add_parser("study", help="what accuracy and effects cost in time")
     kinds = p.add_subparsers(dest="study", required=True)
-    for name, text in (("accuracy", "work-precision study over couplings, steps and solvers"),
-                       ("effects", "time saved and output change of leaving each effect out")):
+    for name, text in (
+        ("accuracy", "work-precision study over couplings, steps and solvers"),
+        ("effects", "time saved and output change of leaving each effect out"),
+    ):
         q = kinds.add_parser(name, help=text)
         q.add_argument("scene", help="a shipped scene's name or a scene file")
-        q.add_argument("-o", "--output", type=Path,
-                       help=f"output folder (default results/SCENE/{name})")
-        q.add_argument("--quick", action="store_true",
-                       help="a few configurations, short stop time (for CI)")
-        q.add_argument("--repeats", type=int, default=None,
-                       help="runs per configuration, the fastest counts")
-        q.add_argument("--stop-time", type=float, default=None,
-                       help="simulated seconds per run (default: [study] stop_time, else the "
-                            "scene's, at most 10 s; 1 s with --quick)")
+        q.add_argument(
+            "-o", "--output", type=Path, help=f"output folder (default results/SCENE/{name})"
+        )
+        q.add_argument(
+            "--quick", action="store_true", help="a few configurations, short stop time (for CI)"
+        )
+        q.add_argument(
+            "--repeats", type=int, default=None, help="runs per configuration, the fastest counts"
+        )
+        q.add_argument(
+            "--stop-time",
+            type=float,
+            default=None,
+            help="simulated seconds per run (default: [study] stop_time, else the "
+            "scene's, at most 10 s; 1 s with --quick)",
+        )
         if name == "accuracy":
-            q.add_argument("--grid", choices=("slices", "product"), default=None,
-                           help="slices (default): every coupling with the scene's solvers and "
-                                "every solver with the scene's coupling; product: all of them")
+            q.add_argument(
+                "--grid",
+                choices=("slices", "product"),
+                default=None,
+                help="slices (default): every coupling with the scene's solvers and "
+                "every solver with the scene's coupling; product: all of them",
+            )
         q.set_defaults(func=cmd_study)
 
 
@@ -223,13 +274,19 @@ def _parser() -> argparse.ArgumentParser:
 
     parser = argparse.ArgumentParser(prog="wire-fmu", description=__doc__.splitlines()[0])
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
-    parser.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR,
-                        help="where our FMUs are built and cached (default: %(default)s)")
+    parser.add_argument(
+        "--fmu-dir",
+        type=Path,
+        default=DEFAULT_FMU_DIR,
+        help="where our FMUs are built and cached (default: %(default)s)",
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("scenes", help="list the shipped scenes").set_defaults(func=cmd_scenes)
-    for name, func, text in (("check", cmd_check, "validate a scene"),
-                             ("run", cmd_run, "run a scene"),
-                             ("draw", cmd_draw, "draw a scene's reevings")):
+    for name, func, text in (
+        ("check", cmd_check, "validate a scene"),
+        ("run", cmd_run, "run a scene"),
+        ("draw", cmd_draw, "draw a scene's reevings"),
+    ):
         p = sub.add_parser(name, help=text)
         p.add_argument("scene", help="a shipped scene's name or a scene file")
         if name != "check":
@@ -242,24 +299,41 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("sweep", help="run a parameter sweep (Dask)")
     p.add_argument("scene", help="a shipped scene's name or a scene file")
     p.add_argument("spec", metavar="SWEEP_SPEC", type=Path, help="the sweep spec (TOML)")
-    p.add_argument("-o", "--output", type=Path,
-                   help="results folder; an existing one is resumed "
-                        "(default: results/sweeps/<scene>_<sweep>)")
-    p.add_argument("--workers", type=int, default=2,
-                   help="worker processes of the local cluster; 0 runs serially in this "
-                        "process (default: %(default)s)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="use an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    p.add_argument("--rerun-failed", action="store_true",
-                   help="also run again cases recorded as failed or stopped")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        help="results folder; an existing one is resumed (default: results/sweeps/<scene>_<sweep>)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="worker processes of the local cluster; 0 runs serially in this "
+        "process (default: %(default)s)",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="use an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
+    )
+    p.add_argument(
+        "--rerun-failed",
+        action="store_true",
+        help="also run again cases recorded as failed or stopped",
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=cmd_sweep)
     p = sub.add_parser("export", help="export a scene as SSP 1.0 or OSP (docs/interop.md)")
     p.add_argument("scene", help="a shipped scene's name, a scene file or an .ssp package")
     p.add_argument("--format", choices=("ssp", "osp"), required=True, help="what to write")
-    p.add_argument("-o", "--output", type=Path,
-                   help="ssp: a .ssp file or a folder for <scene>.ssp; osp: the configuration "
-                        "folder (default: results/export/)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        help="ssp: a .ssp file or a folder for <scene>.ssp; osp: the configuration "
+        "folder (default: results/export/)",
+    )
     p.set_defaults(func=cmd_export)
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")
@@ -268,15 +342,31 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+EXIT_INTERRUPTED = 130
+"""Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``wire-fmu`` command."""
     args = _parser().parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
-                        format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(
+        level=logging.DEBUG if args.verbose else logging.WARNING,
+        format="%(levelname)s %(name)s: %(message)s",
+    )
     try:
         return args.func(args)
     except WireFmuError as err:
         _print(f"error: {err}")
+        return 1
+    except KeyboardInterrupt:
+        _print("\ninterrupted")
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - a command ends with a message, never a traceback
+        logger.debug("unexpected failure", exc_info=True)
+        _print(
+            f"error: unexpected {type(exc).__name__}: {exc}"
+            + ("" if args.verbose else " (run with --verbose for the traceback)")
+        )
         return 1
 
 

@@ -133,7 +133,29 @@ def fastest_mode(system: HybridSystem, t: float, x: np.ndarray) -> float:
 
 
 _MAX_EVENTS_PER_STEP = 10_000
+MAX_INTERNAL_STEPS = 100_000
+"""Most internal steps one communication step may need; a longer one is refused
+at once (its message says how long a step may be) rather than run for hours."""
 _MAX_LOCATE_ITERATIONS = 60
+
+
+def internal_steps(t0: float, t1: float, max_step: float) -> float:
+    """How many steps of at most ``max_step`` (s) span ``[t0, t1]`` (s).
+
+    Raises
+    ------
+    IntegrationError
+        When that is more than :data:`MAX_INTERNAL_STEPS`, naming the longest
+        communication step the unit takes.
+    """
+    count = (t1 - t0) / max_step
+    if not count <= MAX_INTERNAL_STEPS:
+        raise IntegrationError(
+            f"a step of {t1 - t0:.6g} s needs {count:.3g} internal steps of at most "
+            f"{max_step:.3g} s, more than the {MAX_INTERNAL_STEPS} one step may take; "
+            f"take communication steps of at most {MAX_INTERNAL_STEPS * max_step:.6g} s"
+        )
+    return count
 
 
 def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -162,8 +184,7 @@ class _FixedStepSolver:
         self, system: HybridSystem, t0: float, x0: np.ndarray, t1: float
     ) -> tuple[np.ndarray, int]:
         """Integrate from ``t0`` to ``t1``; return the state and the number of events."""
-        n = max(1, math.ceil((t1 - t0) / self.settings.max_step - 1e-9))
-        (t1 - t0) / n
+        n = max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
         t, x = t0, np.array(x0, dtype=float)
         events = 0
         self._on_new_interval(system, t, x)
@@ -173,9 +194,7 @@ class _FixedStepSolver:
         g0 = system.guards(t, x)
         while k < n:
             t_next = grid[k + 1]
-            x_next, g1, fired_at = self._step_with_events(
-                system, t, x, t_next - t, directions, g0
-            )
+            x_next, g1, fired_at = self._step_with_events(system, t, x, t_next - t, directions, g0)
             if fired_at is None:
                 t, x, g0 = t_next, x_next, g1
                 k += 1
@@ -342,6 +361,7 @@ class ScipySolver:
         self.steps = 0
 
     def advance(self, system, t0, x0, t1):
+        internal_steps(t0, t1, self.settings.max_step)
         tol = self.settings.event_time_tolerance
         t, x = t0, np.array(x0, dtype=float)
         events = 0

@@ -14,8 +14,8 @@ Modules
     The core-version guard run at instantiation.
 ``state``
     JSON deep copies for FMU states.
-``pythonfmu_compat``
-    Work-arounds for reference-counting bugs in pythonfmu 0.7.0's binary.
+``binary``
+    Compiles the FMU binary (``native/fmi2_python.c``) that forwards FMI calls to the facade.
 
 This package runs inside FMUs, so nothing here imports fmpy, and this
 ``__init__`` imports nothing (the builder pulls in pythonfmu's build tools,

@@ -15,16 +15,18 @@ import hashlib
 import importlib.util
 import inspect
 import logging
+import os
 import re
 import shutil
 import sys
 import tempfile
 import zipfile
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from xml.etree import ElementTree
 
 import pythonfmu
 from pythonfmu import FmuBuilder
@@ -33,6 +35,7 @@ import wire_fmu
 from wire_fmu._fingerprint import bundled_files, fingerprint, package_dir
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.interface import Unit
+from wire_fmu.export.binary import compiled_binary, platform_folder
 from wire_fmu.export.facade import CoreFacade
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo, imported_core
 from wire_fmu.export.model_description import check_units, patch_model_description
@@ -43,15 +46,8 @@ logger = logging.getLogger(__name__)
 
 MODEL_DESCRIPTION = "modelDescription.xml"
 
-_FOOTER = """
-
-# --- appended by wire_fmu.export.builder -------------------------------------
-# Balances the reference pythonfmu 0.7.0's findClass takes from this module's
-# globals on every instantiation (see wire_fmu.export.pythonfmu_compat).
-from wire_fmu.export.pythonfmu_compat import hold_module_globals as _wire_fmu_hold
-
-_wire_fmu_hold(globals())
-"""
+FACADE_FILE = "resources/wire_fmu_facade.txt"
+"""What the FMU binary instantiates: module, class and GUID, one per line."""
 
 
 class BuildError(ConfigurationError):
@@ -164,7 +160,7 @@ def _stage(script: Path, folder: Path, extra_modules: Sequence[Path]) -> _Stagin
     core_print = _bundle_core(core)
     staged = folder / "script" / f"{unique_module_name(script, core_print)}.py"
     staged.parent.mkdir()
-    staged.write_text(script.read_text(encoding="utf-8") + _FOOTER, encoding="utf-8")
+    shutil.copy2(script, staged)
     extras = tuple(staged.parent / extra.name for extra in extra_modules)
     for source, target in zip(extra_modules, extras, strict=True):
         shutil.copy2(source, target)
@@ -183,21 +179,44 @@ def _write_build_info(staging: _Staging, facade: type[CoreFacade]) -> Path:
     return path
 
 
-def _rewrite_zip_entry(archive: Path, name: str, data: bytes) -> None:
+def _rewrite_zip(archive: Path, drop: Callable[[str], bool], add: dict[str, bytes]) -> None:
+    """Rewrite ``archive`` without the entries ``drop`` selects, with ``add`` added."""
     rewritten = archive.with_suffix(".tmp")
     with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
         for item in src.infolist():
-            if item.filename != name:
+            if not drop(item.filename) and item.filename not in add:
                 dst.writestr(item, src.read(item.filename), zipfile.ZIP_DEFLATED)
-        dst.writestr(name, data, zipfile.ZIP_DEFLATED)
+        for name, data in add.items():
+            dst.writestr(name, data, zipfile.ZIP_DEFLATED)
     rewritten.replace(archive)
 
 
-def _finish(fmu: Path, unit_class: type[Unit]) -> None:
+def _finish(fmu: Path, facade: type[CoreFacade], module: str) -> None:
+    """Our model description, our binary in place of pythonfmu's, the facade file."""
     with zipfile.ZipFile(fmu) as archive:
         xml = archive.read(MODEL_DESCRIPTION)
-    tool = f"wire_fmu {wire_fmu.__version__} (PythonFMU {pythonfmu.__version__})"
-    _rewrite_zip_entry(fmu, MODEL_DESCRIPTION, patch_model_description(xml, unit_class, tool))
+    tool = f"wire_fmu {wire_fmu.__version__} (PythonFMU {pythonfmu.__version__} exporter)"
+    patched = patch_model_description(xml, facade.unit_class, tool)
+    root = ElementTree.fromstring(patched)
+    identifier = root.find("CoSimulation").get("modelIdentifier")
+    folder, suffix = platform_folder()
+    binary = compiled_binary(native_cache()).read_bytes()
+    facade_file = f"{module}\n{facade.__name__}\n{root.get('guid')}\n"
+    _rewrite_zip(
+        fmu,
+        drop=lambda name: name.startswith("binaries/") or name == "resources/slavemodule.txt",
+        add={
+            MODEL_DESCRIPTION: patched,
+            f"binaries/{folder}/{identifier}{suffix}": binary,
+            FACADE_FILE: facade_file.encode(),
+        },
+    )
+
+
+def native_cache() -> Path:
+    """Where compiled FMU binaries are kept (``$XDG_CACHE_HOME/wire_fmu/native``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "wire_fmu" / "native"
 
 
 def _check_sources_unchanged(script: Path, staging: _Staging) -> None:
@@ -269,6 +288,6 @@ def build_fmu(facade_script: Path, out_dir: Path, *, extra_modules: Iterable[Pat
             sys.modules.pop(staging.script.stem, None)
             while module_dir in sys.path:  # pythonfmu inserts it for good
                 sys.path.remove(module_dir)
-    _finish(Path(fmu), facade.unit_class)
+    _finish(Path(fmu), facade, staging.script.stem)
     logger.debug("built %s from %s (module %s)", fmu, script, staging.script.stem)
     return Path(fmu)

@@ -22,21 +22,23 @@ What the facade does at each FMI call
     Rebuilds the unit if a parameter was set in initialisation mode, then
     ``unit.initialize(start_time)``.
 ``fmi2DoStep``
-    ``unit.advance(t, h)``; a refused step is logged (status Discard, with the
-    unit's message) before returning ``False`` (pythonfmu: ``fmi2Discard``).
+    Refuses a step that is not finite and positive or does not start at the
+    unit's time; then ``unit.advance(t, h)``. A step the unit refuses is
+    logged (status Discard, with the unit's message) and returns ``False``
+    (the binary answers ``fmi2Discard``; the state is that before the step).
 ``fmi2Get/SetFMUstate``
     The unit's full ``get_state()`` plus every variable value, as JSON data.
 
 Errors
 ------
-pythonfmu turns any exception into ``fmi2Fatal`` and reports only
-"unknown error" or the exception's repr, and only if the master switched
-logging on. So every entry point logs first: a deliberate
-:class:`~wire_fmu.core.errors.WireFmuError` with its message (status Error),
-anything else with its full traceback (status Fatal), then re-raises. Every
-message of status Warning or worse is also sent to the Python logger
-``wire_fmu.export.facade``, which reaches the master's process when
-pythonfmu drops the FMI message (``loggingOn`` false).
+The FMU binary (``wire_fmu/export/native/fmi2_python.c``) answers any
+exception with ``fmi2Error`` and keeps the instance alive, so a master can
+restore a saved state or free it. Every entry point logs why first, once:
+a deliberate :class:`~wire_fmu.core.errors.WireFmuError` with its message,
+anything else as its type and message (the traceback goes to the Python
+logger at debug level), both with status Error, then re-raises. Every
+message is also sent to the Python logger ``wire_fmu.export.facade`` at
+debug level (the master says the FMI message itself, once).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ import copy
 import functools
 import json
 import logging
+import math
 import traceback
 from collections.abc import Callable, Mapping
 from enum import StrEnum
@@ -57,7 +60,6 @@ import wire_fmu
 from wire_fmu.core.errors import WireFmuError
 from wire_fmu.core.interface import Causality, Unit, Variability, Variable
 from wire_fmu.export.guard import check_core
-from wire_fmu.export.pythonfmu_compat import pin_for_fatal
 from wire_fmu.export.state import json_copy
 
 __all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
@@ -65,6 +67,8 @@ __all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
 logger = logging.getLogger(__name__)
 
 STATE_FORMAT = "wire_fmu.fmu_state/1"
+STEP_TIME_TOLERANCE = 1e-9
+"""Relative tolerance (of max(1 s, t)) between a step's start and the unit's time."""
 """Tag of the FMU state layout written by :meth:`CoreFacade._get_fmu_state`."""
 
 _SCALAR = {float: Real, int: Integer, bool: Boolean, str: String}
@@ -78,13 +82,6 @@ _INITIAL = {
     Causality.parameter: Fmi2Initial.exact,
     Causality.input: None,  # FMI 2.0 forbids `initial` on inputs
     Causality.output: Fmi2Initial.calculated,
-}
-_PY_LEVEL = {
-    Fmi2Status.ok: logging.DEBUG,
-    Fmi2Status.warning: logging.WARNING,
-    Fmi2Status.discard: logging.WARNING,
-    Fmi2Status.error: logging.ERROR,
-    Fmi2Status.fatal: logging.CRITICAL,
 }
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -119,12 +116,12 @@ def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
                 return method(self, *args, **kwargs)
             except WireFmuError as exc:
                 self._report(f"{fmi_name} failed: {exc}", Fmi2Status.error)
-                pin_for_fatal(self)
                 raise
-            except Exception:
-                detail = traceback.format_exc()
-                self._report(f"{fmi_name} failed unexpectedly:\n{detail}", Fmi2Status.fatal)
-                pin_for_fatal(self)
+            except Exception as exc:
+                logger.debug("%s: %s", fmi_name, traceback.format_exc())
+                self._report(
+                    f"{fmi_name} failed unexpectedly: {type(exc).__name__}: {exc}", Fmi2Status.error
+                )
                 raise
 
         return guarded  # type: ignore[return-value]
@@ -163,6 +160,7 @@ class CoreFacade(Fmi2Slave):
         self.unit: Unit = unit_class(instance_name=self.instance_name)
         self._phase = Phase.instantiated
         self._start_time = 0.0
+        self._time = 0.0
         self._reconfigure = False
         self._inputs_changed = False
         self._initial_outputs_stale = True
@@ -215,10 +213,11 @@ class CoreFacade(Fmi2Slave):
 
     # -- messages -----------------------------------------------------------
     def _report(self, message: str, status: Fmi2Status) -> None:
-        """Log to the FMI logger and mirror to the Python logger."""
+        """Log to the FMI logger (the binary hands Warning and worse to every host) and
+        mirror to the Python logger at debug level."""
         text = f"{self.who}: {message}"
         self.log(text, status)
-        logger.log(_PY_LEVEL[status], "%s", text)
+        logger.debug("%s [%s]", text, status.name)
 
     def _require(self, fmi_name: str, *phases: Phase) -> None:
         if self._phase not in phases:
@@ -257,6 +256,10 @@ class CoreFacade(Fmi2Slave):
             raise FacadeError(
                 f"fixed parameter {var.name!r} can only be set before fmi2ExitInitializationMode"
             )
+        if var.type is float and (value != value or (var.causality is Causality.input
+                                                     and not math.isfinite(value))):
+            # a parameter may be infinite (no limit); NaN never, an input never infinite
+            raise FacadeError(f"{var.causality.value} {var.name!r} = {value!r}: must be finite")
         self.unit.values[var.name] = var.type(value)
         self._initial_outputs_stale = True
         if var.causality is Causality.input:
@@ -318,6 +321,7 @@ class CoreFacade(Fmi2Slave):
         """Initialise the unit at the start time."""
         self._require("fmi2ExitInitializationMode", Phase.initialization)
         self._initialize_unit()
+        self._time = self._start_time
         self._phase = Phase.step
         self._inputs_changed = False
 
@@ -325,6 +329,7 @@ class CoreFacade(Fmi2Slave):
     def do_step(self, current_time: float, step_size: float) -> bool:
         """Advance the unit; log and return ``False`` if it refuses the step."""
         self._require("fmi2DoStep", Phase.step)
+        self._check_step(current_time, step_size)
         result = self.unit.advance(current_time, step_size)
         for event in result.events:
             self._report(f"t = {current_time + step_size!r} s: {event}", Fmi2Status.ok)
@@ -335,7 +340,19 @@ class CoreFacade(Fmi2Slave):
             )
             return False
         self._inputs_changed = False
+        self._time = current_time + step_size
         return True
+
+    def _check_step(self, current_time: float, step_size: float) -> None:
+        if not (math.isfinite(step_size) and step_size > 0.0):
+            raise FacadeError(f"communication step {step_size!r} s: must be finite and positive")
+        if not math.isfinite(current_time) or abs(
+            current_time - self._time
+        ) > STEP_TIME_TOLERANCE * max(1.0, abs(self._time)):
+            raise FacadeError(
+                f"communication point {current_time!r} s: the unit is at t = {self._time!r} s "
+                "(a step starts where the last one ended, or at a restored state's time)"
+            )
 
     @fmi_entry("fmi2Terminate")
     def terminate(self) -> None:
@@ -358,6 +375,7 @@ class CoreFacade(Fmi2Slave):
             "unit": self.unit.NAME,
             "phase": self._phase.value,
             "start_time": self._start_time,
+            "time": self._time,
             "reconfigure": self._reconfigure,
             "inputs_changed": self._inputs_changed,
             "values": self.unit.values,
@@ -389,6 +407,7 @@ class CoreFacade(Fmi2Slave):
             self.unit.values.update(values)  # exactly the saved outputs
         self._phase = phase
         self._start_time = float(state["start_time"])
+        self._time = float(state.get("time", self._start_time))
         self._reconfigure = bool(state["reconfigure"])
         self._inputs_changed = bool(state["inputs_changed"])
 

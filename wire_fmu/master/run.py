@@ -15,12 +15,21 @@ from pathlib import Path
 
 from .catalog import DEFAULT_FMU_DIR
 from .observers import CsvRecorder, Progress
-from .scene import Scene, SceneError, load_scene
+from .scene import Scene, SceneError, read_scene
 from .simulation import RunResult, Simulation
 from .validate import validate_scene
 
-__all__ = ["SCENE_DIR", "shipped_scenes", "find_scene", "run_scene", "with_run_settings",
-           "Outcome", "load_scene_file"]
+__all__ = [
+    "SCENE_DIR",
+    "shipped_scenes",
+    "find_scene",
+    "run_scene",
+    "with_run_settings",
+    "Outcome",
+    "load_scene_file",
+    "read_scene_file",
+    "check_scene",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -48,17 +57,54 @@ def find_scene(name_or_path: str | Path) -> Path:
     shipped = shipped_scenes()
     if str(name_or_path) in shipped:
         return shipped[str(name_or_path)]
-    raise SceneError(str(name_or_path), [
-        f"not a shipped scene nor a file; shipped scenes: {', '.join(shipped) or 'none'}"])
+    raise SceneError(
+        str(name_or_path),
+        [f"not a shipped scene nor a file; shipped scenes: {', '.join(shipped) or 'none'}"],
+    )
 
 
 def load_scene_file(path: Path) -> Scene:
     """A scene file (TOML) or an SSP package (``.ssp``, see :mod:`wire_fmu.interop.ssp_read`)."""
+    scene, problems = read_scene_file(path)
+    if problems:
+        raise SceneError(f"scene {scene.name!r}" if scene else str(path), problems)
+    return scene
+
+
+def read_scene_file(path: Path) -> tuple[Scene | None, list[str]]:
+    """A scene file or an SSP package and its problems (see :func:`~.scene.read_scene`)."""
     if Path(path).suffix.lower() == ".ssp":
         from wire_fmu.interop.ssp_read import read_ssp
 
-        return read_ssp(Path(path))
-    return load_scene(path)
+        try:
+            return read_ssp(Path(path)), []
+        except SceneError as err:
+            return None, [f"{err.where}: {p}" for p in err.problems]
+    return read_scene(path)
+
+
+def check_scene(
+    scene: str | Path | Scene, fmu_dir: Path = DEFAULT_FMU_DIR, *, dry_run: bool = True
+) -> Scene:
+    """Every problem a run would refuse, found before anything steps.
+
+    The scene's data, its structure against the units' model descriptions,
+    each unit's own check of its parameters and (``dry_run``) the
+    initialisation of every unit as a run does it.
+
+    Raises
+    ------
+    SceneError
+        Listing every problem, each once.
+    """
+    problems: list[str] = []
+    if not isinstance(scene, Scene):
+        path = find_scene(scene)
+        scene, problems = read_scene_file(path)
+        if scene is None:
+            raise SceneError(str(path), problems)
+    validate_scene(scene, fmu_dir, dry_run=dry_run, problems=problems)
+    return scene
 
 
 @dataclass
@@ -126,7 +172,20 @@ def run_scene(
     result = sim.run()
     outcome = Outcome(scene, result, directory, recorder.csv_path, simulation=sim)
     if plots and scene.plots:
-        from .plots import plot_scene
-
-        outcome.plots = plot_scene(scene, recorder.csv_path, directory)
+        outcome.plots = _plots(scene, recorder.csv_path, directory)
     return outcome
+
+
+def _plots(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
+    """The scene's plots of what was recorded; none (with a warning) if nothing was."""
+    if not csv_path.is_file():
+        logger.warning("no plots: nothing was recorded (the run ended before its first step)")
+        return []
+    from .plots import plot_scene
+
+    try:
+        return plot_scene(scene, csv_path, directory)
+    except Exception as exc:  # noqa: BLE001 - the run's results stand without their plots
+        logger.warning("the plots could not be drawn: %s", exc)
+        logger.debug("plot failure", exc_info=True)
+        return []

@@ -24,6 +24,7 @@ Format::
                               # the energy it carried (inf: off); see energy_guard.py
     min_step = 1e-4
     max_step = 0.05
+    max_steps = 10000000      # a run of more macro steps is refused (adaptive: stop / min_step)
 
     [units.rope]
     fmu = "BlockTrain"        # one of ours by name, or a path to any FMI 2.0 CS FMU
@@ -73,9 +74,10 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -96,6 +98,8 @@ __all__ = [
     "SceneError",
     "load_scene",
     "parse_scene",
+    "read_scene",
+    "read_scene_data",
     "ALGORITHMS",
     "EXTRAPOLATIONS",
     "BOND_KINDS",
@@ -242,6 +246,7 @@ class RunSettings:
     min_step: float = 1e-5
     max_step: float | None = None
     order: tuple[str, ...] = ()
+    max_steps: int = 10_000_000
 
 
 @dataclass(frozen=True)
@@ -268,8 +273,19 @@ class Scene:
         return self.connections + tuple(c for b in self.bonds for c in b.connections)
 
 
-_TOP_KEYS = {"name", "description", "run", "units", "bonds", "connections", "drivers",
-             "events", "outputs", "plots", "study"}
+_TOP_KEYS = {
+    "name",
+    "description",
+    "run",
+    "units",
+    "bonds",
+    "connections",
+    "drivers",
+    "events",
+    "outputs",
+    "plots",
+    "study",
+}
 _RUN_KEYS = set(RunSettings.__dataclass_fields__)
 
 
@@ -281,25 +297,57 @@ def load_scene(path: Path) -> Scene:
     SceneError
         Listing every problem found.
     """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as err:
-        raise SceneError(str(path), [f"cannot read the scene file: {err}"]) from None
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(str(path), [f"not valid TOML: {err}"]) from None
-    return parse_scene(data, base_dir=path.parent, source=path)
+    scene, problems = read_scene(path)
+    if problems:
+        raise SceneError(f"scene {scene.name!r}" if scene else str(path), problems)
+    return scene
 
 
 def parse_scene(data: Mapping[str, Any], *, base_dir: Path, source: Path | None = None) -> Scene:
     """Build a :class:`Scene` from plain data; raise :class:`SceneError` with every problem."""
+    scene, problems = read_scene_data(data, base_dir=base_dir, source=source)
+    if problems:
+        raise SceneError(f"scene {scene.name!r}", problems)
+    return scene
+
+
+def read_scene(path: Path) -> tuple[Scene | None, list[str]]:
+    """Read a scene file; return it (None if unreadable) and every problem of its data.
+
+    The scene returned with problems has each invalid item left out or at its
+    default, so that the checks that need the units can still run and report
+    their problems in the same list (``wire-fmu check``).
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as err:
+        return None, [f"cannot read the scene file: {err}"]
+    except tomllib.TOMLDecodeError as err:
+        return None, [f"not valid TOML: {err}"]
+    except RecursionError:
+        return None, ["nested too deeply to be a scene"]
+    return read_scene_data(data, base_dir=path.parent, source=path)
+
+
+def read_scene_data(
+    data: Mapping[str, Any], *, base_dir: Path, source: Path | None = None
+) -> tuple[Scene, list[str]]:
+    """Build a :class:`Scene` from plain data and list every problem (see :func:`read_scene`)."""
     problems: list[str] = []
+    if not isinstance(data, Mapping):
+        data = {}
+        problems.append("a scene must be a table of keys")
     for key in data:
         if key not in _TOP_KEYS:
             problems.append(f"unknown top-level key {key!r}; known: {', '.join(sorted(_TOP_KEYS))}")
-    name = str(data.get("name", source.stem if source else "scene"))
+    name = _scene_name(data.get("name", source.stem if source else "scene"), problems)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        problems.append(f"'description' must be text, got {type(description).__name__}")
+        description = ""
     units = _parse_units(data.get("units", {}), problems)
-    bonds = _parse_bonds(data.get("bonds", []), problems)
+    bonds = _parse_bonds(data.get("bonds", []), problems, set(units))
     connections = _parse_connections(data.get("connections", []), problems)
     drivers = _parse_drivers(data.get("drivers", []), problems)
     events = _parse_events(data.get("events", []), problems)
@@ -310,10 +358,63 @@ def parse_scene(data: Mapping[str, Any], *, base_dir: Path, source: Path | None 
     if not isinstance(study, Mapping):
         problems.append("[study] must be a table (see wire_fmu.study.accuracy)")
         study = {}
-    if problems:
-        raise SceneError(f"scene {name!r}", problems)
-    return Scene(name, str(data.get("description", "")), units, bonds, connections, drivers,
-                 events, outputs, plots, run, Path(base_dir), source, study=dict(study))
+    scene = Scene(
+        name,
+        description,
+        units,
+        bonds,
+        connections,
+        drivers,
+        events,
+        outputs,
+        plots,
+        run,
+        Path(base_dir),
+        source,
+        study=dict(study),
+    )
+    problems += _unknown_unit_problems(scene)
+    return scene, problems
+
+
+_SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,127}")
+
+
+def _scene_name(name: Any, problems: list[str]) -> str:
+    """The scene's name; it names the results folder, so it must be a plain file name."""
+    if isinstance(name, str) and _SAFE_NAME.fullmatch(name) and ".." not in name:
+        return name
+    problems.append(
+        f"'name' {name!r}: must be a plain file name (letters, digits, '_', '-', "
+        "'.', at most 128 characters, no '..'), since it names the results folder"
+    )
+    return "scene"
+
+
+def _unknown_unit_problems(scene: Scene) -> list[str]:
+    """Every reference to a unit the scene does not have, naming where it is."""
+    units = set(scene.units)
+    known = ", ".join(sorted(units)) or "none"
+    refs: list[tuple[str, VarRef]] = []
+    for bond in scene.bonds:
+        refs += [
+            (f"bond {bond.name!r} {c.role}", r)
+            for c in bond.connections
+            for r in (c.source, c.target)
+        ]
+    for i, c in enumerate(scene.connections):
+        refs += [(f"connection {i}", c.source), (f"connection {i}", c.target)]
+    for i, d in enumerate(scene.drivers):
+        refs += [(f"driver {i}", r) for r in (d.target, d.rate_target) if r is not None]
+    for e in scene.events:
+        refs += [(f"event {e.label!r}", r) for r in e.values]
+    refs += [("outputs", r) for r in scene.outputs or ()]
+    refs += [(f"plot {p.title!r}", r) for p in scene.plots for r in p.variables]
+    return [
+        f"{where}: {ref} names no unit {ref.unit!r}; the scene's units: {known}"
+        for where, ref in refs
+        if ref.unit not in units
+    ]
 
 
 def _as_list(value: Any, where: str, problems: list[str]) -> list:
@@ -337,8 +438,9 @@ def _parse_units(data: Any, problems: list[str]) -> dict[str, UnitSpec]:
             continue
         unknown = set(spec) - {"fmu", "effects", "parameters"}
         if unknown:
-            problems.append(f"{where}: unknown keys {sorted(unknown)}; known: fmu, effects, "
-                            "parameters")
+            problems.append(
+                f"{where}: unknown keys {sorted(unknown)}; known: fmu, effects, parameters"
+            )
         fmu = spec.get("fmu")
         if not isinstance(fmu, str) or not fmu:
             problems.append(f"{where}: 'fmu' must name one of our FMUs or give a path to one")
@@ -369,7 +471,7 @@ def _parse_link(text: Any, where: str, problems: list[str]) -> tuple[VarRef, Var
     return source, target
 
 
-def _parse_bonds(data: Any, problems: list[str]) -> tuple[Bond, ...]:
+def _parse_bonds(data: Any, problems: list[str], units: set[str]) -> tuple[Bond, ...]:
     bonds = []
     names: set[str] = set()
     for i, spec in enumerate(_as_list(data, "bonds", problems)):
@@ -401,10 +503,14 @@ def _parse_bonds(data: Any, problems: list[str]) -> tuple[Bond, ...]:
             problems.append(f"{where}: unknown keys {sorted(unknown)}")
         if "effort" in links and "flow" in links:
             e, f = links["effort"], links["flow"]
-            if e.source.unit != f.target.unit or e.target.unit != f.source.unit:
-                problems.append(f"{where}: the effort must go from the unit the flow goes to "
-                                f"(effort {e.source.unit} -> {e.target.unit}, flow "
-                                f"{f.source.unit} -> {f.target.unit})")
+            named = {e.source.unit, e.target.unit, f.source.unit, f.target.unit}
+            crossed = e.source.unit != f.target.unit or e.target.unit != f.source.unit
+            if named <= units and crossed:
+                problems.append(
+                    f"{where}: the effort must go from the unit the flow goes to "
+                    f"(effort {e.source.unit} -> {e.target.unit}, flow "
+                    f"{f.source.unit} -> {f.target.unit})"
+                )
             bonds.append(Bond(name, str(kind), e, f, links.get("position")))
     return tuple(bonds)
 
@@ -454,7 +560,7 @@ def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
             problems.append(f"{where}: must be a table")
             continue
         time = spec.get("time")
-        if not isinstance(time, int | float) or not math.isfinite(time) or time < 0:
+        if not _finite(time) or time < 0:
             problems.append(f"{where}: 'time' must be a number of seconds >= 0, got {time!r}")
             continue
         values = {}
@@ -466,6 +572,10 @@ def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
             ref = VarRef.parse(key)
             if ref is None:
                 problems.append(f"{where}: {key!r} is not 'unit.input'")
+            elif not _scalar(value):
+                problems.append(
+                    f"{where}: {key} = {value!r}: must be a finite number, true/false or text"
+                )
             else:
                 values[ref] = value
         out.append(EventSpec(float(time), values, str(spec.get("label", f"event {i}"))))
@@ -502,8 +612,9 @@ def _parse_plots(data: Any, problems: list[str]) -> tuple[PlotSpec, ...]:
         if any(r is None for r in refs):
             problems.append(f"plot {i}: every variable must be 'unit.variable'")
             continue
-        out.append(PlotSpec(str(spec.get("title", f"plot {i}")), tuple(refs),
-                            str(spec.get("ylabel", ""))))
+        out.append(
+            PlotSpec(str(spec.get("title", f"plot {i}")), tuple(refs), str(spec.get("ylabel", "")))
+        )
     return tuple(out)
 
 
@@ -514,15 +625,43 @@ def _parse_run(data: Any, problems: list[str]) -> RunSettings:
     unknown = set(data) - _RUN_KEYS
     if unknown:
         problems.append(f"run: unknown keys {sorted(unknown)}; known: {sorted(_RUN_KEYS)}")
-    settings = RunSettings(**{k: (tuple(v) if k == "order" else v)
-                              for k, v in data.items() if k in _RUN_KEYS})
-    _check_run(settings, problems)
+    given = {k: v for k, v in data.items() if k in _RUN_KEYS}
+    if "order" in given:
+        order = given["order"]
+        given["order"] = tuple(order) if isinstance(order, list) else order
+    settings = RunSettings(**given)
+    mine: list[str] = []
+    _check_run(settings, mine)
+    problems += mine
+    if mine:  # go on with the defaults of the settings that are wrong
+        defaults = RunSettings()
+        valid = {}
+        for key, value in given.items():
+            trial: list[str] = []
+            _check_run(replace(defaults, **{key: value}), trial)
+            if not trial:
+                valid[key] = value
+        settings = replace(defaults, **valid)
     return settings
 
 
+def _scalar(value: Any) -> bool:
+    """A finite number, a boolean or text: what one FMI variable can hold."""
+    return isinstance(value, bool | str) or _finite(value)
+
+
+def _finite(value: Any) -> bool:
+    """A finite number (not a boolean); an integer too large for a float is not."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
 def _positive(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(
-        value) and value > 0
+    return _finite(value) and value > 0
 
 
 def _check_run(s: RunSettings, problems: list[str]) -> None:
@@ -530,8 +669,10 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
         if not _positive(getattr(s, key)):
             problems.append(f"run.{key} must be a positive number, got {getattr(s, key)!r}")
     if not (_positive(s.energy_guard) or s.energy_guard == math.inf):
-        problems.append(f"run.energy_guard must be a positive number (inf turns the guard "
-                        f"off), got {s.energy_guard!r}")
+        problems.append(
+            f"run.energy_guard must be a positive number (inf turns the guard "
+            f"off), got {s.energy_guard!r}"
+        )
     for key in ("output_interval", "max_step"):
         value = getattr(s, key)
         if value is not None and not _positive(value):
@@ -539,9 +680,34 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
     if s.algorithm not in ALGORITHMS:
         problems.append(f"run.algorithm must be one of {ALGORITHMS}, got {s.algorithm!r}")
     if s.extrapolation not in EXTRAPOLATIONS:
-        problems.append(f"run.extrapolation must be one of {EXTRAPOLATIONS}, "
-                        f"got {s.extrapolation!r}")
+        problems.append(
+            f"run.extrapolation must be one of {EXTRAPOLATIONS}, got {s.extrapolation!r}"
+        )
     if not isinstance(s.iterations, int) or isinstance(s.iterations, bool) or s.iterations < 1:
         problems.append(f"run.iterations must be an integer >= 1, got {s.iterations!r}")
     if not isinstance(s.adaptive, bool):
         problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")
+    if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):
+        problems.append(f"run.order must be a list of unit names, got {s.order!r}")
+    if not isinstance(s.max_steps, int) or isinstance(s.max_steps, bool) or s.max_steps < 1:
+        problems.append(f"run.max_steps must be an integer >= 1, got {s.max_steps!r}")
+    elif _positive(s.stop_time) and _positive(s.step):
+        _check_step_count(s, problems)
+    if _positive(s.min_step) and s.max_step is not None and _positive(s.max_step):
+        if s.min_step > s.max_step:
+            problems.append(
+                f"run.min_step {s.min_step!r} s is larger than run.max_step {s.max_step!r} s"
+            )
+
+
+def _check_step_count(s: RunSettings, problems: list[str]) -> None:
+    """Refuse a run whose number of macro steps is absurd, saying how to allow it."""
+    smallest = s.min_step if s.adaptive and _positive(s.min_step) else s.step
+    count = s.stop_time / smallest
+    if count > s.max_steps:
+        what = "run.stop_time / run.min_step" if s.adaptive else "run.stop_time / run.step"
+        problems.append(
+            f"{what} = {s.stop_time:g} s / {smallest:g} s is up to {count:.3g} macro steps, more "
+            f"than run.max_steps = {s.max_steps}; raise max_steps to allow it, or take a "
+            "larger step"
+        )

@@ -34,10 +34,12 @@ from __future__ import annotations
 
 import logging
 import math
+import signal
+import threading
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 from .algorithms import make_algorithm, step_order
 from .energy_guard import EnergyGuard
@@ -52,6 +54,11 @@ __all__ = ["Simulation", "Observer", "RunResult", "SimulationStoppedError"]
 logger = logging.getLogger(__name__)
 
 MODE_OUTPUT = "mode_changes"
+STATUSES = ("finished", "stopped", "failed", "interrupted")
+"""How a run ends: ``finished`` at the stop time; ``stopped`` by the physics or the
+numerics with a message (a unit refused a step, the energy guard, a diverging
+iteration); ``failed``, a unit answered with an error (also in initialisation) or
+something unexpected happened; ``interrupted`` by Ctrl-C (SIGINT) or SIGTERM."""
 _PI = {"safety": 0.99, "k_p": 0.2, "k_i": 0.15, "shrink": 0.2, "grow": 1.5}
 
 
@@ -96,7 +103,7 @@ class _Attempt:
 class RunResult:
     """Outcome of :meth:`Simulation.run`."""
 
-    status: str  # "finished", "stopped" (a unit refused or failed), "interrupted"
+    status: str  # one of STATUSES
     message: str = ""
     end_time: float = 0.0
     wall_time: float = 0.0
@@ -132,13 +139,18 @@ class Simulation:
         self.drivers = DriverSet(scene.drivers, scene.base_dir)
         self.events = ScheduledEvents(scene.events)
         self.algorithm = make_algorithm(scene.run.algorithm, self._order(structure))
-        self.energy = EnergyGuard((b.name for b in scene.bonds), scene.run.energy_guard,
-                                  scene.run.energy_tolerance, _remedies(scene.run))
+        self.energy = EnergyGuard(
+            (b.name for b in scene.bonds),
+            scene.run.energy_guard,
+            scene.run.energy_tolerance,
+            _remedies(scene.run),
+        )
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
         self.held: dict[str, float] = {}
         self.mode_counts: dict[str, int] = {}
         self.result = RunResult("not started")
         self._error_prev = 1.0
+        self._interrupts = _Interrupts()
 
     @property
     def bond_residual(self) -> dict[str, float]:
@@ -214,8 +226,9 @@ class Simulation:
     def read_sources(self, unit: str) -> dict[str, float]:
         """Current values of ``unit``'s outputs that feed connections."""
         keys = self.source_keys.get(unit, [])
-        return dict(zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])),
-                        strict=True))
+        return dict(
+            zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
+        )
 
     def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
         """Held values of every connected, driven or overridden input of ``unit``."""
@@ -225,8 +238,9 @@ class Simulation:
             if link.connection.role == "position":
                 value = history.latest  # the unit advances it with the held velocity
             else:
-                value = held_value(history, t, h, link.scheme,
-                                   None if fresh is None else fresh.get(link.key))
+                value = held_value(
+                    history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+                )
             refs.append(link.target_vr)
             values.append(value)
             self.held[f"{link.connection.target}"] = value
@@ -271,13 +285,22 @@ class Simulation:
         new = self._read_all()
         sweeps, changes = 1, []
         for _ in range(self.run_settings.iterations - 1):
+            if not all(map(math.isfinite, new.values())):
+                return new, sweeps  # never handed on: the caller rejects the step
             before = dict(self.held)
             self._restore(states)
             self.algorithm.sweep(self, t, h, fresh=new)
             new = self._read_all()
             sweeps += 1
-            changes.append(max((abs(self.held[k] - before.get(k, 0.0)) /
-                                max(1.0, abs(self.held[k])) for k in self.held), default=0.0))
+            changes.append(
+                max(
+                    (
+                        abs(self.held[k] - before.get(k, 0.0)) / max(1.0, abs(self.held[k]))
+                        for k in self.held
+                    ),
+                    default=0.0,
+                )
+            )
             if changes[-1] < self.run_settings.iteration_tolerance:
                 return new, sweeps
         if len(changes) >= 3 and changes[-1] > changes[0]:  # the fixed point runs away
@@ -285,7 +308,8 @@ class Simulation:
                 f"t = {t:.6g} s: the iteration over the step of {h:.3g} s diverges (input "
                 f"change {changes[0]:.3g} after the second sweep, {changes[-1]:.3g} after the "
                 f"last of {sweeps}): the coupling cannot be resolved at this step; use a "
-                "smaller step or adaptive steps")
+                "smaller step or adaptive steps"
+            )
         return new, sweeps
 
     def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
@@ -327,12 +351,15 @@ class Simulation:
             self._free(states)
             return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
         if not all(map(math.isfinite, new.values())):  # never accepted, never recorded
-            bad = ", ".join(f"{key} = {value!r}" for key, value in new.items()
-                            if not math.isfinite(value))
+            bad = ", ".join(
+                f"{key} = {value!r}" for key, value in new.items() if not math.isfinite(value)
+            )
             message = f"t = {t:.6g} s: after the step of {h:.3g} s, {bad}"
             if states is None:
-                raise SimulationStoppedError(f"{message}: not finite; the run stops here, "
-                                             "everything before is kept; try a smaller step")
+                raise SimulationStoppedError(
+                    f"{message}: not finite; the run stops here, "
+                    "everything before is kept; try a smaller step"
+                )
             self._restore(states)
             self._free(states)
             return _Attempt(False, {}, sweeps, retry_step=new_h(h, 4.0), message=message)
@@ -343,14 +370,20 @@ class Simulation:
             if error > 1.0 and h > self.run_settings.min_step * (1 + 1e-9):
                 self._restore(states)
                 self._free(states)
-                return _Attempt(False, residuals, sweeps, retry_step=new_h(h, error),
-                                message=f"bond energy residual {error:.3g} x tolerance")
+                return _Attempt(
+                    False,
+                    residuals,
+                    sweeps,
+                    retry_step=new_h(h, error),
+                    message=f"bond energy residual {error:.3g} x tolerance",
+                )
             if error > 1.0:
                 self._free(states)
                 raise SimulationStoppedError(
                     f"t = {t:.6g} s: the bonds' energy residual is {error:.3g} times "
                     f"energy_tolerance even at the minimum step {h:.3g} s: the coupling "
-                    "cannot meet the tolerance; lower min_step or raise energy_tolerance")
+                    "cannot meet the tolerance; lower min_step or raise energy_tolerance"
+                )
         if states is not None:
             self._free(states)
         return _Attempt(True, residuals, sweeps, new)
@@ -366,8 +399,11 @@ class Simulation:
                 self.mode_counts[name] = now
                 for key in self.source_keys.get(name, ()):
                     self.histories[key].reset()
-        across = {b.name for b in self.scene.bonds
-                  if b.effort.source.unit in switched or b.flow.source.unit in switched}
+        across = {
+            b.name
+            for b in self.scene.bonds
+            if b.effort.source.unit in switched or b.flow.source.unit in switched
+        }
         self.energy.book(residuals, self.bond_power, h, across_events=across)
         self.time = t + h
 
@@ -384,31 +420,57 @@ class Simulation:
 
     # -- the run --------------------------------------------------------------------------
     def run(self) -> RunResult:
-        """Initialise and run to the stop time; observers see every accepted step."""
+        """Initialise and run to the stop time; observers see every accepted step.
+
+        Never raises: the result's ``status`` (one of :data:`STATUSES`) and
+        ``message`` say how the run ended, and every observer's ``on_end`` is
+        called whatever happened. Ctrl-C (and SIGTERM) end the run after the
+        macro step under way, with status ``interrupted``; a second Ctrl-C
+        interrupts at once.
+        """
         wall = time.perf_counter()
         result = RunResult("finished")
-        try:
-            self.initialize()
-            self._fire_events(self.time)
-            for obs in self.observers:
-                obs.on_start(self)
-            self._loop(result)
-        except KeyboardInterrupt:
-            result.status, result.message = "interrupted", f"interrupted at t = {self.time:.6g} s"
-        except (SimulationStoppedError, UnitFailedError, StepRefusedError) as exc:
-            result.status, result.message = "stopped", str(exc)
-            logger.error("%s", exc)
-        finally:
-            result.end_time, result.wall_time = self.time, time.perf_counter() - wall
-            result.bond_residual = self.bond_residual
-            result.bond_carried = {n: b.carried for n, b in self.energy.bonds.items()}
-            result.bond_error = {n: b.error for n, b in self.energy.bonds.items()}
-            self.result = result
-            for obs in self.observers:
-                obs.on_end(self, result)
-            for slave in self.slaves.values():
-                slave.terminate()
+        with _Interrupts() as interrupts:
+            self._interrupts = interrupts
+            try:
+                self.initialize()
+                self._fire_events(self.time)
+                for obs in self.observers:
+                    obs.on_start(self)
+                self._loop(result)
+            except (KeyboardInterrupt, _InterruptRequestedError):
+                result.status = "interrupted"
+                result.message = f"interrupted at t = {self.time:.6g} s"
+            except (SimulationStoppedError, StepRefusedError) as exc:
+                result.status, result.message = "stopped", str(exc)
+            except UnitFailedError as exc:
+                result.status, result.message = "failed", str(exc)
+            except Exception as exc:  # noqa: BLE001 - a run ends with a status, never a traceback
+                logger.debug("unexpected failure at t = %g s", self.time, exc_info=True)
+                result.status = "failed"
+                result.message = (
+                    f"t = {self.time:.6g} s: unexpected {type(exc).__name__}: "
+                    f"{exc} (run with --verbose for the traceback)"
+                )
+            finally:
+                self._finish(result, wall)
         return result
+
+    def _finish(self, result: RunResult, wall: float) -> None:
+        """Book the result, tell the observers, free the units (all of it, whatever fails)."""
+        result.end_time, result.wall_time = self.time, time.perf_counter() - wall
+        result.bond_residual = self.bond_residual
+        result.bond_carried = {n: b.carried for n, b in self.energy.bonds.items()}
+        result.bond_error = {n: b.error for n, b in self.energy.bonds.items()}
+        self.result = result
+        for obs in self.observers:
+            try:
+                obs.on_end(self, result)
+            except Exception as exc:  # noqa: BLE001 - the other observers still get their end
+                logger.warning("%s could not finish: %s", type(obs).__name__, exc)
+                logger.debug("observer failure", exc_info=True)
+        for slave in self.slaves.values():
+            slave.terminate()
 
     def _loop(self, result: RunResult) -> None:
         # Time is counted in integer nanoseconds, as libcosim does: no drift over long
@@ -423,17 +485,22 @@ class Simulation:
                 next_ns = _ns(upcoming)
             t = now_ns / 1e9
             h = next_ns / 1e9 - t
+            if self._interrupts.requested:
+                raise _InterruptRequestedError
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps
             if not attempt.accepted:
                 result.rejected += 1
                 if h <= self.run_settings.min_step * (1 + 1e-9):
-                    raise SimulationStoppedError(f"step refused at the minimum step "
-                                                 f"{self.run_settings.min_step:g} s: "
-                                                 f"{attempt.message}")
+                    raise SimulationStoppedError(
+                        f"step refused at the minimum step "
+                        f"{self.run_settings.min_step:g} s: "
+                        f"{attempt.message}"
+                    )
                 h = max(self.run_settings.min_step, attempt.retry_step)
-                logger.debug("t = %.6g s: step rejected (%s), retrying with %.3g s", t,
-                             attempt.message, h)
+                logger.debug(
+                    "t = %.6g s: step rejected (%s), retrying with %.3g s", t, attempt.message, h
+                )
                 continue
             self._accept(t, h, attempt.new, attempt.residuals)
             now_ns = next_ns
@@ -447,6 +514,39 @@ class Simulation:
                 raise SimulationStoppedError(blow_up)
             h = self._next_step(h, attempt.residuals)
 
+
+class _InterruptRequestedError(Exception):
+    """Ctrl-C or SIGTERM was asked for between two macro steps."""
+
+
+class _Interrupts:
+    """While a run goes: SIGINT and SIGTERM end it between macro steps.
+
+    A signal then only sets :attr:`requested`, so it never lands inside a
+    unit's own code (all our FMUs share this interpreter); the run loop ends
+    the run cleanly after the step under way. A second SIGINT raises
+    KeyboardInterrupt at once. Outside the main thread nothing is installed.
+    """
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous: dict[int, Any] = {}
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        if self.requested and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        self.requested = True
+        logger.warning("interrupted: the run ends after this step (Ctrl-C again to stop now)")
+
+    def __enter__(self) -> _Interrupts:
+        if threading.current_thread() is threading.main_thread():
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
 
 
 def _remedies(s: RunSettings) -> list[str]:
@@ -466,4 +566,4 @@ def _ns(seconds: float) -> int:
 
 def new_h(h: float, error: float) -> float:
     """A shorter step after a rejection, from the error ratio (> 1)."""
-    return h * max(_PI["shrink"], min(0.9, 0.9 * error ** -0.5))
+    return h * max(_PI["shrink"], min(0.9, 0.9 * error**-0.5))

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ctypes
 import logging
+import math
 import os
 import time
 from collections import defaultdict
@@ -40,7 +41,7 @@ from fmpy.logging import addLoggerProxy
 
 from .archive import ArchiveLimits, extract_temporary, remove_extracted
 
-__all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS"]
+__all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS", "value_problem"]
 
 logger = logging.getLogger(__name__)
 
@@ -49,11 +50,19 @@ _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
 
 
-class StepRefusedError(RuntimeError):
+class _UnitError(RuntimeError):
+    """A unit's answer; ``unit`` names it."""
+
+    def __init__(self, message: str, unit: str | None = None) -> None:
+        super().__init__(message)
+        self.unit = unit
+
+
+class StepRefusedError(_UnitError):
     """A unit answered a step with fmi2Discard (a physical or numerical stop)."""
 
 
-class UnitFailedError(RuntimeError):
+class UnitFailedError(_UnitError):
     """A unit answered with fmi2Error or fmi2Fatal."""
 
 
@@ -74,9 +83,8 @@ class _Messages:
     def __call__(self, env, instance, status, category, message) -> None:
         text = message.decode("utf-8", "replace") if message else ""
         name = instance.decode("utf-8", "replace") if instance else self.name
-        level = {0: logging.DEBUG, 1: logging.WARNING, 2: logging.WARNING}.get(
-            status, logging.ERROR
-        )
+        # Discard, Error and Fatal are kept and said once, by the exception the call raises
+        level = logging.WARNING if status == 1 else logging.DEBUG
         logger.log(level, "%s [%s]: %s", name, FMI_STATUS.get(status, status), text)
         if status >= 1:
             _ROUTES.get(name, self).kept.append(text)
@@ -230,10 +238,17 @@ class Slave:
         """Set variables by name, grouped by type."""
         groups: dict[str, tuple[list[int], list[Any]]] = defaultdict(lambda: ([], []))
         for name, value in values.items():
-            var = self.variables[name]
+            var = self.variables.get(name)
+            if var is None:
+                raise UnitFailedError(f"unit {self.name!r} has no variable {name!r}", self.name)
             refs, vals = groups[var.type]
             refs.append(var.valueReference)
-            vals.append(_coerce(var.type, value))
+            problem = value_problem(var, value)
+            if problem:
+                raise UnitFailedError(
+                    f"unit {self.name!r}: {name} = {value!r}: {problem}", self.name
+                )
+            vals.append(float(value) if var.type == "Real" else value)
         for kind, (refs, vals) in groups.items():
             self._call(f"set{kind}", refs, vals)
 
@@ -276,11 +291,13 @@ class Slave:
             said = "; ".join(self.messages.kept[-3:]) or "no message"
             if exc.status == 2:
                 raise StepRefusedError(
-                    f"unit {self.name!r} refused the step at t = {t:.6g} s (h = {h:.3g} s): {said}"
+                    f"unit {self.name!r} refused the step at t = {t:.6g} s (h = {h:.3g} s): {said}",
+                    self.name,
                 ) from None
             raise UnitFailedError(
                 f"unit {self.name!r} failed at t = {t:.6g} s with "
-                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}"
+                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}",
+                self.name,
             ) from None
 
     def get_state(self) -> object:
@@ -297,7 +314,7 @@ class Slave:
 
     def _call(self, fn: str, *args, **kwargs):
         if self._fmu is None:
-            raise UnitFailedError(f"unit {self.name!r} is not instantiated")
+            raise UnitFailedError(f"unit {self.name!r} is not instantiated", self.name)
         start = time.perf_counter()
         try:
             if fn == "instantiate":
@@ -310,18 +327,39 @@ class Slave:
             said = "; ".join(self.messages.kept[-5:]) or "no message"
             raise UnitFailedError(
                 f"unit {self.name!r}: {fn} failed with "
-                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}"
+                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}",
+                self.name,
             ) from None
         finally:
             self.calls[fn] += 1
             self.seconds[fn] += time.perf_counter() - start
 
 
-def _coerce(kind: str, value: Any) -> Any:
+_INT32 = (-(2**31), 2**31 - 1)
+
+
+def value_problem(variable, value) -> str | None:
+    """What is wrong with ``value`` for an FMI ``variable`` (None if nothing).
+
+    No value is converted silently: a Real takes a finite number, an Integer
+    a whole number within 32 bits, a Boolean true or false, a String text.
+    """
+    kind = variable.type
     if kind == "Real":
-        return float(value)
-    if kind in ("Integer", "Enumeration"):
-        return int(value)
-    if kind == "Boolean":
-        return bool(value)
-    return str(value)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return f"expected a number (Real), got {type(value).__name__}"
+        if value != value or (variable.causality == "input" and not math.isfinite(value)):
+            return "expected a finite number (Real)"
+        if isinstance(value, int) and abs(value) > 1.7976931348623157e308:
+            return "too large for a Real"
+    elif kind in ("Integer", "Enumeration"):
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"expected a whole number ({kind}), got {value!r}"
+        if not _INT32[0] <= value <= _INT32[1]:
+            return f"outside the 32-bit range of an {kind} ({_INT32[0]} to {_INT32[1]})"
+    elif kind == "Boolean":
+        if not isinstance(value, bool):
+            return f"expected true or false (Boolean), got {type(value).__name__} {value!r}"
+    elif kind == "String" and not isinstance(value, str):
+        return f"expected text (String), got {type(value).__name__}"
+    return None

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,9 +23,16 @@ from fmpy import read_model_description
 
 from .catalog import DEFAULT_FMU_DIR, is_ours, resolve_fmu
 from .scene import BOND_KINDS, Scene, SceneError, VarRef
+from .slave import value_problem
 
-__all__ = ["Structure", "resolve_units", "check_structure", "check_through_fmi",
-           "validate_scene", "feedthrough_loops"]
+__all__ = [
+    "Structure",
+    "resolve_units",
+    "check_structure",
+    "check_through_fmi",
+    "validate_scene",
+    "feedthrough_loops",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -78,14 +86,18 @@ def resolve_units(scene: Scene, fmu_dir: Path = DEFAULT_FMU_DIR) -> tuple[Struct
 
 
 def _variable_problem(structure: Structure, ref: VarRef, causality: str, what: str) -> str | None:
+    """What is wrong with ``ref`` as a ``causality`` variable; "" when its unit is unknown or
+    unresolved (said once already, where the scene is read or its FMU resolved)."""
     if ref.unit not in structure.descriptions:
-        return f"{what} {ref}: there is no unit {ref.unit!r}"
+        return ""
     var = structure.variable(ref)
     if var is None:
         md = structure.descriptions[ref.unit]
         names = [v.name for v in md.modelVariables if v.causality == causality]
-        return (f"{what} {ref}: unit {ref.unit!r} has no variable {ref.variable!r}; its "
-                f"{causality}s: {', '.join(names)}")
+        return (
+            f"{what} {ref}: unit {ref.unit!r} has no variable {ref.variable!r}; its "
+            f"{causality}s: {', '.join(names)}"
+        )
     if var.causality != causality:
         hint = " (an output cannot feed an output)" if causality == "input" else ""
         return f"{what} {ref}: is an {var.causality}, expected an {causality}{hint}"
@@ -100,14 +112,16 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
         p_dst = _variable_problem(structure, c.target, "input", f"{what} to")
         problems += [p for p in (p_src, p_dst) if p]
         fed[c.target].append(f"{what} from {c.source}")
-        if p_src or p_dst:
+        if p_src is not None or p_dst is not None:
             continue
         src, dst = structure.variable(c.source), structure.variable(c.target)
         if src.type != dst.type:
             problems.append(f"{what} {c.source} -> {c.target}: type {src.type} feeds {dst.type}")
         elif src.type == "Real" and (src.unit or "") != (dst.unit or ""):
-            problems.append(f"{what} {c.source} -> {c.target}: unit mismatch, "
-                            f"{src.unit or 'no unit'} feeds {dst.unit or 'no unit'}")
+            problems.append(
+                f"{what} {c.source} -> {c.target}: unit mismatch, "
+                f"{src.unit or 'no unit'} feeds {dst.unit or 'no unit'}"
+            )
     for d in scene.drivers:
         for ref in (d.target, d.rate_target):
             if ref is not None:
@@ -121,8 +135,9 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
 def _bond_problems(scene: Scene, structure: Structure) -> list[str]:
     problems = []
     for bond in scene.bonds:
-        units = dict(zip(("effort", "flow", "position"), BOND_KINDS.get(bond.kind, ()),
-                         strict=False))
+        units = dict(
+            zip(("effort", "flow", "position"), BOND_KINDS.get(bond.kind, ()), strict=False)
+        )
         for c in bond.connections:
             var = structure.variable(c.source)
             if var is None or var.type != "Real":
@@ -133,7 +148,8 @@ def _bond_problems(scene: Scene, structure: Structure) -> list[str]:
                 problems.append(
                     f"bond {bond.name!r} ({bond.kind}): {c.source} has unit "
                     f"{var.unit or 'none'} but {noun} of a {bond.kind} bond is in {expected} "
-                    f"(a force must pair with its velocity, a torque with its angular velocity)")
+                    f"(a force must pair with its velocity, a torque with its angular velocity)"
+                )
     return problems
 
 
@@ -153,7 +169,7 @@ def feedthrough_loops(scene: Scene, structure: Structure) -> list[list[str]]:
         stack.append(node)
         for nxt in graph.get(node, ()):
             if colour.get(nxt) == 1:
-                loops.append(stack[stack.index(nxt):] + [nxt])
+                loops.append(stack[stack.index(nxt) :] + [nxt])
             elif nxt not in colour:
                 visit(nxt)
         stack.pop()
@@ -174,31 +190,63 @@ def _other_problems(scene: Scene, structure: Structure) -> list[str]:
                 problems += [p] if p else []
     for e in scene.events:
         if e.time > scene.run.stop_time:  # a shortened run simply ends before it
-            logger.info("event %r at %g s is after the stop time; it will not happen",
-                        e.label, e.time)
+            logger.info(
+                "event %r at %g s is after the stop time; it will not happen", e.label, e.time
+            )
         for ref in e.values:
             p = _variable_problem(structure, ref, "input", f"event {e.label!r} sets")
             problems += [p] if p else []
     for ref in list(scene.outputs or ()) + [r for p in scene.plots for r in p.variables]:
-        if ref.unit not in structure.descriptions or structure.variable(ref) is None:
+        if ref.unit in structure.descriptions and structure.variable(ref) is None:
             problems.append(f"recorded/plotted variable {ref} does not exist")
+    for e in scene.events:
+        for ref, value in e.values.items():
+            var = structure.variable(ref)
+            problem = var is not None and value_problem(var, value)
+            if problem:
+                problems.append(f"event {e.label!r} sets {ref} = {value!r}: {problem}")
+    for d in scene.drivers:
+        for ref in (d.target, d.rate_target):
+            var = structure.variable(ref) if ref is not None else None
+            if var is not None and var.type != "Real":
+                problems.append(f"driver target {ref}: is a {var.type}; a driver feeds a Real")
     for name, spec in scene.units.items():
         md = structure.descriptions.get(name)
         if md is None:
             continue
+        problems += _parameter_problems(name, spec, structure)
         params = {v.name for v in md.modelVariables if v.causality in ("parameter", "input")}
-        for key in spec.parameters:
-            if key not in params:
-                problems.append(f"unit {name!r}: no parameter {key!r}")
         if spec.effects and not is_ours(spec.fmu) and "effects" not in params:
             problems.append(f"unit {name!r}: effects are only known for our FMUs")
     needs_state = scene.run.iterations > 1 or scene.run.adaptive
     if needs_state:
         for name, md in structure.descriptions.items():
             if not md.coSimulation.canGetAndSetFMUstate:
-                problems.append(f"unit {name!r} cannot save its state, which iteration and "
-                                "adaptive steps need (rollback)")
+                problems.append(
+                    f"unit {name!r} cannot save its state, which iteration and "
+                    "adaptive steps need (rollback)"
+                )
     return problems
+
+
+def _parameter_problems(name: str, spec, structure: Structure) -> list[str]:
+    """Parameters a unit does not have, or values of the wrong type for it."""
+    md = structure.descriptions[name]
+    params = {v.name: v for v in md.modelVariables if v.causality in ("parameter", "input")}
+    problems = []
+    for key, value in spec.parameter_values().items():
+        if key not in params:
+            problems.append(f"unit {name!r}: no parameter {key!r}")
+            continue
+        problem = value_problem(params[key], value)
+        if problem:
+            problems.append(f"unit {name!r}: parameter {key!r} = {_short(value)}: {problem}")
+    return problems
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def check_structure(scene: Scene, structure: Structure) -> list[str]:
@@ -221,18 +269,42 @@ def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
 
     problems = []
     for name, spec in scene.units.items():
-        if name not in structure.paths:
-            continue
+        if name not in structure.paths or _parameter_problems(name, spec, structure):
+            continue  # its parameters' names or types are wrong: said already
         slave = Slave(name, structure.paths[name])
         try:
             slave.instantiate()
             slave.initialize(0.0, unit_start_values(spec, slave))
-        except UnitFailedError:
-            said = slave.messages.kept or ["the unit refused its parameters"]
-            problems += [f"unit {name!r}: {m}" for m in said]
+        except UnitFailedError as exc:
+            problems += unit_messages(name, slave, exc)
         finally:
             slave.terminate()
     return problems
+
+
+def unit_messages(name: str, slave, exc: Exception) -> list[str]:
+    """What a unit said when it failed, each message once, naming the unit."""
+    said = list(dict.fromkeys(slave.messages.kept)) or [str(exc)]
+    return [m if m.startswith(f"unit {name!r}") else f"unit {name!r}: {m}" for m in said]
+
+
+def dry_initialization(scene: Scene, structure: Structure) -> list[str]:
+    """Initialise every unit exactly as a run does (connected start values, drivers, events at
+    the start time), then free them: what a run would refuse before its first step."""
+    from .simulation import Simulation
+    from .slave import StepRefusedError, UnitFailedError
+
+    sim = Simulation(scene, structure, ())
+    try:
+        sim.initialize()
+    except (UnitFailedError, StepRefusedError) as exc:
+        name = getattr(exc, "unit", None)
+        slave = sim.slaves.get(name)
+        return unit_messages(name, slave, exc) if slave else [str(exc)]
+    finally:
+        for slave in sim.slaves.values():
+            slave.terminate()
+    return []
 
 
 def unit_start_values(spec, slave) -> dict:
@@ -244,13 +316,40 @@ def unit_start_values(spec, slave) -> dict:
     return values
 
 
-def validate_scene(scene: Scene, fmu_dir: Path = DEFAULT_FMU_DIR, *,
-                   through_fmi: bool = True) -> Structure:
-    """All checks; raise :class:`SceneError` listing every problem."""
-    structure, problems = resolve_units(scene, fmu_dir)
-    problems += check_structure(scene, structure)
-    if through_fmi and not problems:
-        problems += check_through_fmi(scene, structure)
-    if problems:
-        raise SceneError(f"scene {scene.name!r}", problems)
+def validate_scene(
+    scene: Scene,
+    fmu_dir: Path = DEFAULT_FMU_DIR,
+    *,
+    through_fmi: bool = True,
+    dry_run: bool = False,
+    problems: Sequence[str] = (),
+) -> Structure:
+    """All checks; raise :class:`SceneError` listing every problem, each once.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (as :func:`~wire_fmu.master.scene.read_scene` returns it, possibly with
+        invalid items left out).
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+    through_fmi : bool
+        Instantiate each unit with its parameters (its own checks of them).
+    dry_run : bool
+        Then, if nothing else is wrong, initialise all units as a run does
+        (:func:`dry_initialization`); ``wire-fmu check`` does.
+    problems : sequence of str
+        Problems already found in the scene's data, reported with the rest.
+    """
+    found = list(problems)
+    structure, unresolved = resolve_units(scene, fmu_dir)
+    found += unresolved
+    found += check_structure(scene, structure)
+    if through_fmi:
+        found += check_through_fmi(scene, structure)
+    if dry_run and not found:
+        found += dry_initialization(scene, structure)
+    found = list(dict.fromkeys(found))
+    if found:
+        raise SceneError(f"scene {scene.name!r}", found)
     return structure

@@ -1,0 +1,305 @@
+"""Hostile scenes: ``check`` finds, at once and each once, everything ``run`` would refuse.
+
+Every case is a variant of a shipped scene with something wrong in it. The
+check (Python API and command line) must list the offending item by name
+with what was expected, never a traceback; problems in different places come
+out together; a unit that fails its own initialisation is found by the
+check's dry initialisation. Runs that fail end with a true status in
+``metadata.json`` and the unit's message once.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from wire_fmu.cli import main as cli
+from wire_fmu.master.run import SCENE_DIR, check_scene, run_scene
+from wire_fmu.master.scene import SceneError
+
+pytestmark = pytest.mark.integration
+
+RISER = SCENE_DIR / "riser_tensioner.toml"
+DRAWWORKS = SCENE_DIR / "drawworks.toml"
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("hostile_scene_fmus")
+
+
+def variant(
+    folder: Path,
+    base: Path = RISER,
+    *,
+    replace: dict[str, str] | None = None,
+    sections: dict[str, str] | None = None,
+    append: str = "",
+    name: str = "hostile",
+) -> Path:
+    """A copy of ``base`` with text replaced, lines put at the top of sections, text appended."""
+    text = base.read_text(encoding="utf-8")
+    text = re.sub(r'^name = ".*"$', f'name = "{name}"', text, count=1, flags=re.M)
+    for old, new in (replace or {}).items():
+        assert old in text, old
+        text = text.replace(old, new)
+    for header, lines in (sections or {}).items():
+        assert f"{header}\n" in text, header
+        text = text.replace(f"{header}\n", f"{header}\n{lines}\n", 1)
+    path = folder / f"{name}.toml"
+    path.write_text(text + append, encoding="utf-8")
+    return path
+
+
+def problems_of(path: Path, fmu_dir: Path) -> list[str]:
+    with pytest.raises(SceneError) as caught:
+        check_scene(path, fmu_dir)
+    problems = caught.value.problems
+    assert len(problems) == len(set(problems)), "a problem said twice"
+    assert not any("Traceback" in p or "Fatal py exception" in p for p in problems)
+    return problems
+
+
+def only(problems: list[str], *words: str) -> str:
+    """The one problem that names every word."""
+    found = [p for p in problems if all(w in p for w in words)]
+    assert len(found) == 1, (words, problems)
+    return found[0]
+
+
+RISER_ROD = (
+    '"rod.force" = -1.424e6        # N, 4 x 356 kN at the start: the rod begins in equilibrium'
+)
+CYL = "[units.cylinder.parameters]"
+EFFORT = 'effort = "rope.mover_a.force -> cylinder.rod.force"'
+
+
+# -- parameters of the wrong type: named, with the type they need -----------------------
+@pytest.mark.parametrize(
+    ("line", "parameter", "expected"),
+    [
+        ('initial_equilibrium = "false"', "initial_equilibrium", "true or false"),
+        ("initial_equilibrium = 1", "initial_equilibrium", "true or false"),
+        ('initial_position = "1.9"', "initial_position", "a number"),
+        ("initial_position = true", "initial_position", "a number"),
+        ("initial_position = nan", "initial_position", "finite"),
+        ("initial_position = inf", "initial_position", "must lie in"),  # the unit says
+        ("initial_position = 1e999", "initial_position", "must lie in"),
+        ("initial_position = [1.0, 2.0]", "initial_position", "a number"),
+    ],
+)
+def test_a_parameter_of_the_wrong_type_is_named_with_its_type(
+    tmp_path, fmu_dir, line, parameter, expected
+):
+    path = variant(
+        tmp_path,
+        sections={CYL: line},
+        replace={
+            "initial_equilibrium = true\n": "",
+            "initial_position = 1.905      # m, mid stroke\n": "",
+        },
+    )
+    problem = only(problems_of(path, fmu_dir), f"parameter {parameter!r}")
+    assert "unit 'cylinder'" in problem and expected in problem
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ("2.5", "whole number"),
+        ("4294967297", "32-bit range"),
+        ("2147483653", "32-bit range"),
+        ('"2"', "whole number"),
+        ("true", "whole number"),
+    ],
+)
+def test_an_integer_parameter_takes_a_whole_32_bit_number(tmp_path, fmu_dir, value, expected):
+    path = variant(
+        tmp_path, DRAWWORKS, sections={"[units.winch.parameters]": f"drum_layers = {value}"}
+    )
+    problem = only(problems_of(path, fmu_dir), "'drum_layers'")
+    assert expected in problem
+
+
+# -- what a run would refuse at initialisation --------------------------------------------
+@pytest.mark.parametrize(
+    ("line", "words"),
+    [
+        ('"rod.force" = -5.0e6', ("unit 'cylinder'", "precharge_pressure")),
+        ('"rod.force" = 5.0e6', ("unit 'cylinder'",)),
+    ],
+)
+def test_a_unit_that_fails_its_initialisation_is_found_by_check(tmp_path, fmu_dir, line, words):
+    path = variant(tmp_path, replace={RISER_ROD: line})
+    problems = problems_of(path, fmu_dir)
+    only(problems, *words)
+
+
+def test_a_failing_initialisation_runs_to_a_failed_status_with_results_kept(tmp_path, fmu_dir):
+    path = variant(tmp_path, replace={RISER_ROD: '"rod.force" = -5.0e6'})
+    outcome = run_scene(path, tmp_path / "out", fmu_dir=fmu_dir, stop_time=0.1)
+    assert outcome.result.status == "failed"
+    assert outcome.result.message.count("precharge_pressure") == 1
+    meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
+    assert meta["result"]["status"] == "failed"
+    assert outcome.plots == []
+
+
+# -- run settings: absurd step counts and contradictions ------------------------------------
+@pytest.mark.parametrize(
+    ("line", "words"),
+    [
+        ("stop_time = 1e300", ("macro steps", "max_steps")),
+        ("step = 1e-12", ("macro steps", "max_steps")),
+        ("stop_time = 100000000000000000000000000000000000000000", ("run.stop_time",)),
+        ("iterations = 2.5", ("run.iterations",)),
+        ("energy_guard = -1.0", ("run.energy_guard",)),
+        ('adaptive = "yes"', ("run.adaptive",)),
+        ("order = 5", ("run.order",)),
+        ("max_steps = 0", ("run.max_steps",)),
+        ('algorithm = "newton"', ("run.algorithm",)),
+    ],
+)
+def test_bad_run_settings_are_named(tmp_path, fmu_dir, line, words):
+    key = line.split(" =")[0]
+    text = RISER.read_text(encoding="utf-8")
+    replace = {m.group(0): "" for m in re.finditer(rf"^{key} = .*\n", text, flags=re.M)}
+    path = variant(tmp_path, replace=replace, sections={"[run]": line})
+    only(problems_of(path, fmu_dir), *words)
+
+
+def test_min_step_above_max_step_with_adaptive_is_refused(tmp_path, fmu_dir):
+    path = variant(
+        tmp_path, sections={"[run]": "adaptive = true\nmin_step = 0.01\nmax_step = 0.001"}
+    )
+    only(problems_of(path, fmu_dir), "run.min_step", "run.max_step")
+
+
+def test_the_step_count_message_says_how_to_allow_it(tmp_path, fmu_dir):
+    path = variant(tmp_path, replace={"step = 0.002": "step = 1e-12"})
+    problem = only(problems_of(path, fmu_dir), "macro steps")
+    assert "3e+13" in problem and "raise max_steps" in problem
+
+
+# -- events, drivers, connections -----------------------------------------------------------
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ('"high"', "a number"),
+        ("[1.0, 2.0]", "finite number"),
+        ("true", "a number"),
+        ("nan", "finite number"),
+    ],
+)
+def test_an_event_value_of_the_wrong_type_is_named(tmp_path, fmu_dir, value, expected):
+    event = (
+        f'\n[[events]]\ntime = 1.0\nlabel = "push"\nset = {{ "cylinder.rod.force" = {value} }}\n'
+    )
+    path = variant(tmp_path, append=event)
+    problem = only(problems_of(path, fmu_dir), "cylinder.rod.force")
+    assert expected in problem
+
+
+@pytest.mark.parametrize("time", ['"soon"', "-1.0", "nan"])
+def test_an_event_time_that_is_not_a_time_is_named(tmp_path, fmu_dir, time):
+    event = f'\n[[events]]\ntime = {time}\nset = {{ "cylinder.rod.force" = 1.0 }}\n'
+    only(problems_of(variant(tmp_path, append=event), fmu_dir), "'time'")
+
+
+def test_an_unknown_unit_in_a_bond_is_named_as_unknown(tmp_path, fmu_dir):
+    path = variant(
+        tmp_path,
+        replace={EFFORT: EFFORT.replace("cylinder.rod", "piston.rod")},
+    )
+    problems = problems_of(path, fmu_dir)
+    only(problems, "bond 'rod' effort", "no unit 'piston'")
+    assert not any("effort must go from" in p for p in problems)
+
+
+def test_an_unknown_variable_and_an_output_fed_into_an_output(tmp_path, fmu_dir):
+    extra = (
+        '\n[[connections]]\nfrom = "rope.no_such_output"\nto = "cylinder.rod.force2"\n'
+        '\n[[connections]]\nfrom = "rope.tension_max"\nto = "cylinder.rod.position"\n'
+    )
+    problems = problems_of(variant(tmp_path, append=extra), fmu_dir)
+    only(problems, "no_such_output")
+    only(problems, "cylinder.rod.position", "expected an input")
+
+
+def test_a_driver_on_an_output_is_named(tmp_path, fmu_dir):
+    path = variant(
+        tmp_path, replace={'target = "rope.mover_b.position"': 'target = "cylinder.rod.position"'}
+    )
+    only(problems_of(path, fmu_dir), "driver target cylinder.rod.position")
+
+
+# -- names and files ----------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["../../x", "/abs", "a/b", "..", ".hidden", "x" * 300, ""])
+def test_a_scene_name_that_is_not_a_plain_file_name_is_refused(tmp_path, fmu_dir, name):
+    path = variant(tmp_path)
+    text = path.read_text().replace('name = "hostile"', f"name = {json.dumps(name)}")
+    path.write_text(text)
+    only(problems_of(path, fmu_dir), "'name'", "plain file name")
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [
+        (b"\x00\xff\x8b binary", ("cannot read",)),
+        (b"name = [", ("not valid TOML",)),
+        (b"a = " + b"[" * 5000 + b"]" * 5000, ("nested too deeply",)),
+        (b"name = 'x'\n", ("[units]",)),
+        (b"units = 5\n", ("[units]",)),
+    ],
+)
+def test_a_file_that_is_not_a_scene_gives_one_clean_problem(tmp_path, fmu_dir, content, words):
+    path = tmp_path / "junk.toml"
+    path.write_bytes(content)
+    problems = problems_of(path, fmu_dir)
+    assert any(all(w in p for w in words) for p in problems), problems
+
+
+def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
+    path = variant(
+        tmp_path,
+        replace={
+            "step = 0.002": "step = -1.0",
+            "pretension = 356.0e3": 'pretension = "high"',
+            EFFORT: EFFORT.replace("cylinder.rod", "piston.rod"),
+        },
+        sections={CYL: "no_such_parameter = 1.0"},
+        append='\n[[events]]\ntime = 1.0\nset = { "cylinder.rod.force" = "x" }\n',
+    )
+    problems = problems_of(path, fmu_dir)
+    for words in (
+        ("run.step",),
+        ("no unit 'piston'",),
+        ("'no_such_parameter'",),
+        ("'pretension'",),
+        ("event", "cylinder.rod.force"),
+    ):
+        only(problems, *words)
+
+
+def test_a_shipped_scene_passes_check_through_the_command_line(fmu_dir, capsys):
+    assert cli(["--fmu-dir", str(fmu_dir), "check", "riser_tensioner"]) == 0
+    assert "no problems" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("scene", ["rod_force", "bad_name", "stop_time"])
+def test_check_on_the_command_line_exits_1_listing_the_problem(tmp_path, fmu_dir, capsys, scene):
+    edits = {
+        "rod_force": {"replace": {RISER_ROD: '"rod.force" = -5.0e6'}},
+        "bad_name": {"replace": {}, "name": "ok"},
+        "stop_time": {"replace": {"stop_time = 30.0": "stop_time = 1e300"}},
+    }[scene]
+    path = variant(tmp_path, **edits)
+    if scene == "bad_name":
+        path.write_text(path.read_text().replace('name = "ok"', 'name = "../../x"'))
+    assert cli(["--fmu-dir", str(fmu_dir), "check", str(path)]) == 1
+    out = capsys.readouterr()
+    assert "error:" in out.out and "Traceback" not in out.out + out.err
+    assert out.out.count("precharge_pressure") <= 1
