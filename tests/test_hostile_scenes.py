@@ -126,16 +126,23 @@ def test_an_integer_parameter_takes_a_whole_32_bit_number(tmp_path, fmu_dir, val
 
 # -- what a run would refuse at initialisation --------------------------------------------
 @pytest.mark.parametrize(
-    ("line", "words"),
+    ("edits", "words"),
     [
-        ('"rod.force" = -5.0e6', ("unit 'cylinder'", "precharge_pressure")),
-        ('"rod.force" = 5.0e6', ("unit 'cylinder'",)),
+        (
+            {"replace": {RISER_ROD: '"rod.force" = -5.0e6'}},
+            ("unit 'cylinder'", "precharge_pressure"),
+        ),
+        ({"replace": {RISER_ROD: '"rod.force" = 5.0e6'}}, ("unit 'cylinder'",)),
+        ({"sections": {CYL: "moving_mass = 1e300"}}, ("unit 'cylinder'", "precharge_pressure")),
+        ({"replace": {"heave_rao = 0.3": "heave_rao = 1e6"}}, ("unit 'cylinder'",)),
+        (
+            {"sections": {"[units.rope.parameters]": "break_segment = 99"}},
+            ("unit 'rope'", "break_segment 99 does not exist"),
+        ),
     ],
 )
-def test_a_unit_that_fails_its_initialisation_is_found_by_check(tmp_path, fmu_dir, line, words):
-    path = variant(tmp_path, replace={RISER_ROD: line})
-    problems = problems_of(path, fmu_dir)
-    only(problems, *words)
+def test_a_unit_that_fails_its_initialisation_is_found_by_check(tmp_path, fmu_dir, edits, words):
+    only(problems_of(variant(tmp_path, **edits), fmu_dir), *words)
 
 
 def test_a_failing_initialisation_runs_to_a_failed_status_with_results_kept(tmp_path, fmu_dir):

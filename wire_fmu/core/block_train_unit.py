@@ -148,6 +148,11 @@ class BlockTrainUnit(Unit):
     def initialize(self, start_time: float) -> None:
         """Rope stretched for equilibrium (or pretension); outputs filled."""
         model = self._require_model()
+        segment = self.values["break_segment"]
+        if not 0 <= segment <= model.n_segments:
+            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", [
+                f"break_segment {segment} does not exist: 0 for none, 1..{model.n_segments} "
+                "for a segment of this reeving"])
         try:
             model.initialize(start_time, self._inputs(), equilibrium=bool(
                 self.values["initial_equilibrium"]), pretension=float(self.values["pretension"]))

@@ -57,7 +57,7 @@ from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
 import wire_fmu
-from wire_fmu.core.errors import WireFmuError
+from wire_fmu.core.errors import ConfigurationError, WireFmuError
 from wire_fmu.core.interface import Causality, Unit, Variability, Variable
 from wire_fmu.export.guard import check_core
 from wire_fmu.export.state import json_copy
@@ -114,6 +114,9 @@ def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
         def guarded(self: CoreFacade, *args: Any, **kwargs: Any) -> Any:
             try:
                 return method(self, *args, **kwargs)
+            except ConfigurationError as exc:  # its problems, without the "where" we say already
+                self._report(f"{fmi_name} failed: {'; '.join(exc.problems)}", Fmi2Status.error)
+                raise
             except WireFmuError as exc:
                 self._report(f"{fmi_name} failed: {exc}", Fmi2Status.error)
                 raise
