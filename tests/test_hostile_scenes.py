@@ -167,6 +167,7 @@ def test_a_failing_initialisation_runs_to_a_failed_status_with_results_kept(tmp_
         ('adaptive = "yes"', ("run.adaptive",)),
         ("order = 5", ("run.order",)),
         ("max_steps = 0", ("run.max_steps",)),
+        ("iterations = 1000000", ("run.iterations", "at most 1000")),
         ('algorithm = "newton"', ("run.algorithm",)),
     ],
 )
@@ -310,3 +311,30 @@ def test_check_on_the_command_line_exits_1_listing_the_problem(tmp_path, fmu_dir
     out = capsys.readouterr()
     assert "error:" in out.out and "Traceback" not in out.out + out.err
     assert out.out.count("precharge_pressure") <= 1
+
+
+def test_an_output_interval_below_the_round_off_records_every_step_and_ends(tmp_path, fmu_dir):
+    """A loop adding the interval to the next output time ran for ever once the interval was
+    below the round-off of the time (1e-300 s); every step is recorded instead."""
+    path = variant(tmp_path, replace={"output_interval = 0.01": "output_interval = 1e-300"})
+    outcome = run_scene(path, tmp_path / "out", fmu_dir=fmu_dir, stop_time=0.01, plots=False)
+    assert outcome.result.status == "finished"
+    rows = outcome.csv_path.read_text().splitlines()
+    assert len(rows) == 1 + 1 + 5  # header, start, five steps of 2 ms
+
+
+@pytest.mark.parametrize(
+    ("reeving", "words"),
+    [
+        ('"{not json"', "is not JSON"),
+        ("{ bodies = 5 }", "bodies: must be a mapping"),
+    ],
+)
+def test_draw_of_a_reeving_that_is_not_one_names_the_problem(tmp_path, capsys, reeving, words):
+    path = tmp_path / "draw.toml"
+    path.write_text(
+        f'name = "d"\n[units.r]\nfmu = "BlockTrain"\n[units.r.parameters]\nreeving = {reeving}\n'
+    )
+    assert cli(["draw", "-o", str(tmp_path / "out"), str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "error:" in out and words in out and "Traceback" not in out

@@ -105,7 +105,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
     """Draw every block train's reeving in a scene."""
     from wire_fmu.master.draw import draw_reeving
     from wire_fmu.master.run import find_scene
-    from wire_fmu.master.scene import load_scene
+    from wire_fmu.master.scene import SceneError, load_scene
 
     scene = load_scene(find_scene(args.scene))
     out = Path(args.output or Path("results") / scene.name)
@@ -116,7 +116,11 @@ def cmd_draw(args: argparse.Namespace) -> int:
         if reeving is None:
             continue
         if isinstance(reeving, str):
-            reeving = json.loads(reeving)
+            try:
+                reeving = json.loads(reeving)
+            except ValueError as exc:
+                raise SceneError(f"scene {scene.name!r}", [
+                    f"unit {name!r}: parameter 'reeving' is not JSON ({exc})"]) from None
         path = draw_reeving(reeving, out / f"{name}_reeving.png", title=f"{scene.name}: {name}")
         _print(f"drawn: {path.resolve()}")
         drawn += 1

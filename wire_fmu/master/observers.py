@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import json
 import logging
+import math
 import sys
 import time
 from pathlib import Path
@@ -128,8 +129,10 @@ class CsvRecorder:
         self._writer.writerow([_cell(v) for v in values])
         self._file.flush()
         if self.interval is not None:
-            while self._next <= sim.time + 1e-9 * max(1.0, sim.time):
-                self._next += self.interval
+            # the first multiple of the interval after now (in one step, however small the
+            # interval: a loop adding it could run for ever once it is below the round-off)
+            reached = math.floor((sim.time + 1e-9 * max(1.0, sim.time)) / self.interval)
+            self._next = max(self._next, (reached + 1) * self.interval)
 
     def _write_metadata(self, sim: Simulation, result: RunResult | None) -> None:
         variables = {}

@@ -107,6 +107,8 @@ __all__ = [
 
 ALGORITHMS = ("jacobi", "gauss_seidel")
 EXTRAPOLATIONS = ("constant", "linear", "quadratic")
+MAX_ITERATIONS = 1000
+"""Most sweeps of one macro step ``run.iterations`` may ask for."""
 BOND_KINDS = {
     # kind: (effort unit, flow unit, position unit)
     "translational": ("N", "m/s", "m"),
@@ -685,6 +687,9 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
         )
     if not isinstance(s.iterations, int) or isinstance(s.iterations, bool) or s.iterations < 1:
         problems.append(f"run.iterations must be an integer >= 1, got {s.iterations!r}")
+    elif s.iterations > MAX_ITERATIONS:
+        problems.append(f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
+                        "one step (a coupling that needs more does not converge)")
     if not isinstance(s.adaptive, bool):
         problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):
