@@ -91,12 +91,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     _print(f"\nscene {outcome.scene.name!r}")
     _print(_table(summary_rows(outcome.simulation, outcome.result)))
-    _print(f"\nresults: {outcome.csv_path.resolve()}")
+    if outcome.csv_path.is_file():
+        _print(f"\nresults: {outcome.csv_path.resolve()}")
     _print(f"metadata: {(outcome.directory / 'metadata.json').resolve()}")
     for path in outcome.plots:
         _print(f"plot: {path.resolve()}")
     status = outcome.result.status
-    if status != "finished":
+    if status != "finished":  # said once, last, where it is seen
         _print(f"\nrun {status}: {outcome.result.message}")
     return EXIT_INTERRUPTED if status == "interrupted" else 0 if status == "finished" else 1
 

@@ -214,7 +214,7 @@ class Progress:
 def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
     """Key figures of a finished run, for a summary table."""
     rows = [
-        ("status", result.status + (f": {result.message}" if result.message else "")),
+        ("status", result.status),
         ("simulated", f"{result.end_time:.6g} s"),
         ("wall time", f"{result.wall_time:.3g} s"),
         ("real-time factor", f"{result.end_time / result.wall_time:.3g}" if result.wall_time

@@ -179,7 +179,7 @@ def run_scene(
 def _plots(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
     """The scene's plots of what was recorded; none (with a warning) if nothing was."""
     if not csv_path.is_file():
-        logger.warning("no plots: nothing was recorded (the run ended before its first step)")
+        logger.info("no plots: nothing was recorded (the run ended before its first step)")
         return []
     from .plots import plot_scene
 

@@ -324,10 +324,11 @@ class Slave:
             self._fatal = self._fatal or exc.status == 4
             if fn == "doStep":
                 raise
-            said = "; ".join(self.messages.kept[-5:]) or "no message"
-            raise UnitFailedError(
-                f"unit {self.name!r}: {fn} failed with "
-                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}",
+            said = "; ".join(dict.fromkeys(self.messages.kept[-5:]))
+            status = FMI_STATUS.get(exc.status, exc.status)
+            raise UnitFailedError(  # the unit's own words name the call, else we do
+                f"unit {self.name!r}: {said}" if said else f"unit {self.name!r}: {fn} failed "
+                f"with {status} and no message",
                 self.name,
             ) from None
         finally:
