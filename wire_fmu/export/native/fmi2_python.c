@@ -510,34 +510,31 @@ fmi2Status fmi2SetupExperiment(fmi2Component handle, fmi2Boolean toleranceDefine
     return call_status(c, "fmi2SetupExperiment", "setup_experiment", args);
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component handle)
+/* The facade's <method>() for an FMI call without arguments. */
+static fmi2Status call_no_arguments(fmi2Component handle, const char *fmi_name,
+                                    const char *method)
 {
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
     PyGILState_STATE gil = PyGILState_Ensure();
     PyObject *args = PyTuple_New(0);
     PyGILState_Release(gil);
-    return call_status(c, "fmi2EnterInitializationMode", "enter_initialization_mode", args);
+    return call_status(c, fmi_name, method, args);
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component handle)
+{
+    return call_no_arguments(handle, "fmi2EnterInitializationMode", "enter_initialization_mode");
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component handle)
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *args = PyTuple_New(0);
-    PyGILState_Release(gil);
-    return call_status(c, "fmi2ExitInitializationMode", "exit_initialization_mode", args);
+    return call_no_arguments(handle, "fmi2ExitInitializationMode", "exit_initialization_mode");
 }
 
 fmi2Status fmi2Terminate(fmi2Component handle)
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *args = PyTuple_New(0);
-    PyGILState_Release(gil);
-    return call_status(c, "fmi2Terminate", "terminate", args);
+    return call_no_arguments(handle, "fmi2Terminate", "terminate");
 }
 
 fmi2Status fmi2Reset(fmi2Component handle)
@@ -659,125 +656,109 @@ static fmi2Status set_values(Component *c, const char *fmi_name, const char *met
     return status;
 }
 
-fmi2Status fmi2GetReal(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
-                       fmi2Real value[])
+static fmi2Status get_all(fmi2Component handle, const char *fmi_name, const char *method,
+                          const fmi2ValueReference vr[], size_t nvr, void *value, Convert convert)
 {
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2GetReal", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2GetReal", value, nvr);
-    return get_values(c, "fmi2GetReal", "get_real", vr, nvr, value, to_real);
+    REQUIRE_ARRAY(c, fmi_name, vr, nvr);
+    REQUIRE_ARRAY(c, fmi_name, value, nvr);
+    return get_values(c, fmi_name, method, vr, nvr, value, convert);
+}
+
+fmi2Status fmi2GetReal(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
+                       fmi2Real value[])
+{
+    return get_all(handle, "fmi2GetReal", "get_real", vr, nvr, value, to_real);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2GetInteger", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2GetInteger", value, nvr);
-    return get_values(c, "fmi2GetInteger", "get_integer", vr, nvr, value, to_integer);
+    return get_all(handle, "fmi2GetInteger", "get_integer", vr, nvr, value, to_integer);
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2GetBoolean", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2GetBoolean", value, nvr);
-    return get_values(c, "fmi2GetBoolean", "get_boolean", vr, nvr, value, to_boolean);
+    return get_all(handle, "fmi2GetBoolean", "get_boolean", vr, nvr, value, to_boolean);
 }
 
 fmi2Status fmi2GetString(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                          fmi2String value[])
 {
+    return get_all(handle, "fmi2GetString", "get_string", vr, nvr, (void *)value, to_string);
+}
+
+typedef PyObject *(*ToPython)(const void *values, size_t i);
+
+static PyObject *from_real(const void *values, size_t i)
+{
+    return PyFloat_FromDouble(((const fmi2Real *)values)[i]);
+}
+
+static PyObject *from_integer(const void *values, size_t i)
+{
+    return PyLong_FromLong(((const fmi2Integer *)values)[i]);
+}
+
+static PyObject *from_boolean(const void *values, size_t i)
+{
+    return PyBool_FromLong(((const fmi2Boolean *)values)[i] != fmi2False);
+}
+
+static PyObject *from_string(const void *values, size_t i)
+{
+    const char *text = ((const fmi2String *)values)[i];
+    text = text ? text : "";
+    return PyUnicode_DecodeUTF8(text, (Py_ssize_t)strlen(text), "replace");
+}
+
+/* The facade's set_<type>(references, values) with the host's values as a list. */
+static fmi2Status set_all(fmi2Component handle, const char *fmi_name, const char *method,
+                          const fmi2ValueReference vr[], size_t nvr, const void *value,
+                          ToPython convert)
+{
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2GetString", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2GetString", value, nvr);
-    return get_values(c, "fmi2GetString", "get_string", vr, nvr, value, to_string);
+    REQUIRE_ARRAY(c, fmi_name, vr, nvr);
+    REQUIRE_ARRAY(c, fmi_name, value, nvr);
+    PyGILState_STATE gil = PyGILState_Ensure();
+    PyObject *values = PyList_New((Py_ssize_t)nvr);
+    for (size_t i = 0; values && i < nvr; ++i) {
+        PyObject *item = convert(value, i);
+        if (item == NULL)
+            Py_CLEAR(values);
+        else
+            PyList_SET_ITEM(values, (Py_ssize_t)i, item);
+    }
+    fmi2Status status = set_values(c, fmi_name, method, vr, nvr, values);
+    PyGILState_Release(gil);
+    return status;
 }
 
 fmi2Status fmi2SetReal(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2SetReal", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2SetReal", value, nvr);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *values = PyList_New((Py_ssize_t)nvr);
-    for (size_t i = 0; values && i < nvr; ++i) {
-        PyObject *item = PyFloat_FromDouble(value[i]);
-        if (item == NULL)
-            Py_CLEAR(values);
-        else
-            PyList_SET_ITEM(values, (Py_ssize_t)i, item);
-    }
-    fmi2Status status = set_values(c, "fmi2SetReal", "set_real", vr, nvr, values);
-    PyGILState_Release(gil);
-    return status;
+    return set_all(handle, "fmi2SetReal", "set_real", vr, nvr, value, from_real);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2SetInteger", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2SetInteger", value, nvr);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *values = PyList_New((Py_ssize_t)nvr);
-    for (size_t i = 0; values && i < nvr; ++i) {
-        PyObject *item = PyLong_FromLong(value[i]);
-        if (item == NULL)
-            Py_CLEAR(values);
-        else
-            PyList_SET_ITEM(values, (Py_ssize_t)i, item);
-    }
-    fmi2Status status = set_values(c, "fmi2SetInteger", "set_integer", vr, nvr, values);
-    PyGILState_Release(gil);
-    return status;
+    return set_all(handle, "fmi2SetInteger", "set_integer", vr, nvr, value, from_integer);
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Boolean value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2SetBoolean", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2SetBoolean", value, nvr);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *values = PyList_New((Py_ssize_t)nvr);
-    for (size_t i = 0; values && i < nvr; ++i)
-        PyList_SET_ITEM(values, (Py_ssize_t)i, PyBool_FromLong(value[i] != fmi2False));
-    fmi2Status status = set_values(c, "fmi2SetBoolean", "set_boolean", vr, nvr, values);
-    PyGILState_Release(gil);
-    return status;
+    return set_all(handle, "fmi2SetBoolean", "set_boolean", vr, nvr, value, from_boolean);
 }
 
 fmi2Status fmi2SetString(fmi2Component handle, const fmi2ValueReference vr[], size_t nvr,
                          const fmi2String value[])
 {
-    Component *c = component_of(handle);
-    REQUIRE_COMPONENT(c);
-    REQUIRE_ARRAY(c, "fmi2SetString", vr, nvr);
-    REQUIRE_ARRAY(c, "fmi2SetString", value, nvr);
-    PyGILState_STATE gil = PyGILState_Ensure();
-    PyObject *values = PyList_New((Py_ssize_t)nvr);
-    for (size_t i = 0; values && i < nvr; ++i) {
-        PyObject *item = PyUnicode_DecodeUTF8(value[i] ? value[i] : "",
-                                              (Py_ssize_t)strlen(value[i] ? value[i] : ""),
-                                              "replace");
-        if (item == NULL)
-            Py_CLEAR(values);
-        else
-            PyList_SET_ITEM(values, (Py_ssize_t)i, item);
-    }
-    fmi2Status status = set_values(c, "fmi2SetString", "set_string", vr, nvr, values);
-    PyGILState_Release(gil);
-    return status;
+    return set_all(handle, "fmi2SetString", "set_string", vr, nvr, value, from_string);
 }
 
 /* ------------------------------------------------------------------------- */
