@@ -338,3 +338,58 @@ def test_draw_of_a_reeving_that_is_not_one_names_the_problem(tmp_path, capsys, r
     assert cli(["draw", "-o", str(tmp_path / "out"), str(path)]) == 1
     out = capsys.readouterr().out
     assert "error:" in out and words in out and "Traceback" not in out
+
+
+@pytest.mark.parametrize("kind", ["device", "pipe", "folder", "huge"])
+def test_a_scene_path_that_is_no_scene_file_is_refused_without_reading_it(tmp_path, fmu_dir, kind):
+    """``/dev/zero`` and a pipe used to hang the check (read to the end, which never comes)."""
+    import os
+
+    path = {
+        "device": Path("/dev/zero"),
+        "pipe": tmp_path / "pipe.toml",
+        "folder": tmp_path / "folder.toml",
+        "huge": tmp_path / "huge.toml",
+    }[kind]
+    if kind == "pipe":
+        os.mkfifo(path)
+    elif kind == "folder":
+        path.mkdir()
+    elif kind == "huge":
+        with path.open("wb") as handle:  # sparse: 17 MiB that take no room
+            handle.truncate(17 * 2**20)
+    problems = problems_of(path, fmu_dir)
+    words = {
+        "device": "character device",
+        "pipe": "a pipe",
+        "folder": "a folder",
+        "huge": "larger than 16 MiB",
+    }[kind]
+    only(problems, "cannot read the scene file", words)
+
+
+@pytest.mark.parametrize(
+    ("name", "words"),
+    [
+        ('"../../evil"', "plain file name"),
+        ('"/abs"', "plain file name"),
+        ("5", "plain file name"),
+    ],
+)
+def test_a_sweep_name_that_is_not_a_plain_file_name_is_refused(tmp_path, name, words):
+    from wire_fmu.sweep import load_sweep_spec
+    from wire_fmu.sweep.spec import SweepSpecError
+
+    path = tmp_path / "sweep.toml"
+    path.write_text(f"name = {name}\n")
+    with pytest.raises(SweepSpecError) as caught:
+        load_sweep_spec(path)
+    assert any(words in p and "'name'" in p for p in caught.value.problems)
+
+
+def test_a_sweep_spec_path_that_is_a_device_is_refused(tmp_path):
+    from wire_fmu.sweep import load_sweep_spec
+    from wire_fmu.sweep.spec import SweepSpecError
+
+    with pytest.raises(SweepSpecError, match="character device"):
+        load_sweep_spec(Path("/dev/zero"))

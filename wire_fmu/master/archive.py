@@ -58,6 +58,7 @@ from pathlib import Path, PurePosixPath
 from typing import IO, BinaryIO
 
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.master.files import UnreadableFileError, open_regular
 
 __all__ = [
     "ArchiveError",
@@ -152,19 +153,12 @@ def _shown(name: str) -> str:
 @contextmanager
 def _open_regular(path: Path, where: str) -> Iterator[BinaryIO]:
     """Open ``path`` for reading, refusing anything but a regular file."""
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
     try:
-        fd = os.open(path, flags)
-    except (OSError, ValueError) as err:
-        raise ArchiveError(where, [f"cannot read the file: {_reason(err)}"]) from None
-    try:
-        kind = os.fstat(fd).st_mode
-        if not stat.S_ISREG(kind):
-            raise ArchiveError(where, ["not a regular file (a zip archive was expected)"])
-        handle = os.fdopen(fd, "rb")
-    except BaseException:
-        os.close(fd)
-        raise
+        handle = open_regular(path)
+    except UnreadableFileError as err:
+        raise ArchiveError(
+            where, [f"cannot read the file: {err} (a zip archive was expected)"]
+        ) from None
     with handle:
         yield handle
 

@@ -84,6 +84,7 @@ from typing import Any
 from wire_fmu.core.errors import ConfigurationError
 
 from .energy_guard import DEFAULT_SHARE
+from .files import UnreadableFileError, read_regular
 
 __all__ = [
     "VarRef",
@@ -100,6 +101,8 @@ __all__ = [
     "parse_scene",
     "read_scene",
     "read_scene_data",
+    "is_plain_name",
+    "MAX_SCENE_BYTES",
     "ALGORITHMS",
     "EXTRAPOLATIONS",
     "BOND_KINDS",
@@ -107,6 +110,8 @@ __all__ = [
 
 ALGORITHMS = ("jacobi", "gauss_seidel")
 EXTRAPOLATIONS = ("constant", "linear", "quadratic")
+MAX_SCENE_BYTES = 16 * 2**20
+"""The largest scene file read (a scene is a few kilobytes; a reeving table a few more)."""
 MAX_ITERATIONS = 1000
 """Most sweeps of one macro step ``run.iterations`` may ask for."""
 BOND_KINDS = {
@@ -322,9 +327,11 @@ def read_scene(path: Path) -> tuple[Scene | None, list[str]]:
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as err:
+        data = tomllib.loads(read_regular(path, MAX_SCENE_BYTES).decode("utf-8"))
+    except UnreadableFileError as err:
         return None, [f"cannot read the scene file: {err}"]
+    except UnicodeDecodeError:
+        return None, ["cannot read the scene file: it is not UTF-8 text"]
     except tomllib.TOMLDecodeError as err:
         return None, [f"not valid TOML: {err}"]
     except RecursionError:
@@ -382,9 +389,14 @@ def read_scene_data(
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,127}")
 
 
+def is_plain_name(name: str) -> bool:
+    """Whether ``name`` can name a folder inside another: letters, digits, ``_-.``, no ``..``."""
+    return bool(_SAFE_NAME.fullmatch(name)) and ".." not in name
+
+
 def _scene_name(name: Any, problems: list[str]) -> str:
     """The scene's name; it names the results folder, so it must be a plain file name."""
-    if isinstance(name, str) and _SAFE_NAME.fullmatch(name) and ".." not in name:
+    if isinstance(name, str) and is_plain_name(name):
         return name
     problems.append(
         f"'name' {name!r}: must be a plain file name (letters, digits, '_', '-', "
@@ -688,8 +700,10 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
     if not isinstance(s.iterations, int) or isinstance(s.iterations, bool) or s.iterations < 1:
         problems.append(f"run.iterations must be an integer >= 1, got {s.iterations!r}")
     elif s.iterations > MAX_ITERATIONS:
-        problems.append(f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
-                        "one step (a coupling that needs more does not converge)")
+        problems.append(
+            f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
+            "one step (a coupling that needs more does not converge)"
+        )
     if not isinstance(s.adaptive, bool):
         problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):

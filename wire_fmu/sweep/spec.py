@@ -81,6 +81,8 @@ import numpy as np
 from scipy.special import ndtri
 
 from wire_fmu.core.errors import ConfigurationError, WireFmuError
+from wire_fmu.master.files import UnreadableFileError, read_regular
+from wire_fmu.master.scene import MAX_SCENE_BYTES, is_plain_name
 
 __all__ = [
     "Axis",
@@ -135,33 +137,60 @@ def _mean(time: np.ndarray, values: np.ndarray) -> float:
     return float(area / span)
 
 
-FUNCTIONS: Mapping[str, Callable[[np.ndarray, np.ndarray], float]] = MappingProxyType({
-    "max": _peak,
-    "min": _low,
-    "absmax": _absmax,
-    "range": _range,
-    "final": _final,
-    "mean": _mean,
-})
+FUNCTIONS: Mapping[str, Callable[[np.ndarray, np.ndarray], float]] = MappingProxyType(
+    {
+        "max": _peak,
+        "min": _low,
+        "absmax": _absmax,
+        "range": _range,
+        "final": _final,
+        "mean": _mean,
+    }
+)
 """Key figure functions: ``f(time, values) -> float`` over the recorded samples."""
 
-DISTRIBUTIONS: Mapping[str, tuple[str, str]] = MappingProxyType({
-    "uniform": ("low", "high"),
-    "log_uniform": ("low", "high"),
-    "normal": ("mean", "std"),
-})
+DISTRIBUTIONS: Mapping[str, tuple[str, str]] = MappingProxyType(
+    {
+        "uniform": ("low", "high"),
+        "log_uniform": ("low", "high"),
+        "normal": ("mean", "std"),
+    }
+)
 """Distribution of a sampled axis -> the two keys that parametrise it."""
 
 SAMPLING_METHODS = ("latin_hypercube", "random")
 TARGET_ROOTS = ("units", "drivers", "events", "run")
 GRID_KEYS = ("values", "linspace", "logspace")
-RESERVED_COLUMNS = frozenset({"case_id", "index", "status", "error", "wall_time", "end_time",
-                              "worker", "attempts", "finished_at"})
+RESERVED_COLUMNS = frozenset(
+    {
+        "case_id",
+        "index",
+        "status",
+        "error",
+        "wall_time",
+        "end_time",
+        "worker",
+        "attempts",
+        "finished_at",
+    }
+)
 """Columns every summary row has; a key figure may not take one of these names."""
 
 _TOP_KEYS = frozenset({"name", "description", "axes", "sampling", "figures"})
-_AXIS_KEYS = frozenset({"target", "values", "linspace", "logspace", "distribution", "low", "high",
-                        "mean", "std", "integer"})
+_AXIS_KEYS = frozenset(
+    {
+        "target",
+        "values",
+        "linspace",
+        "logspace",
+        "distribution",
+        "low",
+        "high",
+        "mean",
+        "std",
+        "integer",
+    }
+)
 _SAMPLING_KEYS = frozenset({"samples", "method", "seed"})
 _FIGURE_RE = re.compile(r"""^\s*([A-Za-z_]+)\s*\(\s*(["']?)([^"'()\s]+)\2\s*\)\s*$""")
 
@@ -348,11 +377,15 @@ def load_sweep_spec(path: Path) -> SweepSpec:
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except OSError as err:
+        data = tomllib.loads(read_regular(path, MAX_SCENE_BYTES).decode("utf-8"))
+    except UnreadableFileError as err:
         raise SweepSpecError(str(path), [f"cannot read the sweep spec: {err}"]) from None
+    except UnicodeDecodeError:
+        raise SweepSpecError(str(path), ["cannot read the sweep spec: not UTF-8 text"]) from None
     except tomllib.TOMLDecodeError as err:
         raise SweepSpecError(str(path), [f"not valid TOML: {err}"]) from None
+    except RecursionError:
+        raise SweepSpecError(str(path), ["nested too deeply to be a sweep spec"]) from None
     return parse_sweep_spec(data, source=path)
 
 
@@ -373,11 +406,24 @@ def parse_sweep_spec(data: Mapping[str, Any], *, source: Path | None = None) -> 
     axes = _parse_axes(data.get("axes"), problems)
     sampling = _parse_sampling(data.get("sampling"), axes, problems)
     figures = _parse_figures(data.get("figures", {}), problems)
-    name = str(data.get("name", source.stem if source else "sweep"))
+    name = data.get("name", source.stem if source else "sweep")
+    if not (isinstance(name, str) and is_plain_name(name)):
+        problems.append(
+            f"'name' {name!r}: must be a plain file name (letters, digits, '_', "
+            "'-', '.', no '..'), since it names the sweep's results folder"
+        )
+        name = "sweep"
     if problems:
         raise SweepSpecError(f"sweep spec {name!r}", problems)
-    return SweepSpec(tuple(axes), tuple(figures), sampling, name,
-                     str(data.get("description", "")), source, dict(data))
+    return SweepSpec(
+        tuple(axes),
+        tuple(figures),
+        sampling,
+        name,
+        str(data.get("description", "")),
+        source,
+        dict(data),
+    )
 
 
 # -- axes -----------------------------------------------------------------------------
@@ -399,36 +445,48 @@ def _kind_of(values: tuple[Any, ...]) -> str:
 
 def _check_target(target: Any, where: str, problems: list[str]) -> bool:
     if not isinstance(target, str) or "." not in target:
-        problems.append(f"{where}: 'target' must be a dotted path such as "
-                        f"'units.<unit>.parameters.<name>', got {target!r}")
+        problems.append(
+            f"{where}: 'target' must be a dotted path such as "
+            f"'units.<unit>.parameters.<name>', got {target!r}"
+        )
         return False
     root, _, rest = target.partition(".")
     if root not in TARGET_ROOTS:
-        problems.append(f"{where}: target {target!r} must start with one of "
-                        f"{', '.join(TARGET_ROOTS)}")
+        problems.append(
+            f"{where}: target {target!r} must start with one of {', '.join(TARGET_ROOTS)}"
+        )
         return False
     parts = rest.split(".")
     shapes = {
         "units": len(parts) >= 3 and parts[1] == "parameters" or parts[1:] == ["effects"],
         "drivers": len(parts) >= 2 and parts[0].isdigit(),
-        "events": parts[0].isdigit() and (parts[1:] == ["time"] or (
-            len(parts) >= 4 and parts[1] == "set")),
+        "events": parts[0].isdigit()
+        and (parts[1:] == ["time"] or (len(parts) >= 4 and parts[1] == "set")),
         "run": len(parts) == 1,
     }
     if not shapes[root]:
-        problems.append(f"{where}: target {target!r} must read 'units.<unit>.parameters.<name>', "
-                        "'units.<unit>.effects', 'drivers.<i>.<key>', 'events.<i>.time', "
-                        "'events.<i>.set.<unit>.<input>' or 'run.<setting>'")
+        problems.append(
+            f"{where}: target {target!r} must read 'units.<unit>.parameters.<name>', "
+            "'units.<unit>.effects', 'drivers.<i>.<key>', 'events.<i>.time', "
+            "'events.<i>.set.<unit>.<input>' or 'run.<setting>'"
+        )
         return False
     return True
 
 
 def _spaced(spec: Mapping[str, Any], key: str, where: str, problems: list[str]) -> list[float]:
     raw = spec[key]
-    if (not isinstance(raw, list) or len(raw) != 3 or not all(_number(v) for v in raw[:2])
-            or not isinstance(raw[2], int) or isinstance(raw[2], bool) or raw[2] < 1):
-        problems.append(f"{where}: '{key}' must be [start, stop, count] with a whole count >= 1, "
-                        f"got {raw!r}")
+    if (
+        not isinstance(raw, list)
+        or len(raw) != 3
+        or not all(_number(v) for v in raw[:2])
+        or not isinstance(raw[2], int)
+        or isinstance(raw[2], bool)
+        or raw[2] < 1
+    ):
+        problems.append(
+            f"{where}: '{key}' must be [start, stop, count] with a whole count >= 1, got {raw!r}"
+        )
         return []
     start, stop, count = raw
     if key == "logspace":
@@ -439,8 +497,9 @@ def _spaced(spec: Mapping[str, Any], key: str, where: str, problems: list[str]) 
     return [float(v) for v in np.linspace(start, stop, count)]
 
 
-def _grid_values(spec: Mapping[str, Any], key: str, where: str,
-                 problems: list[str]) -> tuple[Any, ...]:
+def _grid_values(
+    spec: Mapping[str, Any], key: str, where: str, problems: list[str]
+) -> tuple[Any, ...]:
     integer = spec.get("integer", False) is True
     if key != "values":
         values = _spaced(spec, key, where, problems)
@@ -458,12 +517,14 @@ def _grid_values(spec: Mapping[str, Any], key: str, where: str,
     return tuple(values)
 
 
-def _distribution(spec: Mapping[str, Any], where: str,
-                  problems: list[str]) -> tuple[str | None, tuple[float, ...]]:
+def _distribution(
+    spec: Mapping[str, Any], where: str, problems: list[str]
+) -> tuple[str | None, tuple[float, ...]]:
     name = spec["distribution"]
     if name not in DISTRIBUTIONS:
-        problems.append(f"{where}: 'distribution' must be one of {', '.join(DISTRIBUTIONS)}, "
-                        f"got {name!r}")
+        problems.append(
+            f"{where}: 'distribution' must be one of {', '.join(DISTRIBUTIONS)}, got {name!r}"
+        )
         return None, ()
     keys = DISTRIBUTIONS[name]
     args = [spec.get(k) for k in keys]
@@ -496,16 +557,23 @@ def _parse_axis(i: int, spec: Any, problems: list[str]) -> Axis | None:
         problems.append(f"{where}: 'integer' must be true or false")
     given = [k for k in (*GRID_KEYS, "distribution") if k in spec]
     if len(given) != 1:
-        problems.append(f"{where}: give exactly one of 'values', 'linspace', 'logspace' or "
-                        f"'distribution', got {given or 'none'}")
+        problems.append(
+            f"{where}: give exactly one of 'values', 'linspace', 'logspace' or "
+            f"'distribution', got {given or 'none'}"
+        )
         return None
     key, integer = given[0], spec.get("integer", False) is True
     if key == "distribution":
         distribution, arguments = _distribution(spec, where, problems)
         if distribution is None or not ok:
             return None
-        return Axis(target, distribution=distribution, arguments=arguments, integer=integer,
-                    log_scale=distribution == "log_uniform")
+        return Axis(
+            target,
+            distribution=distribution,
+            arguments=arguments,
+            integer=integer,
+            log_scale=distribution == "log_uniform",
+        )
     values = _grid_values(spec, key, where, problems)
     _check_duplicates(values, where, problems)
     if not values or not ok:
@@ -536,26 +604,30 @@ def _parse_sampling(data: Any, axes: list[Axis], problems: list[str]) -> Samplin
     sampled = [a.target for a in axes if not a.is_grid]
     if data is None:
         if sampled:
-            problems.append(f"axes {sampled} are sampled: the spec needs [sampling] with "
-                            "'samples'")
+            problems.append(f"axes {sampled} are sampled: the spec needs [sampling] with 'samples'")
         return None
     if not isinstance(data, Mapping):
         problems.append("[sampling] must be a table")
         return None
     unknown = set(data) - _SAMPLING_KEYS
     if unknown:
-        problems.append(f"sampling: unknown keys {sorted(unknown)}; known: "
-                        f"{sorted(_SAMPLING_KEYS)}")
+        problems.append(
+            f"sampling: unknown keys {sorted(unknown)}; known: {sorted(_SAMPLING_KEYS)}"
+        )
     if not sampled:
         problems.append("[sampling] is given but no axis has a 'distribution'")
-    samples, method, seed = data.get("samples"), data.get("method", "latin_hypercube"), data.get(
-        "seed", 0)
+    samples, method, seed = (
+        data.get("samples"),
+        data.get("method", "latin_hypercube"),
+        data.get("seed", 0),
+    )
     if not isinstance(samples, int) or isinstance(samples, bool) or samples < 1:
         problems.append(f"sampling.samples must be a whole number >= 1, got {samples!r}")
         return None
     if method not in SAMPLING_METHODS:
-        problems.append(f"sampling.method must be one of {', '.join(SAMPLING_METHODS)}, "
-                        f"got {method!r}")
+        problems.append(
+            f"sampling.method must be one of {', '.join(SAMPLING_METHODS)}, got {method!r}"
+        )
         return None
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         problems.append(f"sampling.seed must be a whole number >= 0, got {seed!r}")
@@ -569,12 +641,16 @@ def _parse_figure(name: str, text: Any, problems: list[str]) -> Figure | None:
     if not name.isidentifier():
         problems.append(f"{where}: a figure name must be an identifier (letters, digits, _)")
     elif name in RESERVED_COLUMNS:
-        problems.append(f"{where}: the name is a summary column already; reserved: "
-                        f"{', '.join(sorted(RESERVED_COLUMNS))}")
+        problems.append(
+            f"{where}: the name is a summary column already; reserved: "
+            f"{', '.join(sorted(RESERVED_COLUMNS))}"
+        )
     match = _FIGURE_RE.match(text) if isinstance(text, str) else None
     if match is None:
-        problems.append(f"{where}: must read 'function(unit.variable)', e.g. "
-                        f"'max(rope.path_end.tension)', got {text!r}")
+        problems.append(
+            f"{where}: must read 'function(unit.variable)', e.g. "
+            f"'max(rope.path_end.tension)', got {text!r}"
+        )
         return None
     function, _, column = match.groups()
     if function not in FUNCTIONS:
@@ -588,7 +664,7 @@ def _parse_figure(name: str, text: Any, problems: list[str]) -> Figure | None:
 
 def _parse_figures(data: Any, problems: list[str]) -> list[Figure]:
     if not isinstance(data, Mapping):
-        problems.append("[figures] must be a table of name = \"function(unit.variable)\"")
+        problems.append('[figures] must be a table of name = "function(unit.variable)"')
         return []
     figures = [_parse_figure(str(name), text, problems) for name, text in data.items()]
     return [f for f in figures if f is not None]
