@@ -82,8 +82,6 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .files import file_kind
-
 __all__ = [
     "Driver",
     "DriverKind",
@@ -814,6 +812,20 @@ def _shown_path(path: Path) -> str:
     return text if len(text) <= 200 else f"{text[:100]}...{text[-60:]}"
 
 
+def _file_kind(mode: int) -> str:
+    # this module is also bundled alone into the signals FMU: stdlib and numpy only
+    for test, kind in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISFIFO, "a pipe"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return kind
+    return "not a regular file"
+
+
 def _read_table_bytes(path: Path, shown: str, r: _Reader) -> bytes | None:
     """The bytes of a regular file of at most :data:`MAX_TABLE_BYTES` (None after a problem).
 
@@ -830,7 +842,7 @@ def _read_table_bytes(path: Path, shown: str, r: _Reader) -> bytes | None:
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            r.add(f"table file '{shown}' is {file_kind(info.st_mode)}; expected {_EXPECTED_TABLE}")
+            r.add(f"table file '{shown}' is {_file_kind(info.st_mode)}; expected {_EXPECTED_TABLE}")
             return None
         if info.st_size > MAX_TABLE_BYTES:
             r.add(
