@@ -21,6 +21,7 @@ from pathlib import Path
 
 from wire_fmu.core.errors import WireFmuError
 from wire_fmu.export.builder import BuildError, build_fmu
+from wire_fmu.registry import MODELS_DIR, UNIT_TYPES
 
 ROOT = Path(__file__).resolve().parent
 logger = logging.getLogger("build_fmus")
@@ -29,6 +30,13 @@ logger = logging.getLogger("build_fmus")
 def facade_scripts(models: Path) -> list[Path]:
     """Facade scripts in ``models``: ``*.py`` not starting with ``_``, sorted."""
     return sorted(p for p in models.glob("*.py") if not p.name.startswith("_"))
+
+
+def unregistered(scripts: Sequence[Path]) -> list[str]:
+    """Scripts in our ``models/`` that :mod:`wire_fmu.registry` does not list (one message each)."""
+    registered = {u.facade_path.resolve() for u in UNIT_TYPES}
+    return [f"{p}: not in wire_fmu.registry.UNIT_TYPES; add its line there" for p in scripts
+            if p.resolve().parent == MODELS_DIR.resolve() and p.resolve() not in registered]
 
 
 def build_one(script: Path, out: Path, built: dict[Path, Path]) -> Path:
@@ -67,7 +75,8 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     """Command-line options."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "dist" / "fmus", help="output folder")
-    parser.add_argument("--models", type=Path, default=ROOT / "models", help="facade scripts")
+    parser.add_argument("--models", type=Path, default=MODELS_DIR,
+                        help="facade scripts (default: ours, each listed in wire_fmu.registry)")
     return parser.parse_args(argv)
 
 
@@ -76,6 +85,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(message)s")
     scripts = facade_scripts(args.models)
+    problems = unregistered(scripts)
+    if problems:
+        for problem in problems:
+            logger.error("%s", problem)
+        return 1
     if not scripts:
         logger.warning("no facade scripts in %s; nothing to build", args.models)
         return 0

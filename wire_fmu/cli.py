@@ -120,8 +120,10 @@ def cmd_draw(args: argparse.Namespace) -> int:
             try:
                 reeving = json.loads(reeving)
             except ValueError as exc:
-                raise SceneError(f"scene {scene.name!r}", [
-                    f"unit {name!r}: parameter 'reeving' is not JSON ({exc})"]) from None
+                raise SceneError(
+                    f"scene {scene.name!r}",
+                    [f"unit {name!r}: parameter 'reeving' is not JSON ({exc})"],
+                ) from None
         path = draw_reeving(reeving, out / f"{name}_reeving.png", title=f"{scene.name}: {name}")
         _print(f"drawn: {path.resolve()}")
         drawn += 1
@@ -132,12 +134,13 @@ def cmd_draw(args: argparse.Namespace) -> int:
 
 def cmd_build(args: argparse.Namespace) -> int:
     """Build our FMUs into a folder."""
-    from wire_fmu.master.catalog import OUR_FMUS, ROOT, ensure_built
+    from wire_fmu.master.catalog import ensure_built
+    from wire_fmu.registry import UNIT_TYPES
 
-    for name, script in OUR_FMUS.items():
-        path = ROOT / "models" / script
-        if path.exists():
-            _print(f"{name}: {ensure_built(name, path, args.output or args.fmu_dir)}")
+    for unit in UNIT_TYPES:
+        if unit.facade_path.exists():
+            path = ensure_built(unit.name, unit.facade_path, args.output or args.fmu_dir)
+            _print(f"{unit.name}: {path}")
     return 0
 
 

@@ -7,8 +7,8 @@ FMU (fmpy, in this process) and returns a :class:`Row`.
 
 The FMU runs in this process and uses the ``wire_fmu`` already imported
 here, so the time spent inside the unit's ``advance`` during the FMU run is
-measured too; the FMI overhead is the rest of the FMU's time (pythonfmu's
-C++ and Python layers, the facade, fmpy's ctypes calls). Times are medians
+measured too; the FMI overhead is the rest of the FMU's time (our FMU
+binary, pythonfmu's slave class, the facade, fmpy's ctypes calls). Times are medians
 over the steps (wall clock, ``time.perf_counter``) after a warm-up.
 """
 
@@ -189,17 +189,21 @@ def command_line(description: str, argv: list[str] | None) -> argparse.Namespace
     parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
     args = parser.parse_args(argv)
+    if args.steps <= WARM_UP:
+        parser.error(f"--steps must be more than the {WARM_UP} warm-up steps, got {args.steps}")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return args
 
 
-def run_cases(script: str, cases: Sequence[Case], steps: int, title: str) -> str:
-    """Build ``models/<script>`` into a temporary folder, measure every case, log the table."""
+def run_cases(unit: str, cases: Sequence[Case], steps: int, title: str) -> str:
+    """Build our unit type ``unit`` (:mod:`wire_fmu.registry`) into a temporary folder, measure
+    every case, log the table."""
     from wire_fmu.export.builder import build_fmu
+    from wire_fmu.registry import unit_type
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_fmu(ROOT / "models" / script, Path(tmp))
+        fmu = build_fmu(unit_type(unit).facade_path, Path(tmp))
         for case in cases:
             rows.append(measure(fmu, case, steps))
             logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,

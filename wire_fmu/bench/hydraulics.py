@@ -57,7 +57,7 @@ def cases() -> list[Case]:
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases("hydraulics.py", cases(), args.steps,
+    text = run_cases("Hydraulics", cases(), args.steps,
                      f"Riser-tensioner cylinder, ros2, max internal step 1 ms, "
                      f"communication step {STEP:g} s")
     if args.out:

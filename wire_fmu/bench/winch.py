@@ -99,7 +99,7 @@ def accuracy_table(steps: int) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases("winch.py", cases(), args.steps,
+    text = run_cases("Winch", cases(), args.steps,
                      f"Winch (default drawworks drive train), max internal step 1 ms, "
                      f"communication step {STEP:g} s")
     accuracy = accuracy_table(args.steps)

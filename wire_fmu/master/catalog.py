@@ -12,9 +12,11 @@ from __future__ import annotations
 import logging
 import zipfile
 from pathlib import Path
+from types import MappingProxyType
 
 from wire_fmu._fingerprint import fingerprint, package_dir
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo
+from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 __all__ = ["OUR_FMUS", "ROOT", "DEFAULT_FMU_DIR", "resolve_fmu", "is_ours", "ensure_built"]
 
@@ -22,15 +24,8 @@ logger = logging.getLogger(__name__)
 
 ROOT = package_dir().parent
 DEFAULT_FMU_DIR = ROOT / "dist" / "fmus"
-OUR_FMUS = {
-    "BlockTrain": "block_train.py",
-    "Winch": "winch.py",
-    "Hydraulics": "hydraulics.py",
-    "ScissorJack": "scissor_jack.py",
-    "MultiMassDrive": "drive.py",
-    "MachineUnit": "machine_unit.py",
-}
-"""Model name -> facade script in ``models/``."""
+OUR_FMUS = MappingProxyType({u.name: u.facade for u in UNIT_TYPES})
+"""Model name -> facade script in ``models/`` (from :mod:`wire_fmu.registry`)."""
 
 
 def is_ours(fmu: str) -> bool:
@@ -38,14 +33,15 @@ def is_ours(fmu: str) -> bool:
     return fmu in OUR_FMUS
 
 
-def resolve_fmu(fmu: str, base_dir: Path, fmu_dir: Path = DEFAULT_FMU_DIR) -> tuple[Path | None,
-                                                                                    str | None]:
+def resolve_fmu(
+    fmu: str, base_dir: Path, fmu_dir: Path = DEFAULT_FMU_DIR
+) -> tuple[Path | None, str | None]:
     """The FMU file for a scene's ``fmu`` entry, building ours if needed.
 
     Returns ``(path, None)`` or ``(None, problem)``.
     """
     if is_ours(fmu):
-        script = ROOT / "models" / OUR_FMUS[fmu]
+        script = BY_NAME[fmu].facade_path
         if not script.exists():
             return None, f"our FMU {fmu!r} has no facade script {script}"
         return ensure_built(fmu, script, fmu_dir), None
@@ -71,8 +67,9 @@ def _recorded_fingerprint(path: Path) -> str | None:
         return None
     import json
 
-    return BuildInfo(**{k: str(v) for k, v in json.loads(data).items()
-                        if k in BuildInfo.__dataclass_fields__}).fingerprint
+    return BuildInfo(
+        **{k: str(v) for k, v in json.loads(data).items() if k in BuildInfo.__dataclass_fields__}
+    ).fingerprint
 
 
 def ensure_built(name: str, script: Path, fmu_dir: Path) -> Path:

@@ -17,11 +17,11 @@ for the co-simulation and the speed floor it is compared with.
 
 from __future__ import annotations
 
-import importlib
 import logging
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
@@ -30,25 +30,18 @@ from wire_fmu.core.interface import Causality, OdeView, Unit
 from wire_fmu.master.algorithms import step_order
 from wire_fmu.master.manipulators import DriverSet, ScheduledEvents
 from wire_fmu.master.scene import Scene, SceneError, VarRef
+from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 __all__ = ["CORE_UNITS", "MonolithicModel", "MonolithicResult", "run_monolithic"]
 
 logger = logging.getLogger(__name__)
 
-CORE_UNITS = {
-    "BlockTrain": "wire_fmu.core.block_train_unit:BlockTrainUnit",
-    "Winch": "wire_fmu.core.winch_unit:WinchUnit",
-    "Hydraulics": "wire_fmu.core.hydraulics_unit:HydraulicsUnit",
-    "ScissorJack": "wire_fmu.core.scissor_jack_unit:ScissorJackUnit",
-    "MultiMassDrive": "wire_fmu.core.drive_unit:DriveUnit",
-    "MachineUnit": "wire_fmu.core.machine_drive_unit:MachineDriveUnit",
-}
-"""FMU model name -> core unit class (module:class)."""
+CORE_UNITS = MappingProxyType({u.name: u.core for u in UNIT_TYPES})
+"""FMU model name -> core unit class (module:class), from :mod:`wire_fmu.registry`."""
 
 
 def _core_class(name: str) -> type[Unit]:
-    module, _, cls = CORE_UNITS[name].partition(":")
-    return getattr(importlib.import_module(module), cls)
+    return BY_NAME[name].core_class()
 
 
 @dataclass
@@ -84,8 +77,11 @@ class MonolithicModel:
     """
 
     def __init__(self, scene: Scene) -> None:
-        problems = [f"unit {n!r}: {u.fmu!r} is not one of ours ({', '.join(CORE_UNITS)})"
-                    for n, u in scene.units.items() if u.fmu not in CORE_UNITS]
+        problems = [
+            f"unit {n!r}: {u.fmu!r} is not one of ours ({', '.join(CORE_UNITS)})"
+            for n, u in scene.units.items()
+            if u.fmu not in CORE_UNITS
+        ]
         if problems:
             raise SceneError(f"scene {scene.name!r} (monolithic)", problems)
         self.scene = scene
@@ -154,8 +150,7 @@ class MonolithicModel:
         unit = self.units[name]
         for c in self.into.get(name, ()):
             if only is None or c.source.unit in only:
-                unit.values[c.target.variable] = self.units[c.source.unit].values[
-                    c.source.variable]
+                unit.values[c.target.variable] = self.units[c.source.unit].values[c.source.variable]
 
     def _propagate(self, t: float, x: np.ndarray) -> None:
         """Outputs from states, inputs from outputs, in step order."""
@@ -168,8 +163,10 @@ class MonolithicModel:
             view.bind_inputs(t)
             view.publish(t, x[self.slices[name]])
         for name in self.order:  # inputs fed by units later in the order
-            if any(self.order.index(c.source.unit) >= self.order.index(name)
-                   for c in self.into.get(name, ())):
+            if any(
+                self.order.index(c.source.unit) >= self.order.index(name)
+                for c in self.into.get(name, ())
+            ):
                 self._feed(name)
                 self.views[name].bind_inputs(t)
 
@@ -182,8 +179,13 @@ class MonolithicModel:
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
         """Every unit's guards."""
         self._propagate(t, x)
-        return np.concatenate([np.asarray(self.views[n].guards(t, x[self.slices[n]]))
-                               for n in self.order]) if self.order else np.zeros(0)
+        return (
+            np.concatenate(
+                [np.asarray(self.views[n].guards(t, x[self.slices[n]])) for n in self.order]
+            )
+            if self.order
+            else np.zeros(0)
+        )
 
     def guard_directions(self) -> np.ndarray:
         """Every unit's guard directions."""
@@ -197,10 +199,12 @@ class MonolithicModel:
             g = self._guard_slices[name]
             local = [i - g.start for i in fired if g.start <= i < g.stop]
             if local:
-                x[self.slices[name]] = self.views[name].handle_events(t, x[self.slices[name]],
-                                                                      local)
-        self._dirs = np.concatenate([np.asarray(self.views[n].guard_directions(), dtype=float)
-                                     for n in self.order])
+                x[self.slices[name]] = self.views[name].handle_events(
+                    t, x[self.slices[name]], local
+                )
+        self._dirs = np.concatenate(
+            [np.asarray(self.views[n].guard_directions(), dtype=float) for n in self.order]
+        )
         return x
 
     def project(self, x: np.ndarray) -> np.ndarray:
@@ -228,16 +232,26 @@ def _recorded(model: MonolithicModel) -> list[VarRef]:
     if scene.outputs is not None:
         refs = list(scene.outputs)
     else:
-        refs = [VarRef(n, v.name) for n, u in model.units.items() for v in u.VARIABLES
-                if v.causality is Causality.output and v.type is float]
+        refs = [
+            VarRef(n, v.name)
+            for n, u in model.units.items()
+            for v in u.VARIABLES
+            if v.causality is Causality.output and v.type is float
+        ]
     for plot in scene.plots:
         refs += [r for r in plot.variables if r not in refs]
     return refs
 
 
-def run_monolithic(scene: Scene, *, method: str = "radau", rtol: float = 1e-10,
-                   atol: float = 1e-10, output_interval: float | None = None,
-                   max_step: float = np.inf) -> MonolithicResult:
+def run_monolithic(
+    scene: Scene,
+    *,
+    method: str = "radau",
+    rtol: float = 1e-10,
+    atol: float = 1e-10,
+    output_interval: float | None = None,
+    max_step: float = np.inf,
+) -> MonolithicResult:
     """Solve ``scene`` as one ODE and record its outputs.
 
     Parameters
@@ -276,7 +290,12 @@ def run_monolithic(scene: Scene, *, method: str = "radau", rtol: float = 1e-10,
         rows.append(model.outputs(t, x, refs))
     wall = time.perf_counter() - start
     data = np.array(rows)
-    return MonolithicResult(times, {str(r): data[:, i] for i, r in enumerate(refs)}, wall,
-                            solver.rhs_calls, solver.steps, events, [str(r) for r in refs])
-
-
+    return MonolithicResult(
+        times,
+        {str(r): data[:, i] for i, r in enumerate(refs)},
+        wall,
+        solver.rhs_calls,
+        solver.steps,
+        events,
+        [str(r) for r in refs],
+    )
