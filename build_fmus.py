@@ -35,8 +35,11 @@ def facade_scripts(models: Path) -> list[Path]:
 def unregistered(scripts: Sequence[Path]) -> list[str]:
     """Scripts in our ``models/`` that :mod:`wire_fmu.registry` does not list (one message each)."""
     registered = {u.facade_path.resolve() for u in UNIT_TYPES}
-    return [f"{p}: not in wire_fmu.registry.UNIT_TYPES; add its line there" for p in scripts
-            if p.resolve().parent == MODELS_DIR.resolve() and p.resolve() not in registered]
+    return [
+        f"{p}: not in wire_fmu.registry.UNIT_TYPES; add its line there"
+        for p in scripts
+        if p.resolve().parent == MODELS_DIR.resolve() and p.resolve() not in registered
+    ]
 
 
 def build_one(script: Path, out: Path, built: dict[Path, Path]) -> Path:
@@ -75,8 +78,12 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     """Command-line options."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "dist" / "fmus", help="output folder")
-    parser.add_argument("--models", type=Path, default=MODELS_DIR,
-                        help="facade scripts (default: ours, each listed in wire_fmu.registry)")
+    parser.add_argument(
+        "--models",
+        type=Path,
+        default=MODELS_DIR,
+        help="facade scripts (default: ours, each listed in wire_fmu.registry)",
+    )
     return parser.parse_args(argv)
 
 

@@ -57,14 +57,17 @@ LEDGER_FLOOR = 1e-9
 
 def build_our_fmus(directory: Path) -> dict[str, Path]:
     """Build the hoisting units' FMUs from ``models/`` into ``directory``; paths by name."""
-    return {name: build_fmu(ROOT / "models" / OUR_FMUS[name], directory)
-            for name in HOISTING_UNITS}
+    return {name: build_fmu(ROOT / "models" / OUR_FMUS[name], directory) for name in HOISTING_UNITS}
 
 
 def rigid_drum(inertia: float) -> str:
     """A winch drive train of one mass (the drum, no damping) as the JSON parameter."""
-    return json.dumps({"masses": [{"name": "drum", "inertia": inertia, "damping": 0.0,
-                                   "ratio": 1.0}], "shafts": []})
+    return json.dumps(
+        {
+            "masses": [{"name": "drum", "inertia": inertia, "damping": 0.0, "ratio": 1.0}],
+            "shafts": [],
+        }
+    )
 
 
 @dataclass
@@ -102,8 +105,9 @@ class CaseRun:
         return json.loads((self.directory / "metadata.json").read_text())
 
 
-def master_scene(data: Mapping[str, Any], fmus: Mapping[str, Path], base_dir: Path,
-                 **run_settings: Any) -> Scene:
+def master_scene(
+    data: Mapping[str, Any], fmus: Mapping[str, Path], base_dir: Path, **run_settings: Any
+) -> Scene:
     """Parse ``data`` with our units replaced by the built FMUs and run settings overridden."""
     data = copy.deepcopy(dict(data))
     data["run"] = {**data.get("run", {}), **run_settings}
@@ -113,8 +117,9 @@ def master_scene(data: Mapping[str, Any], fmus: Mapping[str, Path], base_dir: Pa
     return parse_scene(data, base_dir=base_dir)
 
 
-def run_case(data: Mapping[str, Any], fmus: Mapping[str, Path], directory: Path,
-             **run_settings: Any) -> CaseRun:
+def run_case(
+    data: Mapping[str, Any], fmus: Mapping[str, Path], directory: Path, **run_settings: Any
+) -> CaseRun:
     """Validate (through FMI too) and run ``data`` in our master; read back its results.
 
     Parameters
@@ -150,16 +155,21 @@ def error_against(run: CaseRun, ref: MonolithicResult, column: str) -> float:
 # --------------------------------------------------------------- global criteria
 def units_with_ledgers(columns: Mapping[str, np.ndarray]) -> list[str]:
     """Units whose ``energy_balance`` was recorded."""
-    return [name[: -len(".energy_balance")] for name in columns
-            if name.endswith(".energy_balance") and name.count(".") == 1]
+    return [
+        name[: -len(".energy_balance")]
+        for name in columns
+        if name.endswith(".energy_balance") and name.count(".") == 1
+    ]
 
 
 def _throughput(columns: Mapping[str, np.ndarray], unit: str) -> float:
     """Energy that went through ``unit``: |external work| + dissipated + stored swing, J."""
     total = 0.0
-    for name, reduce in (("external_work", lambda v: np.max(np.abs(v))),
-                         ("dissipated_energy", lambda v: np.max(np.abs(v))),
-                         ("stored_energy", np.ptp)):
+    for name, reduce in (
+        ("external_work", lambda v: np.max(np.abs(v))),
+        ("dissipated_energy", lambda v: np.max(np.abs(v))),
+        ("stored_energy", np.ptp),
+    ):
         key = f"{unit}.{name}"
         if key in columns and columns[key].size:
             total += float(reduce(columns[key]))
@@ -173,20 +183,24 @@ def _assert_finite(columns: Mapping[str, np.ndarray]) -> None:
 
 def _allowances(columns, tolerance: float, energy_scale: float | None) -> dict[str, float]:
     """Numerical error each unit may show: ``tolerance`` x its energy scale (+ round-off), J."""
-    return {unit: tolerance * (energy_scale if energy_scale is not None
-                               else _throughput(columns, unit)) + LEDGER_FLOOR
-            for unit in units_with_ledgers(columns)}
+    return {
+        unit: tolerance * (energy_scale if energy_scale is not None else _throughput(columns, unit))
+        + LEDGER_FLOOR
+        for unit in units_with_ledgers(columns)
+    }
 
 
 def _assert_ledgers(columns, allowances: Mapping[str, float]) -> None:
     for unit, allowed in allowances.items():
         residual = float(np.max(np.abs(columns[f"{unit}.energy_balance"])))
         assert residual <= allowed, (
-            f"{unit}: energy ledger residual {residual:.4g} J exceeds {allowed:.4g} J")
+            f"{unit}: energy ledger residual {residual:.4g} J exceeds {allowed:.4g} J"
+        )
 
 
-def _assert_invariants(columns, dead_volumes: Mapping[str, float],
-                       allowances: Mapping[str, float]) -> None:
+def _assert_invariants(
+    columns, dead_volumes: Mapping[str, float], allowances: Mapping[str, float]
+) -> None:
     for name, values in columns.items():
         unit, _, variable = name.partition(".")
         if variable.endswith("tension") or variable == "tension_max":
@@ -200,12 +214,14 @@ def _assert_invariants(columns, dead_volumes: Mapping[str, float],
             allowed = allowances.get(unit, LEDGER_FLOOR)
             assert decrease <= allowed, (
                 f"{name} decreased by {decrease:.4g} J in all (allowed {allowed:.4g} J): "
-                "friction or damping injected energy")
+                "friction or damping injected energy"
+            )
         elif variable.endswith("pressure"):
             assert np.min(values) > 0.0, f"{name} <= 0 ({np.min(values):.6g} Pa)"
         elif variable == "gas.volume" and unit in dead_volumes:
             assert np.min(values) > dead_volumes[unit], (
-                f"{name} reached its dead volume {dead_volumes[unit]} m3")
+                f"{name} reached its dead volume {dead_volumes[unit]} m3"
+            )
         elif variable == "end_stop.force" and f"{unit}.stroke_used" in columns:
             # a stop pushes away from its end: down at extension, up at retraction
             away = np.where(columns[f"{unit}.stroke_used"] > 0.5, -1.0, 1.0)
@@ -213,7 +229,8 @@ def _assert_invariants(columns, dead_volumes: Mapping[str, float],
         elif variable == "brake.torque" and f"{unit}.drum.speed" in columns:
             power = values * columns[f"{unit}.drum.speed"]
             assert np.max(power) <= 1e-9 * max(1.0, float(np.max(np.abs(values)))), (
-                f"{name}: the brake drove the drum (friction injected power)")
+                f"{name}: the brake drove the drum (friction injected power)"
+            )
 
 
 def _assert_passive(columns, allowances: Mapping[str, float]) -> None:
@@ -228,9 +245,14 @@ def _assert_passive(columns, allowances: Mapping[str, float]) -> None:
     assert gain <= allowed, f"passive scene gained {gain:.4g} J of energy (allowed {allowed:.4g} J)"
 
 
-def check_global_criteria(columns: Mapping[str, np.ndarray], *, ledger_tolerance: float,
-                          energy_scale: float | None = None, passive: bool = False,
-                          dead_volumes: Mapping[str, float] | None = None) -> None:
+def check_global_criteria(
+    columns: Mapping[str, np.ndarray],
+    *,
+    ledger_tolerance: float,
+    energy_scale: float | None = None,
+    passive: bool = False,
+    dead_volumes: Mapping[str, float] | None = None,
+) -> None:
     """The global criteria of SPEC section 17 on a results table.
 
     * no NaN or Inf in any column;
@@ -271,8 +293,9 @@ def check_global_criteria(columns: Mapping[str, np.ndarray], *, ledger_tolerance
         _assert_passive(columns, allowances)
 
 
-def assert_converges(errors: Sequence[float], *, floor: float, ratio: float = 0.75,
-                     what: str = "error") -> None:
+def assert_converges(
+    errors: Sequence[float], *, floor: float, ratio: float = 0.75, what: str = "error"
+) -> None:
     """Step refinement converges: each finer run's error is at most ``ratio`` of the coarser.
 
     An error at or below ``floor`` (the case is exact to round-off, or at
@@ -281,4 +304,5 @@ def assert_converges(errors: Sequence[float], *, floor: float, ratio: float = 0.
     assert all(math.isfinite(e) for e in errors), f"{what}: {errors}"
     for coarse, fine in zip(errors[:-1], errors[1:], strict=True):
         assert fine <= ratio * coarse or fine <= floor, (
-            f"{what} does not shrink under step refinement: {errors}")
+            f"{what} does not shrink under step refinement: {errors}"
+        )

@@ -8,8 +8,9 @@ import numpy as np
 
 from wire_fmu.core.hydraulics_unit import HydraulicsUnit
 
-ALL_EFFECTS = ("polytropic_gas,line_losses,line_inertance,oil_compressibility,seal_friction,"
-               "end_stops")
+ALL_EFFECTS = (
+    "polytropic_gas,line_losses,line_inertance,oil_compressibility,seal_friction,end_stops"
+)
 
 
 def make_unit(effects: str = "", *, force: float | None = None, **params) -> HydraulicsUnit:
@@ -31,9 +32,16 @@ def quiet_cylinder(**params) -> dict:
     pre-charged to 8 MPa: simple numbers for closed forms.
     """
     base = dict(
-        bore_diameter=0.2, rod_diameter=0.1, stroke=4.0, moving_mass=1000.0,
-        gravity_along_rod=0.0, ambient_pressure=0.0, accumulator_volume=0.2,
-        gas_bank_volume=0.0, accumulator_dead_volume=0.002, precharge_pressure=8.0e6,
+        bore_diameter=0.2,
+        rod_diameter=0.1,
+        stroke=4.0,
+        moving_mass=1000.0,
+        gravity_along_rod=0.0,
+        ambient_pressure=0.0,
+        accumulator_volume=0.2,
+        gas_bank_volume=0.0,
+        accumulator_dead_volume=0.002,
+        precharge_pressure=8.0e6,
         initial_position=2.0,
     )
     base.update(params)
@@ -47,9 +55,14 @@ def constant_force_cylinder(**params) -> dict:
     started with ``initial_gas_pressure`` balanced by ``rod.force`` moves
     freely: a free mass for cushion, stop and line tests.
     """
-    return quiet_cylinder(accumulator_volume=1.0e6, accumulator_dead_volume=1.0,
-                          precharge_pressure=1.0e6, initial_equilibrium=False,
-                          initial_gas_pressure=2.0e6, **params)
+    return quiet_cylinder(
+        accumulator_volume=1.0e6,
+        accumulator_dead_volume=1.0,
+        precharge_pressure=1.0e6,
+        initial_equilibrium=False,
+        initial_gas_pressure=2.0e6,
+        **params,
+    )
 
 
 def balancing_force(unit: HydraulicsUnit) -> float:

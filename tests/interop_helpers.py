@@ -35,49 +35,98 @@ def build_test_fmus(out: Path) -> dict[str, Path]:
     units = SUPPORT / "wire_fmu_test_units.py"
     return {
         "osc": build_fmu(facades / "oscillator.py", out, extra_modules=[units]),
-        "mass": build_fmu(facades / "coupled_mass.py", out,
-                          extra_modules=[SUPPORT / "wire_fmu_master_units.py"]),
+        "mass": build_fmu(
+            facades / "coupled_mass.py", out, extra_modules=[SUPPORT / "wire_fmu_master_units.py"]
+        ),
         "spring": build_fmu(facades / "spring_damper.py", out, extra_modules=[units]),
     }
 
 
-def two_mass_data(fmus: dict[str, Path], *, a_x0: float = 0.0, b_x0: float = 0.1,
-                  signals: bool = True, **run: Any) -> dict[str, Any]:
+def two_mass_data(
+    fmus: dict[str, Path], *, a_x0: float = 0.0, b_x0: float = 0.1, signals: bool = True, **run: Any
+) -> dict[str, Any]:
     """The test scene as plain data (see the module docstring)."""
     data: dict[str, Any] = {
         "name": "two_mass",
         "description": "Two masses on a translational power bond (test scene)",
-        "run": {"stop_time": STOP, "step": STEP, "algorithm": "jacobi",
-                "extrapolation": "constant", **run},
-        "units": {
-            "a": {"fmu": str(fmus["osc"]), "parameters": {
-                "mass": 1.0, "stiffness": 40.0, "damping": 0.0, "x0": a_x0, "substeps": 50,
-                "label": 'left <mass> & "quoted" {"json": [1, 2]}'}},
-            "b": {"fmu": str(fmus["mass"]), "parameters": {
-                "mass": 2.0, "stiffness": 60.0, "damping": 0.0, "x0": b_x0, "substeps": 50}},
+        "run": {
+            "stop_time": STOP,
+            "step": STEP,
+            "algorithm": "jacobi",
+            "extrapolation": "constant",
+            **run,
         },
-        "bonds": [{"name": "spring", "kind": "translational",
-                   "effort": "b.force_on_flange -> a.force",
-                   "flow": "a.velocity -> b.flange.velocity",
-                   "position": "a.position -> b.flange.position"}],
+        "units": {
+            "a": {
+                "fmu": str(fmus["osc"]),
+                "parameters": {
+                    "mass": 1.0,
+                    "stiffness": 40.0,
+                    "damping": 0.0,
+                    "x0": a_x0,
+                    "substeps": 50,
+                    "label": 'left <mass> & "quoted" {"json": [1, 2]}',
+                },
+            },
+            "b": {
+                "fmu": str(fmus["mass"]),
+                "parameters": {
+                    "mass": 2.0,
+                    "stiffness": 60.0,
+                    "damping": 0.0,
+                    "x0": b_x0,
+                    "substeps": 50,
+                },
+            },
+        },
+        "bonds": [
+            {
+                "name": "spring",
+                "kind": "translational",
+                "effort": "b.force_on_flange -> a.force",
+                "flow": "a.velocity -> b.flange.velocity",
+                "position": "a.position -> b.flange.position",
+            }
+        ],
         "outputs": {"variables": "all"},
         "plots": [{"title": "Positions", "variables": ["a.position", "b.position"]}],
     }
     if signals:
-        data["units"].update({
-            "c": {"fmu": str(fmus["osc"]), "parameters": {
-                "mass": 0.5, "stiffness": 20.0, "damping": 0.3, "x0": 0.0}},
-            "d": {"fmu": str(fmus["spring"]), "parameters": {"stiffness": 30.0, "damping": 0.5}},
-            "e": {"fmu": str(fmus["spring"]), "parameters": {"stiffness": 10.0, "damping": 0.1}},
-        })
-        data["connections"] = [{"from": "c.position", "to": "d.position_b"},
-                               {"from": "c.velocity", "to": "d.velocity_b"},
-                               {"from": "a.position", "to": "e.position_b"}]
+        data["units"].update(
+            {
+                "c": {
+                    "fmu": str(fmus["osc"]),
+                    "parameters": {"mass": 0.5, "stiffness": 20.0, "damping": 0.3, "x0": 0.0},
+                },
+                "d": {
+                    "fmu": str(fmus["spring"]),
+                    "parameters": {"stiffness": 30.0, "damping": 0.5},
+                },
+                "e": {
+                    "fmu": str(fmus["spring"]),
+                    "parameters": {"stiffness": 10.0, "damping": 0.1},
+                },
+            }
+        )
+        data["connections"] = [
+            {"from": "c.position", "to": "d.position_b"},
+            {"from": "c.velocity", "to": "d.velocity_b"},
+            {"from": "a.position", "to": "e.position_b"},
+        ]
         data["drivers"] = [
-            {"target": "d.position_a", "rate_target": "d.velocity_a", "kind": "sine",
-             "amplitude": 0.2, "period": 0.7, "label": "heave"},
-            {"target": "e.position_a", "kind": "ramp",
-             "points": [[0.0, 0.0], [0.3, 2.0], [0.6, -1.0]]},
+            {
+                "target": "d.position_a",
+                "rate_target": "d.velocity_a",
+                "kind": "sine",
+                "amplitude": 0.2,
+                "period": 0.7,
+                "label": "heave",
+            },
+            {
+                "target": "e.position_a",
+                "kind": "ramp",
+                "points": [[0.0, 0.0], [0.3, 2.0], [0.6, -1.0]],
+            },
         ]
         data["events"] = [{"time": 0.5, "label": "push", "set": {"c.force": 1.5}}]
     return data
@@ -99,9 +148,12 @@ class StepRecorder:
 
     def on_start(self, sim) -> None:
         """Fix the columns (initial values are not compared: libcosim gives none)."""
-        self.names = [(u, v.name) for u, s in sim.slaves.items()
-                      for v in s.model_description.modelVariables
-                      if v.causality == "output" and v.type == "Real"]
+        self.names = [
+            (u, v.name)
+            for u, s in sim.slaves.items()
+            for v in s.model_description.modelVariables
+            if v.causality == "output" and v.type == "Real"
+        ]
 
     def on_step(self, sim) -> None:
         """Record the row at the new time."""
@@ -128,8 +180,15 @@ def run_ours(scene) -> tuple[list[tuple[str, str]], np.ndarray]:
     return recorder.names, np.array(recorder.rows)
 
 
-def run_libcosim(path: Path, names: list[tuple[str, str]], *, step: float, stop: float,
-                 kind: str = "ssp", watch_inputs: list[tuple[str, str]] = ()) -> np.ndarray:
+def run_libcosim(
+    path: Path,
+    names: list[tuple[str, str]],
+    *,
+    step: float,
+    stop: float,
+    kind: str = "ssp",
+    watch_inputs: list[tuple[str, str]] = (),
+) -> np.ndarray:
     """Run an exported system in libcosimpy one fixed step at a time.
 
     Returns rows of time and the ``names`` (then ``watch_inputs``) after each step.
@@ -144,8 +203,10 @@ def run_libcosim(path: Path, names: list[tuple[str, str]], *, step: float, stop:
     else:
         execution = CosimExecution.from_osp_config_file(str(path))
     index = {info.name.decode(): info.index for info in execution.slave_infos()}
-    refs = {u: {v.name.decode(): v.reference for v in execution.slave_variables(i)}
-            for u, i in index.items()}
+    refs = {
+        u: {v.name.decode(): v.reference for v in execution.slave_variables(i)}
+        for u, i in index.items()
+    }
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer=observer)
     rows = []

@@ -16,8 +16,9 @@ from wire_fmu.core.reevings import drilling_block_train
 from .block_train_helpers import make_unit
 
 ROOT = Path(__file__).resolve().parents[1]
-INPUTS = [v.name for v in BlockTrainUnit.VARIABLES
-          if v.causality is Causality.input and v.type is float]
+INPUTS = [
+    v.name for v in BlockTrainUnit.VARIABLES if v.causality is Causality.input and v.type is float
+]
 
 
 def tensioner_like() -> dict:
@@ -30,8 +31,11 @@ def tensioner_like() -> dict:
         },
         "sheaves": {"moving": {"body": "rod", "centre": [2, 5, 0], "radius": 0.5}},
         "anchors": {"ring": {"body": "riser", "point": [2.5, 0, 0]}},
-        "path": [{"line_end": "line_a", "point": [-3, 5.5, 0]},
-                 {"sheave": "moving", "wrap": "cw"}, {"anchor": "ring"}],
+        "path": [
+            {"line_end": "line_a", "point": [-3, 5.5, 0]},
+            {"sheave": "moving", "wrap": "cw"},
+            {"anchor": "ring"},
+        ],
     }
 
 
@@ -88,8 +92,9 @@ def test_evaluating_outputs_leaves_the_state_alone():
 
 
 def load_facade_class():
-    spec = importlib.util.spec_from_file_location("block_train_facade",
-                                                  ROOT / "models" / "block_train.py")
+    spec = importlib.util.spec_from_file_location(
+        "block_train_facade", ROOT / "models" / "block_train.py"
+    )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module.BlockTrain
@@ -120,8 +125,9 @@ def test_facade_steps_like_the_core():
                 unit.values["line_a.payout"] = 0.2 * i * 0.01
                 unit.advance(i * 0.01, 0.01)
             else:
-                facade.set_real([refs["line_a.payout_rate"], refs["line_a.payout"]],
-                                [0.2, 0.2 * i * 0.01])
+                facade.set_real(
+                    [refs["line_a.payout_rate"], refs["line_a.payout"]], [0.2, 0.2 * i * 0.01]
+                )
                 facade.do_step(i * 0.01, 0.01)
     names = ["line_a.tension", "block_a.position", "energy_balance"]
     got = facade.get_real([refs[n] for n in names])

@@ -24,8 +24,13 @@ pytestmark = pytest.mark.integration
 
 ROOT = Path(__file__).resolve().parents[1]
 EFFECTS = "rope_damping,sheave_inertia,bearing_friction,rope_slip"
-WATCH = ["line_a.tension", "block_a.position", "block_a.velocity", "energy_balance",
-         "dissipated_energy"]
+WATCH = [
+    "line_a.tension",
+    "block_a.position",
+    "block_a.velocity",
+    "energy_balance",
+    "dissipated_energy",
+]
 STEP = 0.01
 
 
@@ -53,8 +58,7 @@ def step_fmu(loaded, fmu, first: int, count: int, payout: float):
     rows = []
     for i in range(first, first + count):
         rate = lowering_rate(i)
-        fmu.setReal([loaded.vr("line_a.payout"), loaded.vr("line_a.payout_rate")],
-                    [payout, rate])
+        fmu.setReal([loaded.vr("line_a.payout"), loaded.vr("line_a.payout_rate")], [payout, rate])
         fmu.doStep(currentCommunicationPoint=i * STEP, communicationStepSize=STEP)
         payout += rate * STEP
         rows.append(fmu.getReal([loaded.vr(n) for n in WATCH]))
@@ -130,8 +134,9 @@ def test_libcosimpy_steps_the_block_train(block_train_fmu):
     assert execution.simulate_until(target_time=int(0.5e9))
     got = observer.last_real_values(index, [refs[n] for n in WATCH])
 
-    unit = make_unit(drilling_block_train(4), "rope_damping", initial_equilibrium=False,
-                     pretension=2.5e5)
+    unit = make_unit(
+        drilling_block_train(4), "rope_damping", initial_equilibrium=False, pretension=2.5e5
+    )
     for i in range(50):
         assert unit.advance(i * STEP, STEP).success
     assert got == pytest.approx([unit.values[n] for n in WATCH], rel=1e-12, abs=1e-9)

@@ -20,25 +20,46 @@ from .block_train_helpers import make_unit, run
 G = 9.81
 
 
-def pulley(*, mass=1000.0, radius=0.5, axial_stiffness=1.0e7, bearing_torque=0.0,
-           efficiency=1.0, mu=0.1, inertia=2.0, linear_mass=2.0):
+def pulley(
+    *,
+    mass=1000.0,
+    radius=0.5,
+    axial_stiffness=1.0e7,
+    bearing_torque=0.0,
+    efficiency=1.0,
+    mu=0.1,
+    inertia=2.0,
+    linear_mass=2.0,
+):
     """A rope from a fixed line end up over one sheave and down to a hanging mass."""
     return {
         "rope": {"axial_stiffness": axial_stiffness, "linear_mass": linear_mass},
-        "bodies": {"load": {"kind": "block", "mass": mass, "direction": [0, 1, 0],
-                            "port": "block_a"}},
-        "sheaves": {"pulley": {"centre": [0, 10, 0], "radius": radius, "inertia": inertia,
-                               "bearing_torque": bearing_torque, "efficiency": efficiency,
-                               "groove_friction": mu}},
+        "bodies": {
+            "load": {"kind": "block", "mass": mass, "direction": [0, 1, 0], "port": "block_a"}
+        },
+        "sheaves": {
+            "pulley": {
+                "centre": [0, 10, 0],
+                "radius": radius,
+                "inertia": inertia,
+                "bearing_torque": bearing_torque,
+                "efficiency": efficiency,
+                "groove_friction": mu,
+            }
+        },
         "anchors": {"hook": {"body": "load", "point": [radius, 0, 0]}},
-        "path": [{"line_end": "line_a", "point": [-radius, 0, 0]},
-                 {"sheave": "pulley", "wrap": "cw"}, {"anchor": "hook"}],
+        "path": [
+            {"line_end": "line_a", "point": [-radius, 0, 0]},
+            {"sheave": "pulley", "wrap": "cw"},
+            {"anchor": "hook"},
+        ],
     }
 
 
 def haul_in(rate):
     def drive(t, unit):
         unit.values["line_a.payout_rate"] = rate
+
     return drive
 
 
@@ -60,18 +81,23 @@ class TestSheaveFriction:
     def test_capstan_slip_threshold(self):
         """Rope slips over a held sheave when T_high / T_low reaches e^(mu alpha) (eq. 9)."""
         mu, mass = 0.1, 1000.0
-        unit = make_unit(pulley(mu=mu, bearing_torque=1e9, mass=mass),
-                         "sheave_inertia,bearing_friction,rope_slip", solver_max_step=2e-4)
-        t = first_event_time(unit, 2.0, 1e-3, "rope on sheave 'pulley' sliding",
-                             haul_in(-0.01))
+        unit = make_unit(
+            pulley(mu=mu, bearing_torque=1e9, mass=mass),
+            "sheave_inertia,bearing_friction,rope_slip",
+            solver_max_step=2e-4,
+        )
+        t = first_event_time(unit, 2.0, 1e-3, "rope on sheave 'pulley' sliding", haul_in(-0.01))
         ratio = unit.values["line_a.tension"] / (mass * G)
         assert ratio == pytest.approx(math.exp(mu * math.pi), rel=3e-3)
         assert t > 0.1
 
     def test_bearing_holds_exactly_below_capacity_and_breaks_away_at_it(self):
         radius, torque, mass = 0.5, 2000.0, 1000.0
-        unit = make_unit(pulley(bearing_torque=torque, radius=radius, mass=mass),
-                         "sheave_inertia,bearing_friction", solver_max_step=5e-4)
+        unit = make_unit(
+            pulley(bearing_torque=torque, radius=radius, mass=mass),
+            "sheave_inertia,bearing_friction",
+            solver_max_step=5e-4,
+        )
         model = unit.model
         rim = model.rim_index[1]
         # haul in slowly: held while T_a - T_b < M/R, with the sheave exactly at rest
@@ -101,8 +127,7 @@ def test_static_fast_line_tension_with_sheave_losses(hoisting):
     n, k_eff, mass = 4, 0.9615, 1.2e5
     reeving = drilling_block_train(n, hook_mass=mass, efficiency=k_eff)
     reeving["rope"]["damping"] = 1.0e7  # settle quickly
-    unit = make_unit(reeving, "rope_damping,sheave_inertia,bearing_friction",
-                     solver_max_step=2e-3)
+    unit = make_unit(reeving, "rope_damping,sheave_inertia,bearing_friction", solver_max_step=2e-3)
     speed = 0.5 * (-1 if hoisting else 1)
 
     def drive(t, u):
@@ -112,8 +137,9 @@ def test_static_fast_line_tension_with_sheave_losses(hoisting):
     last = out["time"] > 3.0
     tension = out["line_a.tension"][last].mean()
     weight = mass * G
-    assert tension == pytest.approx(expected_fast_line_tension(weight, k_eff, n, hoisting),
-                                    rel=3e-3)
+    assert tension == pytest.approx(
+        expected_fast_line_tension(weight, k_eff, n, hoisting), rel=3e-3
+    )
     # the textbook form F = W / (n E), E = K (1 - K^n) / (n (1 - K)), for hoisting
     if hoisting:
         e = k_eff * (1 - k_eff**n) / (n * (1 - k_eff))
@@ -137,8 +163,14 @@ class TestHookStiffness:
         reeving = drilling_block_train(n, hook_mass=mass, radius=radius)
         ea = reeving["rope"]["axial_stiffness"]
         pretension = 0.98 * mass * G / n
-        unit = make_unit(reeving, "", initial_equilibrium=False, pretension=pretension,
-                         solver="rk4", solver_max_step=1e-3)
+        unit = make_unit(
+            reeving,
+            "",
+            initial_equilibrium=False,
+            pretension=pretension,
+            solver="rk4",
+            solver_max_step=1e-3,
+        )
         out = run(unit, 3.0, 1e-3, record=("block_a.position",))
         y = out["block_a.position"] - out["block_a.position"].mean()
         crossings = out["time"][1:][np.diff(np.sign(y)) != 0]
@@ -159,8 +191,12 @@ class TestHookStiffness:
 class TestSlackAndSnap:
     def test_snap_load_matches_closed_form(self):
         mass, length, ea, drop = 1000.0, 10.0, 1.0e7, 0.05
-        unit = make_unit(single_fall(mass=mass, length=length, axial_stiffness=ea),
-                         initial_equilibrium=False, pretension=0.0, solver_max_step=2e-4)
+        unit = make_unit(
+            single_fall(mass=mass, length=length, axial_stiffness=ea),
+            initial_equilibrium=False,
+            pretension=0.0,
+            solver_max_step=2e-4,
+        )
         unit.values["line_a.payout"] = drop  # the rope is now `drop` too long: slack
         out = run(unit, 0.4, 2e-4, record=("line_a.tension", "slack_spans"))
         assert out["slack_spans"][1] == 1 and out["line_a.tension"][1] == 0.0
@@ -177,14 +213,12 @@ class TestSlackAndSnap:
         out = run(unit, 0.5, 1e-2, record=("block_a.position", "line_a.tension", "broken"))
         t = out["time"]
         assert np.all(out["line_a.tension"][1:] == 0.0) and out["broken"][-1]
-        np.testing.assert_allclose(out["block_a.position"], y0 + v0 * t - 0.5 * G * t**2,
-                                   atol=1e-9)
+        np.testing.assert_allclose(out["block_a.position"], y0 + v0 * t - 0.5 * G * t**2, atol=1e-9)
 
     def test_rope_breaks_at_its_breaking_load(self):
         reeving = single_fall(mass=1000.0)
         reeving["rope"]["breaking_load"] = 1.5e4
-        unit = make_unit(reeving, initial_equilibrium=False, pretension=0.0,
-                         solver_max_step=2e-4)
+        unit = make_unit(reeving, initial_equilibrium=False, pretension=0.0, solver_max_step=2e-4)
         unit.values["line_a.payout"] = 0.05  # drop: snap load above 15 kN
         out = run(unit, 0.3, 1e-3, record=("line_a.tension", "broken", "energy_balance"))
         assert out["broken"][-1]
@@ -198,10 +232,20 @@ ALL_EFFECTS = "rope_damping,sheave_inertia,bearing_friction,rope_slip,moving_geo
 def passive_run(effects, solver, max_step, duration=1.0):
     """A 4-line block train released off equilibrium, nothing driving it."""
     reeving = drilling_block_train(4, efficiency=0.97)
-    unit = make_unit(reeving, effects, initial_equilibrium=False, pretension=2.0e5,
-                     solver=solver, solver_max_step=max_step)
-    return run(unit, duration, 1e-2, record=("energy_balance", "stored_energy",
-                                              "dissipated_energy", "external_work"))
+    unit = make_unit(
+        reeving,
+        effects,
+        initial_equilibrium=False,
+        pretension=2.0e5,
+        solver=solver,
+        solver_max_step=max_step,
+    )
+    return run(
+        unit,
+        duration,
+        1e-2,
+        record=("energy_balance", "stored_energy", "dissipated_energy", "external_work"),
+    )
 
 
 def test_energy_ledger_closes_in_a_passive_run():
@@ -218,8 +262,9 @@ def test_energy_ledger_closes_in_a_passive_run():
 def test_energy_ledger_residual_shrinks_with_the_step():
     """ROS2 is second order: halving the step cuts the ledger residual at least fourfold."""
     effects = "sheave_inertia,bearing_friction"
-    residual = [np.max(np.abs(passive_run(effects, "ros2", h, 0.5)["energy_balance"]))
-                for h in (1e-3, 5e-4)]
+    residual = [
+        np.max(np.abs(passive_run(effects, "ros2", h, 0.5)["energy_balance"])) for h in (1e-3, 5e-4)
+    ]
     assert residual[1] < residual[0] / 4
 
 
@@ -233,9 +278,14 @@ class TestBadInput:
         with pytest.raises(ConfigurationError) as info:
             make_unit(reeving, "rope_damping, sheave_inertai")
         text = str(info.value)
-        for needle in ("'radius' must be > 0", "'wrap' must be 'ccw' or 'cw'",
-                       "sheave 'nowhere' is not defined", "unknown key 'colour'",
-                       "unknown effect 'sheave_inertai'", "did you mean 'sheave_inertia'"):
+        for needle in (
+            "'radius' must be > 0",
+            "'wrap' must be 'ccw' or 'cw'",
+            "sheave 'nowhere' is not defined",
+            "unknown key 'colour'",
+            "unknown effect 'sheave_inertai'",
+            "did you mean 'sheave_inertia'",
+        ):
             assert needle in text
         assert len(info.value.problems) >= 5
 
@@ -259,7 +309,8 @@ class TestBadInput:
         with pytest.raises(ConfigurationError) as info:
             unit.configure()
         assert "not valid JSON" in str(info.value) and "solver 'euler' is unknown" in str(
-            info.value)
+            info.value
+        )
 
 
 def test_energy_ledger_books_work_done_by_position_jumps():
@@ -277,11 +328,13 @@ def test_moving_geometry_fast_planar_path_matches_full_geometry():
     unit = make_unit(drilling_block_train(4), "moving_geometry")
     model = unit.model
     for y in (np.array([0.0]), np.array([3.7]), np.array([-5.2])):
-        np.testing.assert_allclose(model._planar_segment_lengths(y),
-                                   model._spatial_segment_lengths(y), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            model._planar_segment_lengths(y), model._spatial_segment_lengths(y), rtol=0, atol=1e-12
+        )
     # lines stay vertical as the block moves: each line shortens by the block's rise
     rise = model._planar_segment_lengths(np.array([0.0])) - model._planar_segment_lengths(
-        np.array([1.0]))
+        np.array([1.0])
+    )
     np.testing.assert_allclose(rise[1:5], 1.0, atol=1e-12)
     np.testing.assert_allclose(rise[[0, 5]], 0.0, atol=1e-12)
 
@@ -305,8 +358,7 @@ class TestSpatialGeometry:
         assert fleet == pytest.approx(math.atan(offset / drop), rel=1e-6)
         # the hanging line is tilted, so the rope holds the weight with T cos(fleet) ... and
         # only the vertical motion of the block stretches it: T = m g / cos(fleet)
-        assert unit.values["line_a.tension"] == pytest.approx(1000 * G / math.cos(fleet),
-                                                              rel=1e-6)
+        assert unit.values["line_a.tension"] == pytest.approx(1000 * G / math.cos(fleet), rel=1e-6)
 
     def test_fleet_angle_above_the_limit_is_refused_naming_both_ends(self):
         with pytest.raises(ConfigurationError) as info:
@@ -318,8 +370,12 @@ def test_a_body_riding_on_a_driven_body_moves_with_it():
     """A crown on cylinders on a heaving deck: its sheaves move by deck + rod displacement."""
     reeving = drilling_block_train(4)
     reeving["bodies"]["deck"] = {"kind": "driven", "direction": [0, 1, 0], "port": "mover_b"}
-    reeving["bodies"]["crown"] = {"kind": "driven", "direction": [0, 1, 0], "port": "mover_a",
-                                  "on": "deck"}
+    reeving["bodies"]["crown"] = {
+        "kind": "driven",
+        "direction": [0, 1, 0],
+        "port": "mover_a",
+        "on": "deck",
+    }
     for name, sheave in reeving["sheaves"].items():
         if name.startswith("crown"):
             sheave["body"] = "crown"

@@ -32,8 +32,9 @@ def core_geometry(reeving: dict):
         if "sheave" in node:
             s = reeving["sheaves"][node["sheave"]]
             sense = 1 if node["wrap"] == "ccw" else -1
-            nodes.append(PathNode(Circle(node["sheave"], s["centre"], s["axis"], s["radius"]),
-                                  sense))
+            nodes.append(
+                PathNode(Circle(node["sheave"], s["centre"], s["axis"], s["radius"]), sense)
+            )
         else:
             point = node.get("point") or reeving["anchors"][node["anchor"]]["point"]
             nodes.append(PathNode(Circle(str(node), point, (0, 0, 1), 0.0), 0))
@@ -69,8 +70,13 @@ def test_spans_end_at_the_core_tangent_points():
 def test_arcs_wrap_from_tangent_point_to_tangent_point_in_the_written_sense():
     drawing = reeving_drawing(drilling_block_train(4))
     centres = {s.name: s.centre for s in drawing.sheaves}
-    assert [a.sheave for a in drawing.arcs] == ["crown_0", "travel_0", "crown_1", "travel_1",
-                                                "crown_2"]
+    assert [a.sheave for a in drawing.arcs] == [
+        "crown_0",
+        "travel_0",
+        "crown_1",
+        "travel_1",
+        "crown_2",
+    ]
     for k, arc in enumerate(drawing.arcs):
         assert np.allclose(arc.points[0], drawing.spans[k].end, atol=1e-12)
         assert np.allclose(arc.points[-1], drawing.spans[k + 1].start, atol=1e-12)
@@ -114,8 +120,9 @@ def test_tensioner_like_quarter_wrap_and_two_moving_bodies():
     assert arc.wrap == "cw" and arc.wrap_angle == pytest.approx(math.pi / 2)
     assert np.allclose(arc.points[0], [2.0, 5.5]) and np.allclose(arc.points[-1], [2.5, 5.0])
     mid = arc.points[len(arc.points) // 2]
-    assert np.allclose(mid, [2 + 0.5 * math.cos(math.pi / 4), 5 + 0.5 * math.sin(math.pi / 4)],
-                       atol=0.01)
+    assert np.allclose(
+        mid, [2 + 0.5 * math.cos(math.pi / 4), 5 + 0.5 * math.sin(math.pi / 4)], atol=0.01
+    )
     assert np.allclose(drawing.line_ends[0].direction, [-1, 0])
     boxes = {b.name: b for b in drawing.bodies}
     assert set(boxes) == {"rod", "riser"}

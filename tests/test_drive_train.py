@@ -18,9 +18,14 @@ from wire_fmu.core.drive_train import (
 
 def chain(inertias, stiffnesses, dampings=None, links=None, motor_ratio=1.0) -> DriveChain:
     n = len(inertias)
-    return DriveChain(tuple(inertias), tuple(dampings or [0.0] * n), tuple(stiffnesses),
-                      tuple(links or [0.0] * (n - 1)), tuple(f"m{i}" for i in range(n)),
-                      motor_ratio)
+    return DriveChain(
+        tuple(inertias),
+        tuple(dampings or [0.0] * n),
+        tuple(stiffnesses),
+        tuple(links or [0.0] * (n - 1)),
+        tuple(f"m{i}" for i in range(n)),
+        motor_ratio,
+    )
 
 
 def state_space_frequencies(j, c, beta=None, beta_link=None) -> np.ndarray:
@@ -82,8 +87,7 @@ def test_delta_star_damping_equals_the_quasi_static_star():
     dissipate exactly w^T B' w of the reduced chain, for any neighbour speeds."""
     c1, c2 = 2e6, 5e6
     b1, bk, b2 = 300.0, 40.0, 700.0
-    red = chain([10.0, 0.0, 20.0], [c1, c2], dampings=[0.0, bk, 0.0],
-                links=[b1, b2]).eliminate(1)
+    red = chain([10.0, 0.0, 20.0], [c1, c2], dampings=[0.0, bk, 0.0], links=[b1, b2]).eliminate(1)
     e1, e2 = 1 / c1, 1 / c2
     rng = np.random.default_rng(0)
     for w1, w2 in rng.normal(size=(5, 2)):
@@ -114,6 +118,7 @@ def test_reduced_chain_keeps_the_lowest_frequencies(keep):
 
 def test_reduction_error_shrinks_with_the_eliminated_mass():
     """The lumping is first order in the eliminated inertia: 10x smaller, ~10x closer."""
+
     def error(j_mid):
         full = chain([400.0, j_mid, 1200.0], [7e6, 2e7])
         return abs(full.reduced(2).natural_frequencies()[1] / full.natural_frequencies()[1] - 1)
@@ -144,34 +149,48 @@ def test_input_impedance_two_mass_formula_and_linear_solve():
         paper_out = (z1 * z2 + z1 * z12 + z12 * z2) / (z1 + z12)
         assert c.input_impedance(omega) == pytest.approx(paper_in, rel=1e-12)
         assert c.output_impedance(omega) == pytest.approx(paper_out, rel=1e-12)
-        assert 1 / c.input_impedance(omega) == pytest.approx(c.speeds_per_torque(omega)[0],
-                                                             rel=1e-10)
+        assert 1 / c.input_impedance(omega) == pytest.approx(
+            c.speeds_per_torque(omega)[0], rel=1e-10
+        )
 
 
 def test_n_mass_input_impedance_matches_the_linear_solve():
-    c = chain([12.0, 3.0, 150.0, 1200.0], [7e6, 5e7, 2e7], dampings=[2, 1, 20, 50],
-              links=[60, 30, 3e3])
+    c = chain(
+        [12.0, 3.0, 150.0, 1200.0], [7e6, 5e7, 2e7], dampings=[2, 1, 20, 50], links=[60, 30, 3e3]
+    )
     for omega in np.geomspace(0.1, 5e3, 15):
-        assert 1 / c.input_impedance(omega) == pytest.approx(c.speeds_per_torque(omega)[0],
-                                                             rel=1e-9)
+        assert 1 / c.input_impedance(omega) == pytest.approx(
+            c.speeds_per_torque(omega)[0], rel=1e-9
+        )
 
 
 def test_elements_are_reduced_through_the_gear_ratio():
     motor = ChainElement("motor", 12.0, 2.0, 6.0)
     assert motor.reduced_value == 12.0 * 36 and motor.reduced_damping == 72.0
-    c = DriveChain.from_elements([motor, ChainElement("drum", 1200.0)],
-                                 [ChainElement("coupling", 2e5, 60.0, 6.0)])
+    c = DriveChain.from_elements(
+        [motor, ChainElement("drum", 1200.0)], [ChainElement("coupling", 2e5, 60.0, 6.0)]
+    )
     assert c.motor_ratio == 6.0 and c.stiffnesses == (7.2e6,)
 
 
 def test_parse_lists_every_problem():
-    chain_, problems = parse_drive_train({
-        "masses": [{"name": "motor", "inertia": -1.0, "ratio": 0.0},
-                   {"name": "drum", "inertia": 10.0, "ratio": 2.0}],
-        "shafts": [], "gear": 3,
-    })
+    chain_, problems = parse_drive_train(
+        {
+            "masses": [
+                {"name": "motor", "inertia": -1.0, "ratio": 0.0},
+                {"name": "drum", "inertia": 10.0, "ratio": 2.0},
+            ],
+            "shafts": [],
+            "gear": 3,
+        }
+    )
     assert chain_ is None
     text = "\n".join(problems)
-    for needle in ("unknown keys ['gear']", "'inertia' must be finite and > 0",
-                   "'ratio' must be finite and > 0", "need 1 shafts, got 0", "must have ratio 1"):
+    for needle in (
+        "unknown keys ['gear']",
+        "'inertia' must be finite and > 0",
+        "'ratio' must be finite and > 0",
+        "need 1 shafts, got 0",
+        "must have ratio 1",
+    ):
         assert needle in text, needle

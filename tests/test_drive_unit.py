@@ -50,8 +50,7 @@ def full_state_eigenvalues(masses, shafts) -> np.ndarray:
             mat[j, j] += v
             mat[i, j] -= v
             mat[j, i] -= v
-    a = np.block([[np.zeros((n, n)), np.eye(n)],
-                  [-np.linalg.solve(m, k), -np.linalg.solve(m, b)]])
+    a = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(m, k), -np.linalg.solve(m, b)]])
     lam = scipy.linalg.eig(a, right=False)
     lam = lam[lam.imag > 1e-2]  # oscillatory modes only (the rigid mode's 0 is noise-prone)
     return lam[np.argsort(lam.imag)]
@@ -70,34 +69,50 @@ def plain(data: dict) -> tuple[list, list]:
 
 # ================================================================= impedances
 def test_two_mass_input_and_output_impedances_are_the_papers_formulas():
-    tree = parse_drive({"masses": [{"name": "a", "inertia": 2.0, "damping": 0.3},
-                                   {"name": "b", "inertia": 5.0, "damping": 0.7}],
-                        "shafts": [{"stiffness": 1e4, "damping": 4.0}]})[0]
+    tree = parse_drive(
+        {
+            "masses": [
+                {"name": "a", "inertia": 2.0, "damping": 0.3},
+                {"name": "b", "inertia": 5.0, "damping": 0.7},
+            ],
+            "shafts": [{"stiffness": 1e4, "damping": 4.0}],
+        }
+    )[0]
     for omega in (0.5, 30.0, 70.7, 400.0):
         p = 1j * omega
         z1, z2, z12 = 2.0 * p + 0.3, 5.0 * p + 0.7, 1e4 / p + 4.0
         numerator = z1 * z2 + z1 * z12 + z12 * z2
-        assert tree.driving_point_impedance(0, omega) == pytest.approx(numerator / (z2 + z12),
-                                                                       rel=1e-13)
-        assert tree.driving_point_impedance(1, omega) == pytest.approx(numerator / (z1 + z12),
-                                                                       rel=1e-13)
+        assert tree.driving_point_impedance(0, omega) == pytest.approx(
+            numerator / (z2 + z12), rel=1e-13
+        )
+        assert tree.driving_point_impedance(1, omega) == pytest.approx(
+            numerator / (z1 + z12), rel=1e-13
+        )
 
 
 def test_tree_of_a_chain_agrees_with_drive_chain():
     tree = chain()
     as_chain = tree.to_chain()
-    np.testing.assert_allclose(tree.natural_frequencies(), as_chain.natural_frequencies(),
-                               rtol=1e-10, atol=1e-4)
+    np.testing.assert_allclose(
+        tree.natural_frequencies(), as_chain.natural_frequencies(), rtol=1e-10, atol=1e-4
+    )
     for omega in (3.0, 80.0, 2000.0):
         assert tree.driving_point_impedance(0, omega) == pytest.approx(
-            as_chain.input_impedance(omega), rel=1e-12)
+            as_chain.input_impedance(omega), rel=1e-12
+        )
         assert tree.driving_point_impedance(-1, omega) == pytest.approx(
-            as_chain.output_impedance(omega), rel=1e-12)
+            as_chain.output_impedance(omega), rel=1e-12
+        )
     back = DriveTree.from_chain(as_chain)
     assert (back.inertias, back.dampings, back.motors, back.load_index) == (
-        tree.inertias, tree.dampings, tree.motors, tree.load_index)
+        tree.inertias,
+        tree.dampings,
+        tree.motors,
+        tree.load_index,
+    )
     assert [(s.a, s.b, s.stiffness, s.damping) for s in back.shafts] == [
-        (s.a, s.b, s.stiffness, s.damping) for s in tree.shafts]
+        (s.a, s.b, s.stiffness, s.damping) for s in tree.shafts
+    ]
 
 
 def test_branched_drive_follows_the_papers_four_equations():
@@ -113,12 +128,14 @@ def test_branched_drive_follows_the_papers_four_equations():
         p = 1j * omega
         z = [j[k] * p + beta[k] for k in range(4)]
         z13, z23, z34 = c13 / p + b13, c23 / p + b23, c34 / p + b34
-        system = np.array([
-            [z[0] + z13, 0, -z13, 0],
-            [0, z[1] + z23, -z23, 0],
-            [-z13, -z23, z13 + z23 + z34 + z[2], -z34],
-            [0, 0, -z34, z34 + z[3]],
-        ])
+        system = np.array(
+            [
+                [z[0] + z13, 0, -z13, 0],
+                [0, z[1] + z23, -z23, 0],
+                [-z13, -z23, z13 + z23 + z34 + z[2], -z34],
+                [0, 0, -z34, z34 + z[3]],
+            ]
+        )
         speeds = np.linalg.solve(system, np.array([1.0, 0.0, 0.0, 0.0]))  # M1 = 1, M2 = Mc = 0
         np.testing.assert_allclose(tree.speeds_per_torque(omega, 0), speeds, rtol=1e-12)
         assert tree.driving_point_impedance(0, omega) == pytest.approx(1 / speeds[0], rel=1e-12)
@@ -146,19 +163,24 @@ def test_reduction_is_exact_in_the_quasi_static_limit():
     masses = [(1.0, 0.0), (1e-9, 0.0), (3.0, 0.0)]
     shafts = [(0, 1, 2e4, 0.0), (1, 2, 5e4, 0.0)]
     full = full_state_eigenvalues(masses, shafts)
-    reduced = DriveChain((1.0, 1e-9, 3.0), (0.0,) * 3, (2e4, 5e4), (0.0, 0.0),
-                         ("a", "b", "c")).reduced(2)
+    reduced = DriveChain(
+        (1.0, 1e-9, 3.0), (0.0,) * 3, (2e4, 5e4), (0.0, 0.0), ("a", "b", "c")
+    ).reduced(2)
     series = 1.0 / (1 / 2e4 + 1 / 5e4)
     assert reduced.stiffnesses[0] == pytest.approx(series, rel=1e-12)
     assert reduced.natural_frequencies()[1] == pytest.approx(full[0].imag, rel=1e-8)
 
 
 # ================================================================= frequency response
-@pytest.mark.parametrize("params, effects", [
-    ({}, ()),
-    ({"masses_kept": 2, "solver_max_step": 5e-3}, ()),
-    ({"drive": two_motor_drive(), "motor_slope": 25.6}, ("motor_characteristic",)),
-], ids=["full chain", "reduced to 2", "two motors with characteristics"])
+@pytest.mark.parametrize(
+    "params, effects",
+    [
+        ({}, ()),
+        ({"masses_kept": 2, "solver_max_step": 5e-3}, ()),
+        ({"drive": two_motor_drive(), "motor_slope": 25.6}, ("motor_characteristic",)),
+    ],
+    ids=["full chain", "reduced to 2", "two motors with characteristics"],
+)
 def test_simulated_frequency_response_matches_one_over_z_in(params, effects):
     """Periodic steady state of the stepped unit against 1/Z_in(j w) and the load transfer."""
     unit = drive_unit(params, effects)
@@ -196,15 +218,18 @@ def run(unit: DriveUnit, duration: float, step: float) -> None:
         assert result.success, result.message
 
 
-@pytest.mark.parametrize("drive", [default_multimass_drive(), two_motor_drive()],
-                         ids=["chain", "two motors"])
+@pytest.mark.parametrize(
+    "drive", [default_multimass_drive(), two_motor_drive()], ids=["chain", "two motors"]
+)
 def test_steady_speed_with_motor_characteristics(drive):
     """Every motor a - b w, ground dampers: w = sum(a) / (sum(b) + sum(beta)) once settled."""
     motors = len(drive.get("motors", [0]))
-    inputs = {"motor.torque": 4000.0, "motor2.torque": 4000.0 if motors == 2 else 0.0,
-              "load.torque": 150.0}
-    unit = make_drive({"drive": drive, "motor_slope": 25.6}, "motor_characteristic",
-                      **inputs)
+    inputs = {
+        "motor.torque": 4000.0,
+        "motor2.torque": 4000.0 if motors == 2 else 0.0,
+        "load.torque": 150.0,
+    }
+    unit = make_drive({"drive": drive, "motor_slope": 25.6}, "motor_characteristic", **inputs)
     run(unit, 3.0, 0.01)
     beta = sum(m["damping"] for m in drive["masses"])
     expected = (4000.0 * motors - 150.0) / (25.6 * motors + beta)
@@ -213,7 +238,8 @@ def test_steady_speed_with_motor_characteristics(drive):
     assert abs(unit.values["energy_balance"]) < 1e-6 * unit.values["external_work"]
     if motors == 2:  # equal motors at equal speeds share the load equally
         assert unit.values["motor.drive_torque"] == pytest.approx(
-            unit.values["motor2.drive_torque"], rel=1e-6)
+            unit.values["motor2.drive_torque"], rel=1e-6
+        )
 
 
 def test_start_in_quasi_static_twist_has_no_ringing():
@@ -229,10 +255,10 @@ def test_start_in_quasi_static_twist_has_no_ringing():
         unit.advance(i * 1e-3, 1e-3)
         speeds.append([unit.values[f"mass_{k}.speed"] for k in range(1, 5)])
     t = 1e-3 * np.arange(1, 51)
-    np.testing.assert_allclose(np.array(speeds), np.outer(70.0 / j_total * t, np.ones(4)),
-                               rtol=1e-9)
-    assert unit.values["shaft_3.torque"] == pytest.approx(30.0 + 2.0 * 70.0 / j_total,
-                                                          rel=1e-9)
+    np.testing.assert_allclose(
+        np.array(speeds), np.outer(70.0 / j_total * t, np.ones(4)), rtol=1e-9
+    )
+    assert unit.values["shaft_3.torque"] == pytest.approx(30.0 + 2.0 * 70.0 / j_total, rel=1e-9)
 
 
 def test_reduced_unit_is_cheaper_and_agrees_at_low_frequency():
@@ -254,9 +280,17 @@ def test_configuration_problems_are_all_reported():
     with pytest.raises(ConfigurationError, match="unstable"):
         make_drive({"solver_max_step": 0.01})
     with pytest.raises(ConfigurationError, match="loop"):
-        make_drive({"drive": {"masses": [{"name": n, "inertia": 1.0} for n in "abc"],
-                              "shafts": [{"from": "a", "to": "b", "stiffness": 1.0},
-                                         {"from": "b", "to": "a", "stiffness": 1.0}]}})
+        make_drive(
+            {
+                "drive": {
+                    "masses": [{"name": n, "inertia": 1.0} for n in "abc"],
+                    "shafts": [
+                        {"from": "a", "to": "b", "stiffness": 1.0},
+                        {"from": "b", "to": "a", "stiffness": 1.0},
+                    ],
+                }
+            }
+        )
 
 
 def test_declarations_and_feedthrough():

@@ -86,24 +86,31 @@ def test_ramp_points_interpolate_and_hold():
 
 
 def test_ramp_short_form_equals_points():
-    short = build({"kind": "ramp", "start_time": 2.0, "end_time": 6.0,
-                   "start_value": -1.0, "end_value": 3.0})
+    short = build(
+        {"kind": "ramp", "start_time": 2.0, "end_time": 6.0, "start_value": -1.0, "end_value": 3.0}
+    )
     points = build({"kind": "ramp", "points": [[2.0, -1.0], [6.0, 3.0]]})
     t = np.linspace(0.0, 8.0, 81)
     assert np.array_equal(short.value(t), points.value(t))
     assert short.rate(4.0) == pytest.approx(1.0)
-    assert build({"kind": "ramp", "end_time": 2.0, "start_value": 0.0,
-                  "end_value": 1.0}).value(1.0) == pytest.approx(0.5)  # start_time 0
+    assert build({"kind": "ramp", "end_time": 2.0, "start_value": 0.0, "end_value": 1.0}).value(
+        1.0
+    ) == pytest.approx(0.5)  # start_time 0
 
 
 def test_ramp_problems():
     problems = problems_of({"kind": "ramp", "points": [[0, 0], [2, 1], [1, 3]]})
     assert "strictly increasing" in problems[0] and "t = 1 s" in problems[0]
-    assert "not both" in problems_of({"kind": "ramp", "points": [[0, 0], [1, 1]],
-                                      "end_value": 2})[0]
+    assert (
+        "not both" in problems_of({"kind": "ramp", "points": [[0, 0], [1, 1]], "end_value": 2})[0]
+    )
     assert "pairs" in problems_of({"kind": "ramp", "points": [[0, 0]]})[0]
-    assert "later than" in problems_of({"kind": "ramp", "start_time": 3, "end_time": 1,
-                                        "start_value": 0, "end_value": 1})[0]
+    assert (
+        "later than"
+        in problems_of(
+            {"kind": "ramp", "start_time": 3, "end_time": 1, "start_value": 0, "end_value": 1}
+        )[0]
+    )
 
 
 # ---------------------------------------------------------------------- sine
@@ -111,22 +118,38 @@ def test_ramp_problems():
 
 def test_sine_value_and_rate_match_closed_form():
     a, period, phase_deg, offset = 0.7, 4.0, 30.0, 1.5
-    d = build({"kind": "sine", "amplitude": a, "period": period, "phase_deg": phase_deg,
-               "offset": offset})
+    d = build(
+        {"kind": "sine", "amplitude": a, "period": period, "phase_deg": phase_deg, "offset": offset}
+    )
     omega, phase = 2.0 * math.pi / period, math.radians(phase_deg)
     t = np.linspace(0.1, 10.0, 37)
     assert np.allclose(d.value(t), offset + a * np.sin(omega * t + phase), atol=1e-14)
     assert np.allclose(d.rate(t), a * omega * np.cos(omega * t + phase), atol=1e-14)
     assert np.allclose(central_rate(d, t), d.rate(t), atol=1e-7)
-    by_frequency = build({"kind": "sine", "amplitude": a, "frequency": 1.0 / period,
-                          "phase_deg": phase_deg, "offset": offset})
+    by_frequency = build(
+        {
+            "kind": "sine",
+            "amplitude": a,
+            "frequency": 1.0 / period,
+            "phase_deg": phase_deg,
+            "offset": offset,
+        }
+    )
     assert np.allclose(by_frequency.value(t), d.value(t), atol=1e-14)
 
 
 def test_sine_fade_in_starts_at_zero_with_zero_rate():
     start, ramp = 2.0, 5.0
-    d = build({"kind": "sine", "amplitude": 1.0, "period": 3.0, "phase_deg": 90.0,
-               "start_time": start, "ramp_time": ramp})
+    d = build(
+        {
+            "kind": "sine",
+            "amplitude": 1.0,
+            "period": 3.0,
+            "phase_deg": 90.0,
+            "start_time": start,
+            "ramp_time": ramp,
+        }
+    )
     assert d.value(start) == 0.0 and d.rate(start) == 0.0  # phase 90: sin part is 1 here
     assert d.value(0.0) == 0.0 and d.rate(0.0) == 0.0
     t = np.linspace(start + 0.01, start + 3 * ramp, 200)
@@ -140,8 +163,9 @@ def test_sine_fade_in_starts_at_zero_with_zero_rate():
 
 
 def test_sine_problems_all_at_once():
-    problems = problems_of({"kind": "sine", "amplitud": 1.0, "period": -2.0,
-                            "ramp_time": -1.0, "phase_deg": "ninety"})
+    problems = problems_of(
+        {"kind": "sine", "amplitud": 1.0, "period": -2.0, "ramp_time": -1.0, "phase_deg": "ninety"}
+    )
     text = "\n".join(problems)
     assert len(problems) == 5
     assert "unknown key 'amplitud'" in text and "did you mean 'amplitude'" in text
@@ -149,11 +173,14 @@ def test_sine_problems_all_at_once():
     assert "'period' must be > 0 s, got -2.0" in text
     assert "'ramp_time' must be >= 0" in text
     assert "'phase_deg' must be a finite number in deg" in text
-    assert "not both" in problems_of({"kind": "sine", "amplitude": 1, "period": 1,
-                                      "frequency": 1})[0]
+    assert (
+        "not both" in problems_of({"kind": "sine", "amplitude": 1, "period": 1, "frequency": 1})[0]
+    )
     assert "is required" in problems_of({"kind": "sine", "amplitude": 1})[0]
-    assert "'period' must be > 0 s, got 0" in problems_of({"kind": "sine", "amplitude": 1,
-                                                           "period": 0})[0]
+    assert (
+        "'period' must be > 0 s, got 0"
+        in problems_of({"kind": "sine", "amplitude": 1, "period": 0})[0]
+    )
 
 
 # ----------------------------------------------------------------- sea state
@@ -162,6 +189,7 @@ def test_sine_problems_all_at_once():
 def test_pierson_moskowitz_zeroth_moment_and_peak():
     def pm(w):
         return pierson_moskowitz_spectrum(w, HS, TP)
+
     assert spectral_moment(pm, 0) == pytest.approx(HS**2 / 16.0, rel=1e-6)
     omega = np.linspace(0.2, 2.0, 180001)
     assert omega[np.argmax(pm(omega))] == pytest.approx(OMEGA_P, abs=1e-4)
@@ -170,8 +198,10 @@ def test_pierson_moskowitz_zeroth_moment_and_peak():
 @pytest.mark.parametrize("gamma", [1.0, 2.0, 3.3, 5.0])
 def test_jonswap_zeroth_moment_peak_and_zero_crossing_period(gamma):
     """m0 = Hs^2/16 (A_gamma normalisation, within 0.3 %); peak at Tp; Tz from DNV-RP-C205."""
+
     def js(w):
         return jonswap_spectrum(w, HS, TP, gamma)
+
     m0, m2 = spectral_moment(js, 0), spectral_moment(js, 2)
     assert m0 == pytest.approx(HS**2 / 16.0, rel=3e-3)
     omega = np.linspace(0.2, 2.0, 180001)
@@ -183,12 +213,24 @@ def test_jonswap_zeroth_moment_peak_and_zero_crossing_period(gamma):
 
 def test_pierson_moskowitz_is_jonswap_with_gamma_one():
     omega = np.linspace(0.05, 5.0, 1000)
-    assert np.allclose(jonswap_spectrum(omega, HS, TP, 1.0),
-                       pierson_moskowitz_spectrum(omega, HS, TP), rtol=1e-14, atol=0.0)
-    pm = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-                "spectrum": "pierson_moskowitz", "seed": 3})
-    js = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-                "gamma": 1.0, "seed": 3})
+    assert np.allclose(
+        jonswap_spectrum(omega, HS, TP, 1.0),
+        pierson_moskowitz_spectrum(omega, HS, TP),
+        rtol=1e-14,
+        atol=0.0,
+    )
+    pm = build(
+        {
+            "kind": "sea_state",
+            "significant_height": HS,
+            "peak_period": TP,
+            "spectrum": "pierson_moskowitz",
+            "seed": 3,
+        }
+    )
+    js = build(
+        {"kind": "sea_state", "significant_height": HS, "peak_period": TP, "gamma": 1.0, "seed": 3}
+    )
     t = np.linspace(0.0, 100.0, 101)
     assert np.allclose(pm.value(t), js.value(t), rtol=1e-12, atol=1e-14)
 
@@ -201,8 +243,7 @@ def test_sea_state_record_has_standard_deviation_hs_over_four(seed):
     (0.3 % of m0 lost above 4 omega_p) and the random bin offsets; a finite
     record adds beating between neighbouring components of a few 0.1 %.
     """
-    d = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-               "seed": seed})
+    d = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP, "seed": seed})
     assert isinstance(d, SeaStateDriver) and len(d.amplitudes) == 200
     assert math.sqrt(d.variance) == pytest.approx(HS / 4.0, rel=0.01)
     t = np.arange(0.0, 3 * 3600.0, 0.25)
@@ -210,19 +251,29 @@ def test_sea_state_record_has_standard_deviation_hs_over_four(seed):
     assert abs(np.mean(heave)) < 0.02 * HS / 4.0
     assert np.std(heave) == pytest.approx(HS / 4.0, rel=0.02)
     # heave velocity: sqrt(m2) of the spectrum over the simulated band [0.5, 4] omega_p
-    m2_band = quad(lambda w: w**2 * jonswap_spectrum(w, HS, TP), 0.5 * OMEGA_P, 4.0 * OMEGA_P,
-                   points=[OMEGA_P])[0]
+    m2_band = quad(
+        lambda w: w**2 * jonswap_spectrum(w, HS, TP), 0.5 * OMEGA_P, 4.0 * OMEGA_P, points=[OMEGA_P]
+    )[0]
     assert np.std(d.rate(t)) == pytest.approx(math.sqrt(m2_band), rel=0.02)
 
 
 def test_sea_state_rate_is_derivative_and_fade_in_starts_at_rest():
-    d = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-               "ramp_time": 30.0, "heave_rao": 0.8, "start_time": 5.0})
+    d = build(
+        {
+            "kind": "sea_state",
+            "significant_height": HS,
+            "peak_period": TP,
+            "ramp_time": 30.0,
+            "heave_rao": 0.8,
+            "start_time": 5.0,
+        }
+    )
     assert d.value(5.0) == 0.0 and d.rate(5.0) == 0.0 and d.value(0.0) == 0.0
     t = np.linspace(5.5, 120.0, 300)
     assert np.allclose(central_rate(d, t), d.rate(t), atol=1e-7)
-    plain = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-                   "start_time": 5.0})
+    plain = build(
+        {"kind": "sea_state", "significant_height": HS, "peak_period": TP, "start_time": 5.0}
+    )
     late = np.array([40.0, 77.7])
     assert np.allclose(d.value(late), 0.8 * plain.value(late), rtol=1e-14)
     assert np.allclose(d.value(t), [d.value(float(x)) for x in t], rtol=1e-12, atol=1e-14)
@@ -238,8 +289,15 @@ def test_sea_state_is_reproducible_with_a_seed():
 
 
 def test_sea_state_frequencies_are_offset_inside_their_bins():
-    d = build({"kind": "sea_state", "significant_height": HS, "peak_period": TP,
-               "components": 50, "cutoff": [0.5, 3.0]})
+    d = build(
+        {
+            "kind": "sea_state",
+            "significant_height": HS,
+            "peak_period": TP,
+            "components": 50,
+            "cutoff": [0.5, 3.0],
+        }
+    )
     edges = np.linspace(0.5 * OMEGA_P, 3.0 * OMEGA_P, 51)
     w = d.angular_frequencies
     assert np.all((w > edges[:-1]) & (w < edges[1:]))
@@ -248,20 +306,48 @@ def test_sea_state_frequencies_are_offset_inside_their_bins():
 
 
 def test_sea_state_problems_all_at_once():
-    problems = problems_of({"kind": "sea_state", "significant_height": "4", "peak_period": 0,
-                            "gamma": 9, "cutoff": [2, 1], "components": 2.5,
-                            "spectrum": "jonswapp", "seed": -1})
+    problems = problems_of(
+        {
+            "kind": "sea_state",
+            "significant_height": "4",
+            "peak_period": 0,
+            "gamma": 9,
+            "cutoff": [2, 1],
+            "components": 2.5,
+            "spectrum": "jonswapp",
+            "seed": -1,
+        }
+    )
     text = "\n".join(problems)
     assert len(problems) == 7, text
-    for part in ("'significant_height' must be a finite number in m", "'peak_period' must be > 0",
-                 "did you mean 'jonswap'", "'gamma' must be in [1, 7]", "'cutoff'",
-                 "'components' must be an integer", "'seed' must be an integer >= 0"):
+    for part in (
+        "'significant_height' must be a finite number in m",
+        "'peak_period' must be > 0",
+        "did you mean 'jonswap'",
+        "'gamma' must be in [1, 7]",
+        "'cutoff'",
+        "'components' must be an integer",
+        "'seed' must be an integer >= 0",
+    ):
         assert part in text
-    assert "'components' must be an integer <= 20000" in problems_of(
-        {"kind": "sea_state", "significant_height": 1, "peak_period": 8, "components": 10**6})[0]
-    assert "'gamma' applies to spectrum 'jonswap' only" in problems_of(
-        {"kind": "sea_state", "significant_height": 1, "peak_period": 8,
-         "spectrum": "pierson_moskowitz", "gamma": 3.3})[0]
+    assert (
+        "'components' must be an integer <= 20000"
+        in problems_of(
+            {"kind": "sea_state", "significant_height": 1, "peak_period": 8, "components": 10**6}
+        )[0]
+    )
+    assert (
+        "'gamma' applies to spectrum 'jonswap' only"
+        in problems_of(
+            {
+                "kind": "sea_state",
+                "significant_height": 1,
+                "peak_period": 8,
+                "spectrum": "pierson_moskowitz",
+                "gamma": 3.3,
+            }
+        )[0]
+    )
 
 
 # --------------------------------------------------------------------- table
@@ -274,8 +360,7 @@ def write_csv(folder: Path, text: str, name: str = "heave.csv") -> Path:
 
 
 def test_table_interpolates_relative_to_the_scene_folder(tmp_path):
-    write_csv(tmp_path, "# vessel heave\ntime, heave , other\n0, 0.0, 9\n2, 1.0, 9\n"
-              "3, -0.5, 9\n\n")
+    write_csv(tmp_path, "# vessel heave\ntime, heave , other\n0, 0.0, 9\n2, 1.0, 9\n3, -0.5, 9\n\n")
     d = build({"kind": "table", "file": "heave.csv", "value_column": "heave"}, tmp_path)
     assert isinstance(d, PiecewiseLinearDriver)
     t = np.array([-1.0, 0.0, 1.0, 2.5, 3.0, 10.0])
@@ -285,16 +370,19 @@ def test_table_interpolates_relative_to_the_scene_folder(tmp_path):
 
 
 def test_table_problems(tmp_path):
-    assert "cannot read table file" in problems_of({"kind": "table", "file": "nope.csv"},
-                                                   tmp_path)[0]
+    assert (
+        "cannot read table file" in problems_of({"kind": "table", "file": "nope.csv"}, tmp_path)[0]
+    )
     write_csv(tmp_path, "t,heave\n0,1\n1,2\n")
     problems = problems_of({"kind": "table", "file": "heave.csv"}, tmp_path)
     assert len(problems) == 2
     assert "no column 'time'" in problems[0] and "columns: t, heave" in problems[0]
     assert "no column 'value'" in problems[1]
     write_csv(tmp_path, "time,value\n0,1\n2,x\n1,3\n")
-    assert "'value' is not a finite number in data row 2 ('x')" in problems_of(
-        {"kind": "table", "file": "heave.csv"}, tmp_path)[0]
+    assert (
+        "'value' is not a finite number in data row 2 ('x')"
+        in problems_of({"kind": "table", "file": "heave.csv"}, tmp_path)[0]
+    )
     write_csv(tmp_path, "time,value\n0,1\n2,2\n1,3\n")
     problems = problems_of({"kind": "table", "file": "heave.csv"}, tmp_path)
     assert "column 'time' must be strictly increasing" in problems[0]
@@ -305,8 +393,10 @@ def test_table_problems(tmp_path):
 
 def test_unknown_kind_names_the_known_kinds_and_a_close_match():
     (problem,) = problems_of({"kind": "sine_wave", "amplitude": 1})
-    assert problem == (f"{WHERE}: unknown kind 'sine_wave' (did you mean 'sine'?); known kinds: "
-                       "constant, ramp, sea_state, sine, table")
+    assert problem == (
+        f"{WHERE}: unknown kind 'sine_wave' (did you mean 'sine'?); known kinds: "
+        "constant, ramp, sea_state, sine, table"
+    )
     assert "'kind' is required" in problems_of({"amplitude": 1})[0]
     assert "a driver must be a table" in problems_of(["sine"])[0]  # type: ignore[arg-type]
     assert "unknown kind [1]" in problems_of({"kind": [1]})[0]

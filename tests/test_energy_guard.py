@@ -27,8 +27,9 @@ def test_books_net_and_gross_coupling_energy_and_carried_energy():
 
 
 def test_stops_only_above_both_the_share_and_the_floor():
-    guard = EnergyGuard(["rod"], share=0.1, floor=5.0,
-                        remedies=["a smaller step", "iterations > 1"])
+    guard = EnergyGuard(
+        ["rod"], share=0.1, floor=5.0, remedies=["a smaller step", "iterations > 1"]
+    )
     guard.book({"rod": 4.0}, {"rod": 1.0}, 10.0)  # 40 % of 10 J carried, but under 5 J
     assert guard.blow_up(1.0, 0.01) is None
     guard.book({"rod": 0.0}, {"rod": 1.0}, 90.0)  # 4 J of 100 J: under 10 %
@@ -37,9 +38,16 @@ def test_stops_only_above_both_the_share_and_the_floor():
     guard.book({"rod": 6.5}, {"rod": 0.0}, 0.01)  # 10.5 J of 100 J: over both
     message = guard.blow_up(3.0, 0.01)
     assert message is not None
-    for part in ("t = 3 s", "macro step 0.01 s", "bond 'rod' created and destroyed 10.5 J",
-                 "(net +10.5 J)", "10.5 % of the 100 J it carried", "energy_guard = 0.1",
-                 "energy_tolerance 5 J", "use a smaller step or iterations > 1"):
+    for part in (
+        "t = 3 s",
+        "macro step 0.01 s",
+        "bond 'rod' created and destroyed 10.5 J",
+        "(net +10.5 J)",
+        "10.5 % of the 100 J it carried",
+        "energy_guard = 0.1",
+        "energy_tolerance 5 J",
+        "use a smaller step or iterations > 1",
+    ):
         assert part in message, (part, message)
 
 

@@ -249,8 +249,9 @@ def test_unexpected_exception_is_one_error_line_and_a_debug_traceback(monkeypatc
         return 1 / 0
 
     monkeypatch.setattr(facade.unit, "advance", broken)
-    with caplog.at_level("DEBUG", logger="wire_fmu.export.facade"), pytest.raises(
-        ZeroDivisionError
+    with (
+        caplog.at_level("DEBUG", logger="wire_fmu.export.facade"),
+        pytest.raises(ZeroDivisionError),
     ):
         facade.do_step(0.0, 0.01)
     (message,) = log_entries(facade, Fmi2Status.error)

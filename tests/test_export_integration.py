@@ -175,8 +175,9 @@ def test_bad_parameter_in_simulate_fmu_raises_not_crashes(fmus):
         said.append((status, message.decode()))
 
     with pytest.raises(FMICallException, match="error"):
-        simulate_fmu(str(fmus["oscillator"]), stop_time=0.1, start_values={"mass": -1.0},
-                     logger=collect)
+        simulate_fmu(
+            str(fmus["oscillator"]), stop_time=0.1, start_values={"mass": -1.0}, logger=collect
+        )
     # fmpy switches the FMU's logging off by default; a message of status Error reaches
     # the host all the same, once
     (error,) = [m for s, m in said if s == FMI_ERROR]

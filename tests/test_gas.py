@@ -33,8 +33,9 @@ def test_stiffness_is_n_p_a2_over_v(n):
     dx = 1e-5
     force = [gas.pressure(volume + area * s) * area for s in (-dx, dx)]
     numeric = -(force[1] - force[0]) / (2 * dx)
-    assert gas.stiffness(volume, area) == pytest.approx(n * gas.pressure(volume) * area**2
-                                                        / volume, rel=1e-14)
+    assert gas.stiffness(volume, area) == pytest.approx(
+        n * gas.pressure(volume) * area**2 / volume, rel=1e-14
+    )
     assert gas.stiffness(volume, area) == pytest.approx(numeric, rel=1e-8)
     assert gas.compliance(volume) == pytest.approx(volume / (n * gas.pressure(volume)))
 

@@ -78,20 +78,40 @@ def stiff_pulley_scene(solver_max_step: float) -> dict:
     reeving = {
         "rope": {"axial_stiffness": PULLEY_EA},
         "gravity": [0.0, -G, 0.0],
-        "bodies": {"load": {"kind": "block", "mass": PULLEY_MASS, "direction": [0, 1, 0],
-                            "port": "block_a"}},
-        "sheaves": {"pulley": {"centre": [0.0, LONG_SPAN, 0.0], "radius": r,
-                               "inertia": RIM_MASS * r * r}},
+        "bodies": {
+            "load": {
+                "kind": "block",
+                "mass": PULLEY_MASS,
+                "direction": [0, 1, 0],
+                "port": "block_a",
+            }
+        },
+        "sheaves": {
+            "pulley": {"centre": [0.0, LONG_SPAN, 0.0], "radius": r, "inertia": RIM_MASS * r * r}
+        },
         "anchors": {"hook": {"body": "load", "point": [r, 0.0, 0.0]}},
-        "path": [{"line_end": "line_a", "point": [-r, LONG_SPAN - SHORT_SPAN, 0.0]},
-                 {"sheave": "pulley", "wrap": "cw"}, {"anchor": "hook"}],
+        "path": [
+            {"line_end": "line_a", "point": [-r, LONG_SPAN - SHORT_SPAN, 0.0]},
+            {"sheave": "pulley", "wrap": "cw"},
+            {"anchor": "hook"},
+        ],
     }
     return {
         "name": "stiff_span",
         "run": {"stop_time": 0.5, "step": 2e-3},
-        "units": {"rope": {"fmu": "BlockTrain", "effects": ["sheave_inertia"], "parameters": {
-            "reeving": reeving, "solver": "ros2", "solver_max_step": solver_max_step,
-            "initial_equilibrium": False, "pretension": PULLEY_PRETENSION}}},
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "effects": ["sheave_inertia"],
+                "parameters": {
+                    "reeving": reeving,
+                    "solver": "ros2",
+                    "solver_max_step": solver_max_step,
+                    "initial_equilibrium": False,
+                    "pretension": PULLEY_PRETENSION,
+                },
+            }
+        },
         "outputs": {"variables": "all"},
     }
 
@@ -110,8 +130,7 @@ def pulley_modes() -> tuple[float, float, float]:
     return float(omega[0]), float(omega[1]), k0 * k1 / (k0 + k1)
 
 
-def test_stiff_rope_inside_one_unit_is_stable_with_the_right_frequency_and_energy(
-        fmus, tmp_path):
+def test_stiff_rope_inside_one_unit_is_stable_with_the_right_frequency_and_energy(fmus, tmp_path):
     """A short stiff span on a light sheave inside the BlockTrain FMU, integrated by the
     L-stable ros2 at 4 and 2 times RK4's stability limit of the fast mode: the hook
     oscillates at the closed-form frequency (within 0.6 % / 0.15 % at the two steps) with
@@ -137,8 +156,7 @@ def test_stiff_rope_inside_one_unit_is_stable_with_the_right_frequency_and_energ
         assert frequency == pytest.approx(slow, rel=tolerance)
         assert np.ptp(y) == pytest.approx(2 * amplitude, rel=2 * tolerance)
         energy_errors.append(float(np.max(np.abs(run["rope.energy_balance"]))) / energy)
-        check_global_criteria(run.columns, ledger_tolerance=lost, energy_scale=energy,
-                              passive=True)
+        check_global_criteria(run.columns, ledger_tolerance=lost, energy_scale=energy, passive=True)
     assert_converges(frequency_errors, floor=1e-5, what="hook frequency error")
     assert_converges(energy_errors, floor=1e-5, what="energy lost")
 
@@ -162,18 +180,37 @@ def winch_and_fall_scene(step: float, *, stop: float = WINCH_STOP, **run) -> dic
         "name": "winch_and_fall",
         "run": {"stop_time": stop, "step": step, **run},
         "units": {
-            "winch": {"fmu": "Winch", "effects": ["drum_inertia"], "parameters": {
-                "drive_train": rigid_drum(DRUM_INERTIA), "drum_radius": DRUM_RADIUS,
-                "motor.command": -HOLD, "solver": "ros2", "solver_max_step": 5e-4}},
-            "rope": {"fmu": "BlockTrain", "effects": ["rope_damping"], "parameters": {
-                "reeving": single_fall(mass=LOAD, length=FALL, axial_stiffness=LINE_EA,
-                                       damping=LINE_DAMPING),
-                "solver_max_step": 5e-4}},
+            "winch": {
+                "fmu": "Winch",
+                "effects": ["drum_inertia"],
+                "parameters": {
+                    "drive_train": rigid_drum(DRUM_INERTIA),
+                    "drum_radius": DRUM_RADIUS,
+                    "motor.command": -HOLD,
+                    "solver": "ros2",
+                    "solver_max_step": 5e-4,
+                },
+            },
+            "rope": {
+                "fmu": "BlockTrain",
+                "effects": ["rope_damping"],
+                "parameters": {
+                    "reeving": single_fall(
+                        mass=LOAD, length=FALL, axial_stiffness=LINE_EA, damping=LINE_DAMPING
+                    ),
+                    "solver_max_step": 5e-4,
+                },
+            },
         },
-        "bonds": [{"name": "fast_line", "kind": "rope",
-                   "effort": "rope.line_a.tension -> winch.rope.tension",
-                   "flow": "winch.rope.payout_rate -> rope.line_a.payout_rate",
-                   "position": "winch.rope.payout -> rope.line_a.payout"}],
+        "bonds": [
+            {
+                "name": "fast_line",
+                "kind": "rope",
+                "effort": "rope.line_a.tension -> winch.rope.tension",
+                "flow": "winch.rope.payout_rate -> rope.line_a.payout_rate",
+                "position": "winch.rope.payout -> rope.line_a.payout",
+            }
+        ],
         "events": [{"time": 0.05, "label": "hoist", "set": {"winch.motor.command": -1.3 * HOLD}}],
         "outputs": {"variables": "all"},
     }
@@ -193,12 +230,13 @@ def winch_reference():
 
 def coupling_errors(run, ref) -> dict[str, float]:
     """Largest deviations from the monolithic reference."""
-    return {c: error_against(run, ref, c) for c in
-            ("rope.line_a.tension", "rope.block_a.position", "winch.drum.speed")}
+    return {
+        c: error_against(run, ref, c)
+        for c in ("rope.line_a.tension", "rope.block_a.position", "winch.drum.speed")
+    }
 
 
-def assert_close_to_reference(run, ref, *, position: float, tension: float,
-                              speed: float) -> None:
+def assert_close_to_reference(run, ref, *, position: float, tension: float, speed: float) -> None:
     """Within the stated tolerances of the reference, tension inside its envelope."""
     errors = coupling_errors(run, ref)
     tension_ref = ref.values["rope.line_a.tension"]
@@ -210,7 +248,8 @@ def assert_close_to_reference(run, ref, *, position: float, tension: float,
 
 
 def test_stiff_rope_across_a_unit_boundary_is_stable_with_iteration(
-        fmus, tmp_path, winch_reference):
+    fmus, tmp_path, winch_reference
+):
     """Drum and load coupled through the rope bond at omega H = 1: explicit coupling
     blows up there (the energy guard stops it; unguarded, the tension runs to more than
     twice its peak); iterating each step with rollback stays stable and follows the
@@ -228,13 +267,17 @@ def test_stiff_rope_across_a_unit_boundary_is_stable_with_iteration(
     explicit = run_case(winch_and_fall_scene(step), fmus, tmp_path / "explicit")
     assert explicit.result.status == "stopped"  # the energy guard: explicit coupling blows up
     assert "bond 'fast_line'" in explicit.result.message
-    unguarded = run_case(winch_and_fall_scene(step, energy_guard=math.inf), fmus,
-                         tmp_path / "unguarded")
+    unguarded = run_case(
+        winch_and_fall_scene(step, energy_guard=math.inf), fmus, tmp_path / "unguarded"
+    )
     assert unguarded["rope.line_a.tension"].max() > 2 * ref.values["rope.line_a.tension"].max()
     errors = []
     for h in (step, step / 2):
-        run = run_case(winch_and_fall_scene(h, iterations=10, iteration_tolerance=1e-8),
-                       fmus, tmp_path / f"iterated_{h}")
+        run = run_case(
+            winch_and_fall_scene(h, iterations=10, iteration_tolerance=1e-8),
+            fmus,
+            tmp_path / f"iterated_{h}",
+        )
         assert run.result.status == "finished", run.result.message
         assert_close_to_reference(run, ref, position=1e-3, tension=0.1, speed=0.15)
         assert abs(run.result.bond_residual["fast_line"]) < 1e-3  # J over the run
@@ -245,8 +288,13 @@ def test_stiff_rope_across_a_unit_boundary_is_stable_with_iteration(
 
 
 # ================================================== 2. band brake stick and slip
-BRAKE = {"brake_rim_radius": 0.6, "brake_lever_ratio": 10.0, "brake_efficiency": 0.9,
-         "brake_friction": 0.35, "brake_wrap_angle": 4.7}
+BRAKE = {
+    "brake_rim_radius": 0.6,
+    "brake_lever_ratio": 10.0,
+    "brake_efficiency": 0.9,
+    "brake_friction": 0.35,
+    "brake_wrap_angle": 4.7,
+}
 BRAKE_DRUM, BRAKE_RADIUS, LEVER = 1000.0, 0.5, 1000.0  # kg m^2, m, N
 RAMP_END, APPLY = 0.4, 0.5  # s: the load stops rising; the lever force doubles
 
@@ -254,8 +302,13 @@ RAMP_END, APPLY = 0.4, 0.5  # s: the load stops rising; the lever force doubles
 def brake_capacity(lever_force: float) -> float:
     """Eq. (34) written out: r_f F (L/l) eta (e^(mu alpha) - 1), N m (paying out)."""
     b = BRAKE
-    return (b["brake_rim_radius"] * lever_force * b["brake_lever_ratio"]
-            * b["brake_efficiency"] * math.expm1(b["brake_friction"] * b["brake_wrap_angle"]))
+    return (
+        b["brake_rim_radius"]
+        * lever_force
+        * b["brake_lever_ratio"]
+        * b["brake_efficiency"]
+        * math.expm1(b["brake_friction"] * b["brake_wrap_angle"])
+    )
 
 
 CAPACITY = brake_capacity(LEVER)
@@ -269,14 +322,32 @@ def brake_scene(step: float) -> dict:
     return {
         "name": "band_brake",
         "run": {"stop_time": 0.8, "step": step},
-        "units": {"winch": {"fmu": "Winch", "effects": ["drum_inertia", "band_brake"],
-                            "parameters": {"drive_train": rigid_drum(BRAKE_DRUM),
-                                           "drum_radius": BRAKE_RADIUS, **BRAKE,
-                                           "brake.lever_force": LEVER}}},
-        "drivers": [{"target": "winch.rope.tension", "kind": "ramp",
-                     "points": [[0.0, T_START], [RAMP_END, T_END]]}],
-        "events": [{"time": APPLY, "label": "brake applied harder",
-                    "set": {"winch.brake.lever_force": 2 * LEVER}}],
+        "units": {
+            "winch": {
+                "fmu": "Winch",
+                "effects": ["drum_inertia", "band_brake"],
+                "parameters": {
+                    "drive_train": rigid_drum(BRAKE_DRUM),
+                    "drum_radius": BRAKE_RADIUS,
+                    **BRAKE,
+                    "brake.lever_force": LEVER,
+                },
+            }
+        },
+        "drivers": [
+            {
+                "target": "winch.rope.tension",
+                "kind": "ramp",
+                "points": [[0.0, T_START], [RAMP_END, T_END]],
+            }
+        ],
+        "events": [
+            {
+                "time": APPLY,
+                "label": "brake applied harder",
+                "set": {"winch.brake.lever_force": 2 * LEVER},
+            }
+        ],
         "outputs": {"variables": "all"},
     }
 
@@ -333,8 +404,7 @@ def test_band_brake_holds_breaks_away_slides_and_resticks_without_chatter(fmus, 
         np.testing.assert_allclose(slope, expected, rtol=1e-9)
         restuck = t >= t_stop + step
         assert np.all(w[restuck] == 0.0) and np.all(run["winch.brake.state"][restuck] == 2)
-        assert run["winch.brake.torque"][restuck] == pytest.approx(-T_END * BRAKE_RADIUS,
-                                                                   rel=1e-12)
+        assert run["winch.brake.torque"][restuck] == pytest.approx(-T_END * BRAKE_RADIUS, rel=1e-12)
         assert run["winch.mode_changes"][-1] == 2  # breakaway, re-stick: no chatter
         assert np.count_nonzero(np.diff(run["winch.brake.state"])) == 2
         check_global_criteria(run.columns, ledger_tolerance=1e-9)
@@ -352,9 +422,19 @@ def snap_scene(step: float) -> dict:
     return {
         "name": "snap",
         "run": {"stop_time": 0.3, "step": step},
-        "units": {"rope": {"fmu": "BlockTrain", "parameters": {
-            "reeving": single_fall(mass=SNAP_MASS, length=SNAP_LENGTH, axial_stiffness=SNAP_EA),
-            "initial_equilibrium": False, "pretension": 0.0, "solver_max_step": step}}},
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "parameters": {
+                    "reeving": single_fall(
+                        mass=SNAP_MASS, length=SNAP_LENGTH, axial_stiffness=SNAP_EA
+                    ),
+                    "initial_equilibrium": False,
+                    "pretension": 0.0,
+                    "solver_max_step": step,
+                },
+            }
+        },
         "events": [{"time": 0.0, "label": "payout step", "set": {"rope.line_a.payout": DROP}}],
         "outputs": {"variables": "all"},
     }
@@ -384,8 +464,9 @@ def test_slack_rope_carries_nothing_and_snaps_to_the_closed_form(fmus, tmp_path)
         assert np.all(tension[slack] == 0.0) and np.all(run["rope.slack_spans"][slack] == 1)
         assert t_engage < t[np.flatnonzero(tension > 0.0)[0]] <= t_engage + step
         assert tension.max() == pytest.approx(expected, rel=tolerance)
-        check_global_criteria(run.columns, ledger_tolerance=1e-2, energy_scale=fall_energy,
-                              passive=True)
+        check_global_criteria(
+            run.columns, ledger_tolerance=1e-2, energy_scale=fall_energy, passive=True
+        )
         errors.append(abs(tension.max() / expected - 1))
     assert_converges(errors, floor=1e-6, what="snap load error")
 
@@ -408,35 +489,61 @@ def break_scene(step: float, how: str) -> dict:
         event = {"time": 0.05, "label": "hoist hard", "set": {"winch.motor.command": -2 * HOLD}}
     else:
         event = {"time": 0.1, "label": "rope cut", "set": {"rope.break_segment": 1}}
-    watch = ["rope.line_a.tension", "rope.tension_max", "rope.block_a.position",
-             "rope.block_a.velocity", "rope.broken", "rope.mode_changes", "rope.stored_energy",
-             "rope.dissipated_energy", "rope.external_work", "winch.rope.tension",
-             "winch.drum.speed", "winch.motor.torque", "winch.stored_energy",
-             "winch.dissipated_energy", "winch.external_work"]
+    watch = [
+        "rope.line_a.tension",
+        "rope.tension_max",
+        "rope.block_a.position",
+        "rope.block_a.velocity",
+        "rope.broken",
+        "rope.mode_changes",
+        "rope.stored_energy",
+        "rope.dissipated_energy",
+        "rope.external_work",
+        "winch.rope.tension",
+        "winch.drum.speed",
+        "winch.motor.torque",
+        "winch.stored_energy",
+        "winch.dissipated_energy",
+        "winch.external_work",
+    ]
     return {
         "name": "rope_break",
         "run": {"stop_time": BREAK_STOP, "step": step},
         "units": {
-            "winch": {"fmu": "Winch", "effects": ["drum_inertia"], "parameters": {
-                "drive_train": rigid_drum(BREAK_DRUM), "drum_radius": DRUM_RADIUS,
-                "motor.command": -HOLD, "solver": "ros2"}},
+            "winch": {
+                "fmu": "Winch",
+                "effects": ["drum_inertia"],
+                "parameters": {
+                    "drive_train": rigid_drum(BREAK_DRUM),
+                    "drum_radius": DRUM_RADIUS,
+                    "motor.command": -HOLD,
+                    "solver": "ros2",
+                },
+            },
             "rope": {"fmu": "BlockTrain", "parameters": {"reeving": reeving}},
         },
-        "bonds": [{"name": "fast_line", "kind": "rope",
-                   "effort": "rope.line_a.tension -> winch.rope.tension",
-                   "flow": "winch.rope.payout_rate -> rope.line_a.payout_rate",
-                   "position": "winch.rope.payout -> rope.line_a.payout"}],
+        "bonds": [
+            {
+                "name": "fast_line",
+                "kind": "rope",
+                "effort": "rope.line_a.tension -> winch.rope.tension",
+                "flow": "winch.rope.payout_rate -> rope.line_a.payout_rate",
+                "position": "winch.rope.payout -> rope.line_a.payout",
+            }
+        ],
         "events": [event],
         "outputs": {"variables": watch},
     }
 
 
-@pytest.mark.parametrize("how", [
-    "breaking_load",
-    "commanded",
-])
-def test_rope_break_leaves_zero_tension_free_fall_and_no_phantom_tension(
-        fmus, tmp_path, how):
+@pytest.mark.parametrize(
+    "how",
+    [
+        "breaking_load",
+        "commanded",
+    ],
+)
+def test_rope_break_leaves_zero_tension_free_fall_and_no_phantom_tension(fmus, tmp_path, how):
     """Winch and rope in one scene; after the break the rope's tension is exactly 0, the
     load falls on the parabola y_b + v_b t - g t^2 / 2, the break is a mode event
     (rope.mode_changes moves), and from the step after the break on the winch holds
@@ -460,20 +567,27 @@ def test_rope_break_leaves_zero_tension_free_fall_and_no_phantom_tension(
         assert np.all(run["rope.tension_max"][k:] == 0.0)
         tau = t[k:] - t[k]
         y_k, v_k = run["rope.block_a.position"][k], run["rope.block_a.velocity"][k]
-        np.testing.assert_allclose(run["rope.block_a.position"][k:],
-                                   y_k + v_k * tau - 0.5 * G * tau**2, rtol=0, atol=1e-9)
-        np.testing.assert_allclose(run["rope.block_a.velocity"][k:], v_k - G * tau,
-                                   rtol=0, atol=1e-9)
+        np.testing.assert_allclose(
+            run["rope.block_a.position"][k:], y_k + v_k * tau - 0.5 * G * tau**2, rtol=0, atol=1e-9
+        )
+        np.testing.assert_allclose(
+            run["rope.block_a.velocity"][k:], v_k - G * tau, rtol=0, atol=1e-9
+        )
         # the winch steps first (Gauss-Seidel, flow side): the step containing the break
         # holds the tension from before it; every later step must hold exactly 0
-        assert np.all(run["winch.rope.tension"][k + 1:] == 0.0), (
-            run["winch.rope.tension"][k:k + 3])
+        assert np.all(run["winch.rope.tension"][k + 1 :] == 0.0), run["winch.rope.tension"][
+            k : k + 3
+        ]
         spin_up = np.diff(run["winch.drum.speed"][k:]) / step
         torque = run["winch.motor.torque"][-1]
         np.testing.assert_allclose(spin_up, torque / BREAK_DRUM, rtol=1e-9)
         check_global_criteria(run.columns, ledger_tolerance=1e-3)
-        errors.append(max(error_against(run, ref, "winch.drum.speed"),
-                          error_against(run, ref, "rope.block_a.velocity")))
+        errors.append(
+            max(
+                error_against(run, ref, "winch.drum.speed"),
+                error_against(run, ref, "rope.block_a.velocity"),
+            )
+        )
     assert_converges(errors, floor=1e-9, what="speed error after the break")
 
 
@@ -486,10 +600,14 @@ BORE_AREA = math.pi * 0.2**2 / 4
 def impact_scene(step: float, solver_max_step: float) -> dict:
     """A free rod (its oil force balanced by rod.force) runs at 0.5 m/s onto the extension
     stop, 1e8 N/m with restitution 0.3, no cushion; contact begins at 0.08 s."""
-    params = constant_force_cylinder(initial_velocity=IMPACT_SPEED, initial_position=3.96,
-                                     cushion_length=0.0, stop_stiffness=STOP_STIFFNESS,
-                                     stop_restitution=RESTITUTION,
-                                     solver_max_step=solver_max_step)
+    params = constant_force_cylinder(
+        initial_velocity=IMPACT_SPEED,
+        initial_position=3.96,
+        cushion_length=0.0,
+        stop_stiffness=STOP_STIFFNESS,
+        stop_restitution=RESTITUTION,
+        solver_max_step=solver_max_step,
+    )
     params["rod.force"] = -BORE_AREA * GAS_PRESSURE
     return {
         "name": "end_stop",
@@ -532,8 +650,13 @@ def test_end_stop_impact_restitution_no_tunnelling_no_pull(fmus, tmp_path):
         if step < 0.01:  # the contact is sampled: its depth is the contact's compliance
             assert np.max(x) - STROKE >= 0.98 * peak and np.min(force) < 0.0
             errors.append(abs(v[-1] / (-RESTITUTION * IMPACT_SPEED) - 1))
-        check_global_criteria(run.columns, ledger_tolerance=5e-3, energy_scale=impact_energy,
-                              passive=True, dead_volumes={"cyl": 1.0})
+        check_global_criteria(
+            run.columns,
+            ledger_tolerance=5e-3,
+            energy_scale=impact_energy,
+            passive=True,
+            dead_volumes={"cyl": 1.0},
+        )
     assert_converges(errors, floor=1e-6, what="restitution error")
 
 
@@ -548,15 +671,19 @@ def zero_gas_scene(step: float, solver_max_step: float) -> dict:
     """A gas spring at rest at 10 MPa (0.04 m^3 of gas, isothermal); at t = 0 the rod load
     grows by 0.5 MN, which the gas (p0 V0 ln 8 = 0.83 MJ between here and its dead
     volume) cannot stop: the rod drives the gas towards zero volume at about 12 m/s."""
-    params = quiet_cylinder(accumulator_volume=GAS_FULL, accumulator_dead_volume=GAS_DEAD,
-                            solver_max_step=solver_max_step)
+    params = quiet_cylinder(
+        accumulator_volume=GAS_FULL,
+        accumulator_dead_volume=GAS_DEAD,
+        solver_max_step=solver_max_step,
+    )
     params["rod.force"] = F_EQ
     return {
         "name": "zero_gas",
         "run": {"stop_time": 1.0, "step": step},
         "units": {"cyl": {"fmu": "Hydraulics", "parameters": params}},
-        "events": [{"time": 0.0, "label": "load added",
-                    "set": {"cyl.rod.force": F_EQ - EXTRA_LOAD}}],
+        "events": [
+            {"time": 0.0, "label": "load added", "set": {"cyl.rod.force": F_EQ - EXTRA_LOAD}}
+        ],
         "outputs": {"variables": "all"},
     }
 
@@ -616,8 +743,7 @@ def test_accumulator_driven_to_zero_gas_volume_refuses_the_step(fmus, tmp_path):
 LARGE_STEP = 0.02  # s: omega H = 10 for the 510 rad/s mode across the bond
 
 
-def test_far_too_large_macro_step_is_shrunk_by_the_adaptive_master(
-        fmus, tmp_path, winch_reference):
+def test_far_too_large_macro_step_is_shrunk_by_the_adaptive_master(fmus, tmp_path, winch_reference):
     """The winch-and-fall scene at H = 20 ms (omega H = 10) with adaptive steps: rejected
     steps shrink it to what the coupled mode needs, every accepted step keeps the bond's
     energy residual under the tolerance, and the run follows the monolithic reference
@@ -630,17 +756,24 @@ def test_far_too_large_macro_step_is_shrunk_by_the_adaptive_master(
     assert coupled_frequency() * LARGE_STEP > 5
     errors = []
     for tolerance in (1e-2, 1e-3):
-        run = run_case(winch_and_fall_scene(LARGE_STEP, adaptive=True, energy_tolerance=tolerance,
-                                            min_step=1e-5, max_step=LARGE_STEP),
-                       fmus, tmp_path / f"tol{tolerance}")
+        run = run_case(
+            winch_and_fall_scene(
+                LARGE_STEP,
+                adaptive=True,
+                energy_tolerance=tolerance,
+                min_step=1e-5,
+                max_step=LARGE_STEP,
+            ),
+            fmus,
+            tmp_path / f"tol{tolerance}",
+        )
         assert run.result.status == "finished", run.result.message
         assert run.result.rejected > 0
         steps = np.diff(run.time)
         assert steps.min() < LARGE_STEP / 10  # shrunk where the coupled mode rings
         residual = np.abs(np.diff(run["bond.fast_line.energy_residual"]))
         assert residual.max() <= tolerance * (1 + 1e-9)
-        assert_close_to_reference(run, winch_reference, position=1e-3, tension=0.1,
-                                  speed=0.15)
+        assert_close_to_reference(run, winch_reference, position=1e-3, tension=0.1, speed=0.15)
         check_global_criteria(run.columns, ledger_tolerance=3e-3)
         errors.append(coupling_errors(run, winch_reference))
     for column in ("rope.line_a.tension", "winch.drum.speed"):
@@ -654,21 +787,29 @@ def unstable_internal_step(unit: str) -> dict:
     about 400 1/s). ``rope``: the stiff-span block train at 0.5 ms (|lambda| h = 12).
     """
     if unit == "winch":
-        return {"name": "unstable_internal_step",
-                "units": {"winch": {"fmu": "Winch",
-                                    "effects": ["drum_inertia", "elastic_drive_train"],
-                                    "parameters": {"solver": "rk4", "solver_max_step": 0.05}}}}
+        return {
+            "name": "unstable_internal_step",
+            "units": {
+                "winch": {
+                    "fmu": "Winch",
+                    "effects": ["drum_inertia", "elastic_drive_train"],
+                    "parameters": {"solver": "rk4", "solver_max_step": 0.05},
+                }
+            },
+        }
     data = stiff_pulley_scene(5e-4)
     data["units"]["rope"]["parameters"]["solver"] = "rk4"
     return data
 
 
-@pytest.mark.parametrize("unit", [
-    "winch",
-    "rope",
-])
-def test_an_internal_step_that_cannot_be_stable_is_refused_before_the_run(
-        fmus, tmp_path, unit):
+@pytest.mark.parametrize(
+    "unit",
+    [
+        "winch",
+        "rope",
+    ],
+)
+def test_an_internal_step_that_cannot_be_stable_is_refused_before_the_run(fmus, tmp_path, unit):
     """A unit whose rk4 step is far too large for its own dynamics is refused when the scene
     is validated (through FMI), naming the unit, the parameter and a stable step.
 
@@ -688,17 +829,21 @@ def test_an_internal_step_that_cannot_be_stable_is_refused_before_the_run(
 SILENT = {
     # settings: (run settings, what the stop message must say)
     "explicit": ({}, ("the coupling blows up", "bond 'fast_line' created and destroyed")),
-    "iteration_not_converged": ({"iterations": 10, "iteration_tolerance": 1e-8},
-                                ("the iteration over the step", "diverges")),
-    "adaptive_at_its_minimum_step": ({"adaptive": True, "energy_tolerance": 1e-2,
-                                      "min_step": 0.01, "max_step": LARGE_STEP},
-                                     ("cannot meet the tolerance", "minimum step")),
+    "iteration_not_converged": (
+        {"iterations": 10, "iteration_tolerance": 1e-8},
+        ("the iteration over the step", "diverges"),
+    ),
+    "adaptive_at_its_minimum_step": (
+        {"adaptive": True, "energy_tolerance": 1e-2, "min_step": 0.01, "max_step": LARGE_STEP},
+        ("cannot meet the tolerance", "minimum step"),
+    ),
 }
 
 
 @pytest.mark.parametrize("settings", list(SILENT))
 def test_far_too_large_macro_step_is_never_a_silent_blow_up(
-        fmus, tmp_path, winch_reference, settings):
+    fmus, tmp_path, winch_reference, settings
+):
     """Whatever the settings, H = 20 ms (omega H = 10) must end stable or stopped with a
     message: 'finished' is acceptable only with the tension in its physical envelope and
     the bonds' energy residual under 1 J. Stopped, the message says when, at which step
@@ -737,9 +882,11 @@ def test_far_too_large_macro_step_is_never_a_silent_blow_up(
     tension = run["rope.line_a.tension"]
     expected = winch_reference.values["rope.line_a.tension"]
     residual = result.bond_residual["fast_line"]
-    summary = (f"'finished' with the tension in {tension.min():.4g}..{tension.max():.4g} N "
-               f"(reference {expected.min():.4g}..{expected.max():.4g} N) and a bond energy "
-               f"residual of {residual:.3g} J")
+    summary = (
+        f"'finished' with the tension in {tension.min():.4g}..{tension.max():.4g} N "
+        f"(reference {expected.min():.4g}..{expected.max():.4g} N) and a bond energy "
+        f"residual of {residual:.3g} J"
+    )
     assert 0.5 * expected.min() <= tension.min(), summary
     assert tension.max() <= 1.5 * expected.max(), summary
     assert abs(residual) < 1.0, summary
@@ -748,8 +895,9 @@ def test_far_too_large_macro_step_is_never_a_silent_blow_up(
 def shipped_scene(name: str, fmus):
     """A shipped scene on our built FMUs."""
     scene = load_scene(find_scene(name))
-    return replace(scene, units={n: replace(u, fmu=str(fmus[u.fmu]))
-                                 for n, u in scene.units.items()})
+    return replace(
+        scene, units={n: replace(u, fmu=str(fmus[u.fmu])) for n, u in scene.units.items()}
+    )
 
 
 def shipped_run(name: str, fmus, directory: Path, **run_settings) -> tuple[RunResult, dict]:
@@ -774,10 +922,10 @@ def test_shipped_riser_tensioner_blow_up_is_stopped_soon_after_it_shows(fmus, tm
     Mutation: the guard removed (EnergyGuard.blow_up returning None): the guarded run
     'finished' at 12 s: the status assertion failed.
     """
-    jacobi = {"algorithm": "jacobi", "extrapolation": "constant", "step": 0.008,
-              "stop_time": 12.0}
-    _, unguarded = shipped_run("riser_tensioner", fmus, tmp_path / "unguarded",
-                               energy_guard=math.inf, **jacobi)
+    jacobi = {"algorithm": "jacobi", "extrapolation": "constant", "step": 0.008, "stop_time": 12.0}
+    _, unguarded = shipped_run(
+        "riser_tensioner", fmus, tmp_path / "unguarded", energy_guard=math.inf, **jacobi
+    )
     tension = unguarded["rope.path_end.tension"]
     outside = np.flatnonzero((tension < RISER_BAND[0]) | (tension > RISER_BAND[1]))
     assert outside.size and tension.min() == 0.0 and tension.max() > 1e6  # a blow-up
@@ -787,8 +935,9 @@ def test_shipped_riser_tensioner_blow_up_is_stopped_soon_after_it_shows(fmus, tm
     assert "the coupling blows up" in result.message and "bond 'rod'" in result.message
     assert leaves <= result.end_time <= leaves + 0.25
     assert columns["time"][-1] == pytest.approx(result.end_time)
-    np.testing.assert_array_equal(columns["rope.path_end.tension"],
-                                  tension[:len(columns["time"])])  # the same run, cut short
+    np.testing.assert_array_equal(
+        columns["rope.path_end.tension"], tension[: len(columns["time"])]
+    )  # the same run, cut short
     own, columns = shipped_run("riser_tensioner", fmus, tmp_path / "own", stop_time=12.0)
     assert own.status == "finished", own.message
     tension = columns["rope.path_end.tension"]
@@ -806,10 +955,14 @@ def test_a_deliberate_algebraic_loop_is_detected_and_named(fmus, tmp_path):
     Mutation: loop detection disabled (validate.feedthrough_loops returning []); the
     scene validated and no SceneError was raised.
     """
-    loop = {"name": "loop",
-            "units": {"a": {"fmu": "Hydraulics"}, "b": {"fmu": "Hydraulics"}},
-            "connections": [{"from": "a.hydraulic_force", "to": "b.rod.force"},
-                            {"from": "b.hydraulic_force", "to": "a.rod.force"}]}
+    loop = {
+        "name": "loop",
+        "units": {"a": {"fmu": "Hydraulics"}, "b": {"fmu": "Hydraulics"}},
+        "connections": [
+            {"from": "a.hydraulic_force", "to": "b.rod.force"},
+            {"from": "b.hydraulic_force", "to": "a.rod.force"},
+        ],
+    }
     with pytest.raises(SceneError) as info:
         validate_scene(master_scene(loop, fmus, tmp_path))
     problems = [p for p in info.value.problems if "algebraic loop" in p]
@@ -819,12 +972,19 @@ def test_a_deliberate_algebraic_loop_is_detected_and_named(fmus, tmp_path):
     with pytest.raises(SceneError, match="algebraic loop"):
         run_scene(master_scene(loop, fmus, tmp_path), tmp_path / "never", plots=False)
     assert not (tmp_path / "never" / "timeseries.csv").exists()
-    proper = {"name": "cut_at_the_rod",
-              "units": {"rope": {"fmu": "BlockTrain"}, "cyl": {"fmu": "Hydraulics"}},
-              "bonds": [{"name": "rod", "kind": "translational",
-                         "effort": "rope.mover_a.force -> cyl.rod.force",
-                         "flow": "cyl.rod.velocity -> rope.mover_a.velocity",
-                         "position": "cyl.rod.displacement -> rope.mover_a.position"}]}
+    proper = {
+        "name": "cut_at_the_rod",
+        "units": {"rope": {"fmu": "BlockTrain"}, "cyl": {"fmu": "Hydraulics"}},
+        "bonds": [
+            {
+                "name": "rod",
+                "kind": "translational",
+                "effort": "rope.mover_a.force -> cyl.rod.force",
+                "flow": "cyl.rod.velocity -> rope.mover_a.velocity",
+                "position": "cyl.rod.displacement -> rope.mover_a.position",
+            }
+        ],
+    }
     validate_scene(master_scene(proper, fmus, tmp_path), through_fmi=False)
 
 
@@ -835,8 +995,9 @@ SHIPPED = ("drawworks", "riser_tensioner", "heave_compensated_hoist")
 def quiet_shipped_scene(name: str, fmus, step_factor: float):
     """A shipped scene for its first second, drivers and events off, every output recorded."""
     scene = replace(shipped_scene(name, fmus), drivers=(), events=(), outputs=None, plots=())
-    return with_run_settings(scene, stop_time=1.0, step=scene.run.step * step_factor,
-                             output_interval=None)
+    return with_run_settings(
+        scene, stop_time=1.0, step=scene.run.step * step_factor, output_interval=None
+    )
 
 
 @pytest.mark.parametrize("name", SHIPPED)

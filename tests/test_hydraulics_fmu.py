@@ -37,9 +37,18 @@ def test_declarations_are_sound():
 
 def test_rod_motion_is_a_state_with_no_direct_feedthrough():
     """The cut is at the rod's inertia: position and velocity depend on no input."""
-    for name in ("rod.position", "rod.velocity", "rod.displacement", "gas.pressure",
-                 "gas.volume", "stored_energy", "dissipated_energy", "external_work",
-                 "energy_balance", "mode_changes"):
+    for name in (
+        "rod.position",
+        "rod.velocity",
+        "rod.displacement",
+        "gas.pressure",
+        "gas.volume",
+        "stored_energy",
+        "dissipated_energy",
+        "external_work",
+        "energy_balance",
+        "mode_changes",
+    ):
         assert HydraulicsUnit.variable(name).depends_on == ()
     for name in ("rod.acceleration", "chamber.pressure", "seal.friction_force"):
         assert HydraulicsUnit.variable(name).depends_on == ("rod.force",)
@@ -56,8 +65,17 @@ def perturbed(unit: HydraulicsUnit, delta: float) -> tuple[dict, dict]:
     return before, after
 
 
-@pytest.mark.parametrize("effects", ["", "line_inertance", "seal_friction", "end_stops",
-                                     "oil_compressibility,line_inertance", ALL_EFFECTS])
+@pytest.mark.parametrize(
+    "effects",
+    [
+        "",
+        "line_inertance",
+        "seal_friction",
+        "end_stops",
+        "oil_compressibility,line_inertance",
+        ALL_EFFECTS,
+    ],
+)
 def test_declared_feedthrough_matches_the_numbers(effects):
     """Outputs declared without dependencies never move when the input does, at rest
     and in motion; the declared ones do where the physics says so."""
@@ -73,7 +91,8 @@ def test_declared_feedthrough_matches_the_numbers(effects):
             assert after["rod.acceleration"] != before["rod.acceleration"]
         else:  # the seals carry the change
             assert after["seal.friction_force"] - before["seal.friction_force"] == (
-                pytest.approx(-delta))
+                pytest.approx(-delta)
+            )
         if effects == "line_inertance":  # the line's oil column is accelerated with the rod
             assert after["chamber.pressure"] != before["chamber.pressure"]
 
@@ -112,10 +131,16 @@ def test_state_round_trip_is_bit_identical_in_stick_mode():
 
 
 def test_state_round_trip_is_bit_identical_on_an_end_stop():
-    unit = make_free_rod("end_stops,seal_friction", 0.5, cushion_length=0.0,
-                         stop_stiffness=1e8, initial_position=3.99,
-                         seal_static_friction=10.0, seal_coulomb_friction=5.0,
-                         seal_viscous_friction=0.0)
+    unit = make_free_rod(
+        "end_stops,seal_friction",
+        0.5,
+        cushion_length=0.0,
+        stop_stiffness=1e8,
+        initial_position=3.99,
+        seal_static_friction=10.0,
+        seal_coulomb_friction=5.0,
+        seal_viscous_friction=0.0,
+    )
     hold = unit.values["rod.force"]
     for i in range(1000):  # into the contact
         assert unit.advance(i * 1e-4, 1e-4).success
@@ -123,10 +148,16 @@ def test_state_round_trip_is_bit_identical_on_an_end_stop():
             break
     assert unit.values["end_stop.contact"]
     saved = json.loads(json.dumps(unit.get_state()))
-    other = make_free_rod("end_stops,seal_friction", 0.5, cushion_length=0.0,
-                          stop_stiffness=1e8, initial_position=3.99,
-                          seal_static_friction=10.0, seal_coulomb_friction=5.0,
-                          seal_viscous_friction=0.0)
+    other = make_free_rod(
+        "end_stops,seal_friction",
+        0.5,
+        cushion_length=0.0,
+        stop_stiffness=1e8,
+        initial_position=3.99,
+        seal_static_friction=10.0,
+        seal_coulomb_friction=5.0,
+        seal_viscous_friction=0.0,
+    )
     other.set_state(saved)
     start = (i + 1) * 1e-4
     first = replay(unit, start, 20, lambda t: hold)
@@ -136,8 +167,9 @@ def test_state_round_trip_is_bit_identical_on_an_end_stop():
 
 
 def load_facade_class():
-    spec = importlib.util.spec_from_file_location("hydraulics_facade",
-                                                  ROOT / "models" / "hydraulics.py")
+    spec = importlib.util.spec_from_file_location(
+        "hydraulics_facade", ROOT / "models" / "hydraulics.py"
+    )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module.Hydraulics
@@ -172,8 +204,9 @@ def test_facade_steps_like_the_core():
     assert facade.get_integer([refs["mode_changes"]]) == [unit.values["mode_changes"]]
 
 
-@pytest.mark.parametrize("effects", ["seal_friction,line_losses",
-                                     "oil_compressibility,line_inertance,polytropic_gas"])
+@pytest.mark.parametrize(
+    "effects", ["seal_friction,line_losses", "oil_compressibility,line_inertance,polytropic_gas"]
+)
 def test_ode_view_integrates_like_the_unit(effects):
     """As a piece of a monolithic model the unit is the same hybrid ODE: integrated
     by the shared solver with a held force it matches the unit's own steps, and the

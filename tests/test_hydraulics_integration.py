@@ -23,8 +23,17 @@ from .hydraulics_helpers import ALL_EFFECTS, make_unit, quiet_cylinder  # noqa: 
 pytestmark = pytest.mark.integration
 
 ROOT = Path(__file__).resolve().parents[1]
-WATCH = ["rod.position", "rod.velocity", "chamber.pressure", "gas.pressure", "gas.volume",
-         "seal.friction_force", "end_stop.force", "energy_balance", "dissipated_energy"]
+WATCH = [
+    "rod.position",
+    "rod.velocity",
+    "chamber.pressure",
+    "gas.pressure",
+    "gas.volume",
+    "seal.friction_force",
+    "end_stop.force",
+    "energy_balance",
+    "dissipated_energy",
+]
 STEP = 0.01
 F0 = -4 * 356.0e3
 

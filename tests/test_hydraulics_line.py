@@ -9,8 +9,14 @@ import pytest
 
 from wire_fmu.core.hydraulic_line import HydraulicLine
 
-LINE = HydraulicLine(length=15.0, diameter=0.15, density=870.0, viscosity=0.028,
-                     friction_factor=0.025, loss_coefficient=5.0)
+LINE = HydraulicLine(
+    length=15.0,
+    diameter=0.15,
+    density=870.0,
+    viscosity=0.028,
+    friction_factor=0.025,
+    loss_coefficient=5.0,
+)
 
 
 def test_laminar_resistance_is_hagen_poiseuille():
@@ -21,12 +27,12 @@ def test_laminar_resistance_is_hagen_poiseuille():
 def test_turbulent_resistance_is_darcy_weisbach_plus_minor_losses():
     area = math.pi * 0.15**2 / 4
     k_total = 0.025 * 15.0 / 0.15 + 5.0  # 7.5
-    assert LINE.turbulent_resistance == pytest.approx(870.0 * k_total / (2 * area**2),
-                                                      rel=1e-12)
+    assert LINE.turbulent_resistance == pytest.approx(870.0 * k_total / (2 * area**2), rel=1e-12)
     # the velocity-head form: dp = K rho u^2 / 2 with u = q / A
     q = 0.05
     assert LINE.turbulent_resistance * q * q == pytest.approx(
-        k_total * 870.0 * (q / area) ** 2 / 2, rel=1e-12)
+        k_total * 870.0 * (q / area) ** 2 / 2, rel=1e-12
+    )
 
 
 def test_inertance_is_rho_l_over_a_and_stores_the_columns_kinetic_energy():
@@ -39,12 +45,12 @@ def test_inertance_is_rho_l_over_a_and_stores_the_columns_kinetic_energy():
 
 def test_pure_regimes():
     laminar = HydraulicLine(10.0, 0.05, 870.0, 0.05, friction_factor=0.0, loss_coefficient=0.0)
-    turbulent = HydraulicLine(10.0, 0.05, 870.0, 0.0, friction_factor=0.02,
-                              loss_coefficient=1.0)
+    turbulent = HydraulicLine(10.0, 0.05, 870.0, 0.0, friction_factor=0.02, loss_coefficient=1.0)
     for q in (-0.01, 1e-4, 0.02):
         assert laminar.pressure_drop(q) == pytest.approx(laminar.laminar_resistance * q)
         assert turbulent.pressure_drop(q) == pytest.approx(
-            turbulent.turbulent_resistance * q * abs(q))
+            turbulent.turbulent_resistance * q * abs(q)
+        )
         assert turbulent.flow(turbulent.pressure_drop(q)) == pytest.approx(q, rel=1e-12)
         assert laminar.flow(laminar.pressure_drop(q)) == pytest.approx(q, rel=1e-12)
 
@@ -52,7 +58,8 @@ def test_pure_regimes():
 def test_blend_is_continuous_and_monotonic_across_the_transition():
     q_star = LINE.transition_flow
     assert LINE.laminar_resistance * q_star == pytest.approx(
-        LINE.turbulent_resistance * q_star**2, rel=1e-12)
+        LINE.turbulent_resistance * q_star**2, rel=1e-12
+    )
     flows = np.linspace(-20 * q_star, 20 * q_star, 4001)
     drops = np.array([LINE.pressure_drop(q) for q in flows])
     assert np.all(np.diff(drops) > 0.0)
@@ -60,9 +67,11 @@ def test_blend_is_continuous_and_monotonic_across_the_transition():
     assert np.max(np.abs(np.diff(slopes))) < 1e-2 * np.max(slopes)  # no kink (C^1)
     # laminar far below the transition, turbulent far above
     assert LINE.pressure_drop(1e-3 * q_star) == pytest.approx(
-        LINE.laminar_resistance * 1e-3 * q_star, rel=2e-3)
+        LINE.laminar_resistance * 1e-3 * q_star, rel=2e-3
+    )
     assert LINE.pressure_drop(1e3 * q_star) == pytest.approx(
-        LINE.turbulent_resistance * (1e3 * q_star) ** 2, rel=2e-3)
+        LINE.turbulent_resistance * (1e3 * q_star) ** 2, rel=2e-3
+    )
 
 
 @pytest.mark.parametrize("q", [-0.3, -1e-7, 0.0, 3e-6, 0.11])

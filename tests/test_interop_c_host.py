@@ -63,8 +63,22 @@ def host(tmp_path_factory) -> tuple[Path, Path]:
         pytest.skip(reason)
     folder = tmp_path_factory.mktemp("c_host")
     exe = folder / "fmu_host"
-    subprocess.run(["gcc", "-Wall", "-Wextra", "-Werror", "-o", str(exe), str(HOST_SOURCE),
-                    f"-I{FMI_HEADERS}", "-ldl"], check=True, capture_output=True, text=True)
+    subprocess.run(
+        [
+            "gcc",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-o",
+            str(exe),
+            str(HOST_SOURCE),
+            f"-I{FMI_HEADERS}",
+            "-ldl",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     fmu = build_fmu(ROOT / "models" / "block_train.py", folder)
     unzipped = folder / "BlockTrain"
     with zipfile.ZipFile(fmu) as archive:
@@ -87,8 +101,13 @@ def _fmpy_values(unzipped: Path) -> list[float]:
 
 def test_c_host_runs_the_block_train_with_libpython_preloaded(host):
     exe, unzipped = host
-    run = subprocess.run([str(exe), str(unzipped), VARIABLE, str(STEPS), str(STEP)],
-                         env=host_environment(), capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [str(exe), str(unzipped), VARIABLE, str(STEPS), str(STEP)],
+        env=host_environment(),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     values = [float(line.split()[1]) for line in run.stdout.splitlines()]
     assert len(values) == STEPS
@@ -100,7 +119,12 @@ def test_without_libpython_the_binary_does_not_load(host):
     exe, unzipped = host
     env = host_environment()
     del env["LD_PRELOAD"]
-    run = subprocess.run([str(exe), str(unzipped), VARIABLE, "1"], env=env,
-                         capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [str(exe), str(unzipped), VARIABLE, "1"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 1
     assert "undefined symbol" in run.stderr and "Py" in run.stderr

@@ -61,15 +61,18 @@ def test_exported_ssp_validates_against_the_ssp_1_0_schemas(ssp):
         names = archive.namelist()
         assert schema_errors(archive.read(SSD_NAME), "ssp/SystemStructureDescription.xsd") == []
         ssvs = [n for n in names if n.endswith(".ssv")]
-        assert sorted(ssvs) == [f"resources/{u}.ssv" for u in ("a", "b", "c", "d", "e",
-                                                               "signals")]
+        assert sorted(ssvs) == [f"resources/{u}.ssv" for u in ("a", "b", "c", "d", "e", "signals")]
         for name in ssvs:
-            assert schema_errors(archive.read(name), "ssp/SystemStructureParameterValues.xsd") \
-                == [], name
+            assert (
+                schema_errors(archive.read(name), "ssp/SystemStructureParameterValues.xsd") == []
+            ), name
     # one copy of each FMU, however many units use it
     assert sorted(n for n in names if n.endswith(".fmu")) == [
-        "resources/CoupledMass.fmu", "resources/Oscillator.fmu", "resources/Signals_two_mass.fmu",
-        "resources/SpringDamper.fmu"]
+        "resources/CoupledMass.fmu",
+        "resources/Oscillator.fmu",
+        "resources/Signals_two_mass.fmu",
+        "resources/SpringDamper.fmu",
+    ]
 
 
 def test_fmpy_reads_the_package_with_its_own_validating_ssp_reader(ssp):
@@ -78,8 +81,9 @@ def test_fmpy_reads_the_package_with_its_own_validating_ssp_reader(ssp):
     ssd = read_ssd(str(ssp), validate=True)
     components = {c.name: c for c in ssd.system.elements}
     assert set(components) == {"a", "b", "c", "d", "e", "signals"}
-    label = {p.name: p.value for p in
-             components["a"].parameterBindings[0].parameterValues[0].parameters}["label"]
+    label = {
+        p.name: p.value for p in components["a"].parameterBindings[0].parameterValues[0].parameters
+    }["label"]
     assert label == 'left <mass> & "quoted" {"json": [1, 2]}'  # a String parameter survives
     assert len(ssd.system.connections) == 3 + 3 + 4  # bond, plain, signals
 
@@ -90,13 +94,20 @@ def test_ssp_marks_the_bond_with_its_name_kind_and_roles(ssp):
     for c in root.iter(f"{{{NS['ssd']}}}Connection"):
         bond = c.find(f".//{{{NS['wf']}}}Bond")
         if bond is not None:
-            marks[bond.get("role")] = (bond.get("name"), bond.get("kind"),
-                                       f"{c.get('startElement')}.{c.get('startConnector')}")
-    assert marks == {"effort": ("spring", "translational", "b.force_on_flange"),
-                     "flow": ("spring", "translational", "a.velocity"),
-                     "position": ("spring", "translational", "a.position")}
-    units = {u.get("name"): u.find(f"{{{NS['ssc']}}}BaseUnit").attrib
-             for u in root.iter(f"{{{NS['ssc']}}}Unit")}
+            marks[bond.get("role")] = (
+                bond.get("name"),
+                bond.get("kind"),
+                f"{c.get('startElement')}.{c.get('startConnector')}",
+            )
+    assert marks == {
+        "effort": ("spring", "translational", "b.force_on_flange"),
+        "flow": ("spring", "translational", "a.velocity"),
+        "position": ("spring", "translational", "a.position"),
+    }
+    units = {
+        u.get("name"): u.find(f"{{{NS['ssc']}}}BaseUnit").attrib
+        for u in root.iter(f"{{{NS['ssc']}}}Unit")
+    }
     assert units["N"] == {"kg": "1", "m": "1", "s": "-2"}  # SI exponents from the FMU
     step = root.find(f".//{{{NS['osp']}}}FixedStepAlgorithm").get("baseStepSize")
     assert float(step) == 0.01
@@ -110,13 +121,21 @@ def test_exported_osp_validates_and_groups_the_bond_as_mechanical_ports(osp):
         assert schema_errors(path.read_bytes(), "osp/OspModelDescription-1.0.1.xsd") == [], model
     md = etree.parse(str(folder / "Oscillator_OspModelDescription.xml")).getroot()
     port = md.find(f".//{{{OSP_MD_NS}}}LinearMechanicalPort")
-    refs = [(etree.QName(g).localname, g.find(f"{{{OSP_MD_NS}}}Variable").get("ref"),
-             g.find(f"{{{OSP_MD_NS}}}Variable").get("unit")) for g in port]
+    refs = [
+        (
+            etree.QName(g).localname,
+            g.find(f"{{{OSP_MD_NS}}}Variable").get("ref"),
+            g.find(f"{{{OSP_MD_NS}}}Variable").get("unit"),
+        )
+        for g in port
+    ]
     assert refs == [("Force", "force", "N"), ("LinearVelocity", "velocity", "m/s")]
     root = etree.parse(str(osp)).getroot()
     assert root.findtext(f"{{{OSP_NS}}}Algorithm") == "fixedStep"
-    groups = [[(v.get("simulator"), v.get("name")) for v in c]
-              for c in root.iter(f"{{{OSP_NS}}}VariableGroupConnection")]
+    groups = [
+        [(v.get("simulator"), v.get("name")) for v in c]
+        for c in root.iter(f"{{{OSP_NS}}}VariableGroupConnection")
+    ]
     assert [("b", "force_on_flange|flange.velocity"), ("a", "force|velocity")] in groups
     assert "power bond 'spring' (translational)" in osp.read_text()
 
@@ -170,8 +189,7 @@ def test_a_plain_ssp_without_our_annotations_runs_as_plain_connections(fmus, ssp
     assert scene.run.algorithm == "gauss_seidel"  # our default: nothing said otherwise
     from wire_fmu.master.run import with_run_settings
 
-    names, plain = run_ours(with_run_settings(scene, algorithm="jacobi",
-                                              extrapolation="constant"))
+    names, plain = run_ours(with_run_settings(scene, algorithm="jacobi", extrapolation="constant"))
     names_ours, ours = run_ours(two_mass_scene(fmus, tmp_path))
     plain_cols = {n: plain[:, i + 1] for i, n in enumerate(names)}
     for i, n in enumerate(names_ours):  # the signals unit replays drivers and events exactly
@@ -179,7 +197,7 @@ def test_a_plain_ssp_without_our_annotations_runs_as_plain_connections(fmus, ssp
 
 
 def test_reader_reports_what_it_cannot_run(tmp_path):
-    ssd = f"""<ssd:SystemStructureDescription xmlns:ssd="{NS['ssd']}" xmlns:ssc="{NS['ssc']}"
+    ssd = f"""<ssd:SystemStructureDescription xmlns:ssd="{NS["ssd"]}" xmlns:ssc="{NS["ssc"]}"
         version="1.0" name="x"><ssd:System name="x"><ssd:Elements>
         <ssd:Component name="u" source="resources/U.fmu"/>
         <ssd:System name="inner"/></ssd:Elements><ssd:Connections>
@@ -206,11 +224,17 @@ def test_signals_program_records_modes_and_metadata_is_json(fmus, tmp_path):
     plan = plan_export(two_mass_scene(fmus, tmp_path), fmu_dir=fmus["osc"].parent)
     signals = plan.unit("signals")
     outputs = {v.name: v.unit for v in signals.model.modelVariables if v.causality == "output"}
-    assert outputs == {"d.position_a": "m", "d.velocity_a": "m/s", "e.position_a": "m",
-                       "c.force": "N"}
+    assert outputs == {
+        "d.position_a": "m",
+        "d.velocity_a": "m/s",
+        "e.position_a": "m",
+        "c.force": "N",
+    }
     meta = json.loads(json.dumps(plan.metadata))
-    assert meta["drivers"][1]["spec"] == {"kind": "ramp",
-                                          "points": [[0.0, 0.0], [0.3, 2.0], [0.6, -1.0]]}
+    assert meta["drivers"][1]["spec"] == {
+        "kind": "ramp",
+        "points": [[0.0, 0.0], [0.3, 2.0], [0.6, -1.0]],
+    }
     assert plan.signals == "signals" and plan.units[-1].generated
 
 
@@ -218,10 +242,14 @@ def test_cli_exports_and_runs_an_ssp_package(fmus, ssp, tmp_path, capsys):
     scene_file = tmp_path / "two_mass.toml"
     scene_file.write_text(_toml(two_mass_data(fmus, signals=False, stop_time=0.1)))
     fmu_dir = ["--fmu-dir", str(fmus["osc"].parent)]
-    assert main([*fmu_dir, "export", str(scene_file), "--format", "ssp", "-o",
-                 str(tmp_path / "out")]) == 0
-    assert main([*fmu_dir, "export", str(scene_file), "--format", "osp", "-o",
-                 str(tmp_path / "osp")]) == 0
+    assert (
+        main([*fmu_dir, "export", str(scene_file), "--format", "ssp", "-o", str(tmp_path / "out")])
+        == 0
+    )
+    assert (
+        main([*fmu_dir, "export", str(scene_file), "--format", "osp", "-o", str(tmp_path / "osp")])
+        == 0
+    )
     assert (tmp_path / "osp" / "OspSystemStructure.xml").exists()
     package = tmp_path / "out" / "two_mass.ssp"
     assert main([*fmu_dir, "check", str(package)]) == 0
@@ -235,8 +263,11 @@ def _toml(data: dict) -> str:
     lines = [f"name = {json.dumps(data['name'])}", "[run]"]
     lines += [f"{k} = {json.dumps(v)}" for k, v in data["run"].items()]
     for unit, spec in data["units"].items():
-        lines += [f"[units.{unit}]", f"fmu = {json.dumps(spec['fmu'])}",
-                  f"[units.{unit}.parameters]"]
+        lines += [
+            f"[units.{unit}]",
+            f"fmu = {json.dumps(spec['fmu'])}",
+            f"[units.{unit}.parameters]",
+        ]
         lines += [f"{k} = {json.dumps(v)}" for k, v in spec["parameters"].items()]
     for bond in data["bonds"]:
         lines += ["[[bonds]]"] + [f"{k} = {json.dumps(v)}" for k, v in bond.items()]

@@ -47,8 +47,11 @@ def _largest_difference(names, ours: np.ndarray, theirs: np.ndarray) -> tuple[fl
     scale = np.maximum(1.0, np.abs(ours[:, 1:]).max(axis=0)) * np.ones_like(ours[:, 1:])
     for i, (unit, name) in enumerate(names):
         if name == "energy_balance":  # a difference of large terms: round-off is relative
-            terms = [j for j, (u, n) in enumerate(names) if u == unit and n in (
-                "stored_energy", "dissipated_energy", "external_work")]  # to the terms
+            terms = [
+                j
+                for j, (u, n) in enumerate(names)
+                if u == unit and n in ("stored_energy", "dissipated_energy", "external_work")
+            ]  # to the terms
             if terms:
                 scale[:, i] = np.maximum(scale[:, i], np.abs(ours[:, 1:][:, terms]).max())
     relative = np.abs(theirs[:, 1:] - ours[:, 1:]) / scale
@@ -98,9 +101,14 @@ CROSS_CHECK_TIME = 2.0
 @pytest.mark.parametrize("name", sorted(SHIPPED) or ["none"])
 def test_libcosim_runs_each_shipped_scene_like_our_master(name, tmp_path):
     scene = load_scene(SHIPPED[name])
-    scene = with_run_settings(scene, algorithm="jacobi", extrapolation="constant",
-                              stop_time=min(scene.run.stop_time, CROSS_CHECK_TIME),
-                              iterations=1, adaptive=False)
+    scene = with_run_settings(
+        scene,
+        algorithm="jacobi",
+        extrapolation="constant",
+        stop_time=min(scene.run.stop_time, CROSS_CHECK_TIME),
+        iterations=1,
+        adaptive=False,
+    )
     fmu_dir = tmp_path / "fmus"
     path = export_ssp(scene, tmp_path / "ssp", fmu_dir=fmu_dir)
     names, ours = run_ours(scene)

@@ -60,7 +60,8 @@ def test_fourier_work_is_exact():
     assert series.integral(0.3, 2.9) == pytest.approx(exact, rel=1e-12)
     d = 1e-6
     assert series.derivative(1.1) == pytest.approx(
-        (series(1.1 + d) - series(1.1 - d)) / (2 * d), rel=1e-7)
+        (series(1.1 + d) - series(1.1 - d)) / (2 * d), rel=1e-7
+    )
 
 
 def test_cycle_statistics_of_a_uniform_rotation():
@@ -81,10 +82,14 @@ def reference():
     return reference_trajectory(0.01 * np.arange(301))
 
 
-@pytest.mark.parametrize("solver, order, steps", [
-    ("energy1", 1, (1.25e-3, 6.25e-4, 3.125e-4)),
-    ("energy", 2, (1e-2, 5e-3, 2.5e-3)),
-], ids=["first-order step (9, 15): order 1", "successive refinement (12, 18): order 2"])
+@pytest.mark.parametrize(
+    "solver, order, steps",
+    [
+        ("energy1", 1, (1.25e-3, 6.25e-4, 3.125e-4)),
+        ("energy", 2, (1e-2, 5e-3, 2.5e-3)),
+    ],
+    ids=["first-order step (9, 15): order 1", "successive refinement (12, 18): order 2"],
+)
 def test_paper_method_converges_with_the_claimed_order(reference, solver, order, steps):
     runs = compare(solver, steps, stop_time=3.0, step=0.01, reference=reference)
     orders = [r.order for r in runs[1:]]
@@ -130,8 +135,9 @@ def test_energy_ledger_closes(solver):
 
 
 def test_study_writes_its_table_and_plot(tmp_path):
-    study = steady_motion_study(tmp_path, stop_time=1.0, max_steps=(5e-3, 2.5e-3),
-                                solvers=("energy1", "energy"))
+    study = steady_motion_study(
+        tmp_path, stop_time=1.0, max_steps=(5e-3, 2.5e-3), solvers=("energy1", "energy")
+    )
     for path in study["files"].values():
         assert path.exists() and path.stat().st_size > 0
     assert "| energy | 2 |" in study["files"]["md"].read_text()
@@ -172,8 +178,9 @@ def test_declarations_and_feedthrough():
 
 
 def test_facade_steps_like_the_core():
-    spec = importlib.util.spec_from_file_location("machine_facade",
-                                                  ROOT / "models" / "machine_unit.py")
+    spec = importlib.util.spec_from_file_location(
+        "machine_facade", ROOT / "models" / "machine_unit.py"
+    )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     facade = module.MachineUnit(instance_name="m", resources=None)

@@ -31,8 +31,9 @@ def loom_like(a: float = 100.0) -> MachineUnit:
         a=a,
         b=2.0,
         resistance_angle=lambda p: 10.0 + 5.0 * math.cos(2 * p),
-        resistance_angle_work=lambda p0, p1: 10 * (p1 - p0) + 2.5 * (math.sin(2 * p1)
-                                                                      - math.sin(2 * p0)),
+        resistance_angle_work=lambda p0, p1: (
+            10 * (p1 - p0) + 2.5 * (math.sin(2 * p1) - math.sin(2 * p0))
+        ),
         resistance_speed=lambda w: 0.05 * w * w,
         resistance_speed_slope=lambda w: 0.1 * w,
         resistance_time=lambda t: 3.0 * math.sin(5.0 * t),
@@ -62,8 +63,11 @@ def by_time(integrator, machine, omega0, span, n):
     return omega, phi, forms
 
 
-@pytest.mark.parametrize("refinements, order", [(0, 1), (1, 2), (None, 2)],
-                         ids=["first-order (9, 15)", "one correction (12, 18)", "refined"])
+@pytest.mark.parametrize(
+    "refinements, order",
+    [(0, 1), (1, 2), (None, 2)],
+    ids=["first-order (9, 15)", "one correction (12, 18)", "refined"],
+)
 def test_angle_steps_converge_with_the_claimed_order(refinements, order):
     machine, span = loom_like(), 10.0
     ref = solve_ivp(machine.rhs_angle, (0, span), [20.0, 0.0], **TIGHT)
@@ -86,10 +90,12 @@ def test_time_steps_converge_with_the_claimed_order(refinements, order):
     integrator = EnergyFormIntegrator(refinements)
     results = [by_time(integrator, machine, 20.0, span, n) for n in (100, 200, 400, 800)]
     assert all(forms == {"energy"} for *_, forms in results)
-    np.testing.assert_allclose(observed_orders([abs(w - omega_ref) for w, _, _ in results]),
-                               order, atol=0.1)
-    np.testing.assert_allclose(observed_orders([abs(p - phi_ref) for _, p, _ in results]),
-                               order, atol=0.1)
+    np.testing.assert_allclose(
+        observed_orders([abs(w - omega_ref) for w, _, _ in results]), order, atol=0.1
+    )
+    np.testing.assert_allclose(
+        observed_orders([abs(p - phi_ref) for _, p, _ in results]), order, atol=0.1
+    )
 
 
 def test_without_torques_i_omega_squared_is_kept_exactly():

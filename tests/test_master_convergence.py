@@ -42,30 +42,56 @@ STOP = 1.0
 def fmus(tmp_path_factory) -> dict[str, Path]:
     out = tmp_path_factory.mktemp("fmus")
     return {
-        "osc": build_fmu(FACADES / "oscillator.py", out,
-                         extra_modules=[SUPPORT / "wire_fmu_test_units.py"]),
-        "mass": build_fmu(FACADES / "coupled_mass.py", out,
-                          extra_modules=[SUPPORT / "wire_fmu_master_units.py"]),
+        "osc": build_fmu(
+            FACADES / "oscillator.py", out, extra_modules=[SUPPORT / "wire_fmu_test_units.py"]
+        ),
+        "mass": build_fmu(
+            FACADES / "coupled_mass.py", out, extra_modules=[SUPPORT / "wire_fmu_master_units.py"]
+        ),
     }
 
 
 def scene_data(fmus, *, step, algorithm="jacobi", extrapolation="linear", **run):
     return {
         "name": "two_mass",
-        "run": {"stop_time": STOP, "step": step, "algorithm": algorithm,
-                "extrapolation": extrapolation, **run},
-        "units": {
-            "a": {"fmu": str(fmus["osc"]), "parameters": {
-                "mass": M1, "stiffness": K1, "damping": 0.0, "x0": X0, "substeps": 50}},
-            "b": {"fmu": str(fmus["mass"]), "parameters": {
-                "mass": M2, "stiffness": K, "damping": 0.0, "x0": 0.0, "substeps": 50}},
+        "run": {
+            "stop_time": STOP,
+            "step": step,
+            "algorithm": algorithm,
+            "extrapolation": extrapolation,
+            **run,
         },
-        "bonds": [{
-            "name": "spring", "kind": "translational",
-            "effort": "b.force_on_flange -> a.force",
-            "flow": "a.velocity -> b.flange.velocity",
-            "position": "a.position -> b.flange.position",
-        }],
+        "units": {
+            "a": {
+                "fmu": str(fmus["osc"]),
+                "parameters": {
+                    "mass": M1,
+                    "stiffness": K1,
+                    "damping": 0.0,
+                    "x0": X0,
+                    "substeps": 50,
+                },
+            },
+            "b": {
+                "fmu": str(fmus["mass"]),
+                "parameters": {
+                    "mass": M2,
+                    "stiffness": K,
+                    "damping": 0.0,
+                    "x0": 0.0,
+                    "substeps": 50,
+                },
+            },
+        },
+        "bonds": [
+            {
+                "name": "spring",
+                "kind": "translational",
+                "effort": "b.force_on_flange -> a.force",
+                "flow": "a.velocity -> b.flange.velocity",
+                "position": "a.position -> b.flange.position",
+            }
+        ],
         "outputs": {"variables": ["a.position", "b.position"]},
     }
 
@@ -74,8 +100,9 @@ def exact_positions(t: float) -> np.ndarray:
     """x1, x2 at t from expm of [x1, x2, v1, v2]' = A [...]."""
     stiffness = np.array([[K1 + K, -K], [-K, K]])
     mass = np.diag([M1, M2])
-    a = np.block([[np.zeros((2, 2)), np.eye(2)],
-                  [-np.linalg.solve(mass, stiffness), np.zeros((2, 2))]])
+    a = np.block(
+        [[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(mass, stiffness), np.zeros((2, 2))]]
+    )
     return (expm(a * t) @ np.array([X0, 0.0, 0.0, 0.0]))[:2]
 
 
@@ -102,8 +129,10 @@ def final_error(fmus, tmp_path, **kw) -> float:
 @pytest.mark.parametrize(("extrapolation", "order"), [("constant", 1), ("linear", 2)])
 def test_observed_convergence_order(fmus, tmp_path, algorithm, extrapolation, order):
     steps = [0.01, 0.005, 0.0025]
-    errors = [final_error(fmus, tmp_path, step=h, algorithm=algorithm,
-                          extrapolation=extrapolation) for h in steps]
+    errors = [
+        final_error(fmus, tmp_path, step=h, algorithm=algorithm, extrapolation=extrapolation)
+        for h in steps
+    ]
     observed = [math.log2(errors[i] / errors[i + 1]) for i in range(len(errors) - 1)]
     assert observed[-1] == pytest.approx(order, abs=0.3), (errors, observed)
     assert errors[-1] < (5e-3 if order == 2 else 5e-2) * X0
@@ -124,14 +153,22 @@ def test_constant_hold_injects_energy_linear_much_less(fmus, tmp_path):
 
 def test_iteration_with_rollback_converges_to_a_smaller_error(fmus, tmp_path):
     plain = final_error(fmus, tmp_path, step=0.02, algorithm="jacobi")
-    iterated = final_error(fmus, tmp_path, step=0.02, algorithm="jacobi", iterations=6,
-                           iteration_tolerance=1e-10)
+    iterated = final_error(
+        fmus, tmp_path, step=0.02, algorithm="jacobi", iterations=6, iteration_tolerance=1e-10
+    )
     assert iterated < 0.6 * plain
 
 
 def test_adaptive_step_keeps_the_bond_residual_per_step_below_tolerance(fmus, tmp_path):
-    columns, result = run(fmus, tmp_path, step=0.05, adaptive=True, energy_tolerance=1e-6,
-                          min_step=1e-4, max_step=0.05)
+    columns, result = run(
+        fmus,
+        tmp_path,
+        step=0.05,
+        adaptive=True,
+        energy_tolerance=1e-6,
+        min_step=1e-4,
+        max_step=0.05,
+    )
     assert result.rejected > 0  # the first, too large steps were rejected
     assert result.steps > STOP / 0.05
     residual = np.diff(columns["bond.spring.energy_residual"])
@@ -164,7 +201,8 @@ def energy_run(fmus, tmp_path, **kw):
 @pytest.mark.parametrize("algorithm", ["jacobi", "gauss_seidel"])
 @pytest.mark.parametrize("extrapolation", ["constant", "linear"])
 def test_bond_residual_is_the_energy_the_lossless_pair_gained(
-        fmus, tmp_path, algorithm, extrapolation):
+    fmus, tmp_path, algorithm, extrapolation
+):
     """Both units are lossless and their internal RK4 is exact to 1e-7 here, so whatever
     energy the pair gains, the coupling created: the bond's booked residual must equal the
     change of the pair's energy computed from its states (constant hold: +120 % to +400 %
@@ -177,8 +215,14 @@ def test_bond_residual_is_the_energy_the_lossless_pair_gained(
     """
     errors = []
     for step in (0.01, 0.005):
-        columns, result = energy_run(fmus, tmp_path, step=step, algorithm=algorithm,
-                                     extrapolation=extrapolation, energy_guard=math.inf)
+        columns, result = energy_run(
+            fmus,
+            tmp_path,
+            step=step,
+            algorithm=algorithm,
+            extrapolation=extrapolation,
+            energy_guard=math.inf,
+        )
         assert result.status == "finished", result.message
         energy = pair_energy(columns)
         assert energy[0] == pytest.approx(E0, rel=1e-12)
@@ -190,13 +234,17 @@ def test_bond_residual_is_the_energy_the_lossless_pair_gained(
     assert errors[1] < 0.5 * errors[0], errors
 
 
-@pytest.mark.parametrize(("algorithm", "extrapolation", "step"), [
-    ("jacobi", "constant", 0.05),
-    ("jacobi", "linear", 0.1),
-    ("gauss_seidel", "linear", 0.1),
-])
+@pytest.mark.parametrize(
+    ("algorithm", "extrapolation", "step"),
+    [
+        ("jacobi", "constant", 0.05),
+        ("jacobi", "linear", 0.1),
+        ("gauss_seidel", "linear", 0.1),
+    ],
+)
 def test_energy_guard_stops_an_explicit_blow_up_early_and_says_why(
-        fmus, tmp_path, algorithm, extrapolation, step):
+    fmus, tmp_path, algorithm, extrapolation, step
+):
     """Explicit coupling at omega H = 0.55-1.1 (the fast mode is 10.95 rad/s): unguarded the
     pair's energy grows from 0.5 J to 1e4-1e8 J in 5 s; guarded, the run stops, naming the
     bond, while the pair holds less than three times its energy, every row up to the stop
@@ -218,16 +266,20 @@ def test_energy_guard_stops_an_explicit_blow_up_early_and_says_why(
     assert pair_energy(columns).max() < 3 * E0
 
 
-@pytest.mark.parametrize(("algorithm", "extrapolation"), [
-    ("jacobi", "linear"),
-    ("gauss_seidel", "linear"),
-])
+@pytest.mark.parametrize(
+    ("algorithm", "extrapolation"),
+    [
+        ("jacobi", "linear"),
+        ("gauss_seidel", "linear"),
+    ],
+)
 def test_energy_guard_lets_a_stable_coupling_finish(fmus, tmp_path, algorithm, extrapolation):
     """At omega H = 0.11 the same coupling is stable and second order: the guarded run
     finishes, the coupling having created under 2 % of the pair's energy (and the pair gained
     as much)."""
-    columns, result = energy_run(fmus, tmp_path, step=0.01, algorithm=algorithm,
-                                 extrapolation=extrapolation, **GUARDED)
+    columns, result = energy_run(
+        fmus, tmp_path, step=0.01, algorithm=algorithm, extrapolation=extrapolation, **GUARDED
+    )
     assert result.status == "finished", result.message
     assert abs(result.bond_residual["spring"]) < 2e-2 * E0
     assert abs(pair_energy(columns)[-1] - E0) < 2e-2 * E0
@@ -236,7 +288,8 @@ def test_energy_guard_lets_a_stable_coupling_finish(fmus, tmp_path, algorithm, e
 @pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid:RuntimeWarning")
 @pytest.mark.parametrize("run_settings", [{}, {"iterations": 3}])
 def test_a_unit_that_overflows_stops_the_run_before_anything_non_finite_is_kept(
-        fmus, tmp_path, run_settings):
+    fmus, tmp_path, run_settings
+):
     """Unit a made explosive (a 1e6 rad/s spring under one RK4 step per 10 ms, no position
     limit) and the energy guard off: its outputs overflow to inf and NaN. Explicitly the
     run stops at the step that produced them, naming them; with rollback the step is

@@ -23,10 +23,12 @@ from wire_fmu.master.validate import validate_scene  # noqa: E402
 def fmus(tmp_path_factory) -> dict[str, Path]:
     out = tmp_path_factory.mktemp("fmus")
     return {
-        "osc": build_fmu(FACADES / "oscillator.py", out,
-                         extra_modules=[SUPPORT / "wire_fmu_test_units.py"]),
-        "mass": build_fmu(FACADES / "coupled_mass.py", out,
-                          extra_modules=[SUPPORT / "wire_fmu_master_units.py"]),
+        "osc": build_fmu(
+            FACADES / "oscillator.py", out, extra_modules=[SUPPORT / "wire_fmu_test_units.py"]
+        ),
+        "mass": build_fmu(
+            FACADES / "coupled_mass.py", out, extra_modules=[SUPPORT / "wire_fmu_master_units.py"]
+        ),
     }
 
 
@@ -42,11 +44,19 @@ def test_parse_errors_are_all_listed(tmp_path):
     with pytest.raises(SceneError) as info:
         parse_scene(data, base_dir=tmp_path)
     text = str(info.value)
-    for needle in ("unknown top-level key 'colour'", "run.step must be a positive number",
-                   "run.algorithm must be one of", "run.extrapolation must be one of",
-                   "unit 'a': 'fmu' must name", "may not contain '.'", "'effects' must be a list",
-                   "'kind' must be one of", "'flow' is required", "connection 0",
-                   "event 0: 'time'"):
+    for needle in (
+        "unknown top-level key 'colour'",
+        "run.step must be a positive number",
+        "run.algorithm must be one of",
+        "run.extrapolation must be one of",
+        "unit 'a': 'fmu' must name",
+        "may not contain '.'",
+        "'effects' must be a list",
+        "'kind' must be one of",
+        "'flow' is required",
+        "connection 0",
+        "event 0: 'time'",
+    ):
         assert needle in text, needle
 
 
@@ -59,9 +69,14 @@ def broken_scene(fmus) -> dict:
             "c": {"fmu": str(fmus["mass"])},
             "d": {"fmu": str(fmus["mass"])},
         },
-        "bonds": [{"name": "wrong", "kind": "translational",
-                   "effort": "b.force_on_flange -> a.force",
-                   "flow": "a.position -> b.flange.velocity"}],
+        "bonds": [
+            {
+                "name": "wrong",
+                "kind": "translational",
+                "effort": "b.force_on_flange -> a.force",
+                "flow": "a.position -> b.flange.velocity",
+            }
+        ],
         "connections": [
             {"from": "a.velocity", "to": "b.flange.velocity"},  # fed twice (bond above)
             {"from": "a.position", "to": "a.velocity"},  # output to output
@@ -104,10 +119,16 @@ def test_check_command_lists_problems_and_exits_nonzero(fmus, tmp_path, capsys):
 
     lines = [
         'name = "cli_broken"',
-        "[units.a]", f'fmu = "{fmus["osc"]}"',
-        "[units.b]", f'fmu = "{fmus["mass"]}"',
-        "[[connections]]", 'from = "a.position"', 'to = "a.velocity"',
-        "[[connections]]", 'from = "b.nothing"', 'to = "a.force"',
+        "[units.a]",
+        f'fmu = "{fmus["osc"]}"',
+        "[units.b]",
+        f'fmu = "{fmus["mass"]}"',
+        "[[connections]]",
+        'from = "a.position"',
+        'to = "a.velocity"',
+        "[[connections]]",
+        'from = "b.nothing"',
+        'to = "a.force"',
     ]
     path = tmp_path / "broken.toml"
     path.write_text("\n".join(lines) + "\n")
@@ -123,8 +144,15 @@ def test_configuration_problems_come_back_through_fmi(tmp_path):
     reeving = drilling_block_train(4)
     reeving["sheaves"]["crown_0"]["radius"] = -1
     reeving["path"][1]["wrap"] = "sideways"
-    data = {"units": {"rope": {"fmu": "BlockTrain", "effects": ["rope_dampingg"],
-                               "parameters": {"reeving": reeving}}}}
+    data = {
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "effects": ["rope_dampingg"],
+                "parameters": {"reeving": reeving},
+            }
+        }
+    }
     scene = parse_scene(data, base_dir=tmp_path)
     with pytest.raises(SceneError) as info:
         validate_scene(scene)

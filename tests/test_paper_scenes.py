@@ -55,23 +55,37 @@ def machine_inputs(i: int) -> dict[str, float]:
 
 
 CASES = {
-    "ScissorJack": ("scissor_jack.py", {"handle_drive": "torque", "effects": "thread_friction"},
-                    jack_inputs, ["load.height", "handle.speed", "thread.state",
-                                  "energy_balance"], ScissorJackUnit),
-    "MultiMassDrive": ("drive.py", {}, drive_inputs,
-                       ["motor.speed", "load.speed", "shaft_2.torque", "energy_balance"],
-                       DriveUnit),
-    "MachineUnit": ("machine_unit.py", {}, machine_inputs,
-                    ["shaft.speed", "shaft.angle", "cycle.delta", "energy_balance"],
-                    MachineDriveUnit),
+    "ScissorJack": (
+        "scissor_jack.py",
+        {"handle_drive": "torque", "effects": "thread_friction"},
+        jack_inputs,
+        ["load.height", "handle.speed", "thread.state", "energy_balance"],
+        ScissorJackUnit,
+    ),
+    "MultiMassDrive": (
+        "drive.py",
+        {},
+        drive_inputs,
+        ["motor.speed", "load.speed", "shaft_2.torque", "energy_balance"],
+        DriveUnit,
+    ),
+    "MachineUnit": (
+        "machine_unit.py",
+        {},
+        machine_inputs,
+        ["shaft.speed", "shaft.angle", "cycle.delta", "energy_balance"],
+        MachineDriveUnit,
+    ),
 }
 
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory) -> dict[str, LoadedFmu]:
     folder = tmp_path_factory.mktemp("paper_fmus")
-    return {name: LoadedFmu(build_fmu(ROOT / "models" / script, folder))
-            for name, (script, *_) in CASES.items()}
+    return {
+        name: LoadedFmu(build_fmu(ROOT / "models" / script, folder))
+        for name, (script, *_) in CASES.items()
+    }
 
 
 @pytest.fixture(scope="module")
@@ -107,8 +121,11 @@ def test_model_description_is_complete(fmus, name):
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
     assert md.coSimulation.modelIdentifier == name
     deps = {o.variable.name: [d.name for d in o.dependencies] for o in md.outputs}
-    state_output = {"ScissorJack": "load.height", "MultiMassDrive": "load.speed",
-                    "MachineUnit": "shaft.speed"}[name]
+    state_output = {
+        "ScissorJack": "load.height",
+        "MultiMassDrive": "load.speed",
+        "MachineUnit": "shaft.speed",
+    }[name]
     assert deps[state_output] == []
 
 
@@ -145,8 +162,19 @@ def test_fmu_equals_the_core_and_restores_its_state_bit_for_bit(fmus, name):
 
 # ----------------------------------------------------------------------- the scenes
 def run_cli(name: str, out: Path, fmu_dir: Path, stop_time: float) -> dict[str, np.ndarray]:
-    code = main(["--fmu-dir", str(fmu_dir), "run", name, "-o", str(out), "--stop-time",
-                 str(stop_time), "-q"])
+    code = main(
+        [
+            "--fmu-dir",
+            str(fmu_dir),
+            "run",
+            name,
+            "-o",
+            str(out),
+            "--stop-time",
+            str(stop_time),
+            "-q",
+        ]
+    )
     assert code == 0
     scene = load_scene(find_scene(name))
     for plot in scene.plots:

@@ -60,16 +60,21 @@ print("no problems")
 @pytest.fixture(scope="module")
 def fmu_dir(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("exit_fmus")
-    subprocess.run([sys.executable, "-m", "wire_fmu.cli", "--fmu-dir", str(folder), "build"],
-                   check=True, capture_output=True)
+    subprocess.run(
+        [sys.executable, "-m", "wire_fmu.cli", "--fmu-dir", str(folder), "build"],
+        check=True,
+        capture_output=True,
+    )
     return folder
 
 
 @pytest.fixture(scope="module")
 def failing_scene(tmp_path_factory) -> Path:
-    text = RISER.read_text(encoding="utf-8").replace(
-        '"rod.force" = -1.424e6', '"rod.force" = -5.0e6').replace(
-        'name = "riser_tensioner"', 'name = "failing"')
+    text = (
+        RISER.read_text(encoding="utf-8")
+        .replace('"rod.force" = -1.424e6', '"rod.force" = -5.0e6')
+        .replace('name = "riser_tensioner"', 'name = "failing"')
+    )
     path = tmp_path_factory.mktemp("exit_scenes") / "failing.toml"
     path.write_text(text, encoding="utf-8")
     return path
@@ -90,15 +95,24 @@ def _checked(run: subprocess.CompletedProcess, expected: int) -> str:
 
 
 def _python(script: str, scene: Path, out: Path, fmu_dir: Path, expected: int) -> str:
-    run = subprocess.run([sys.executable, "-c", script, str(scene), str(out), str(fmu_dir)],
-                         capture_output=True, text=True, env=_environment(), timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-c", script, str(scene), str(out), str(fmu_dir)],
+        capture_output=True,
+        text=True,
+        env=_environment(),
+        timeout=300,
+    )
     return _checked(run, expected)
 
 
 def _cli(args: list[str], fmu_dir: Path, expected: int) -> str:
-    run = subprocess.run([sys.executable, "-m", "wire_fmu.cli", "--fmu-dir", str(fmu_dir),
-                          *args], capture_output=True, text=True, env=_environment(),
-                         timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-m", "wire_fmu.cli", "--fmu-dir", str(fmu_dir), *args],
+        capture_output=True,
+        text=True,
+        env=_environment(),
+        timeout=300,
+    )
     return _checked(run, expected)
 
 
@@ -112,8 +126,11 @@ def test_python_api_runs_and_checks_exit_cleanly(tmp_path, fmu_dir, failing_scen
 
 @pytest.mark.parametrize("attempt", range(3))
 def test_command_line_runs_and_checks_exit_cleanly(tmp_path, fmu_dir, failing_scene, attempt):
-    _cli(["run", "-q", "--stop-time", "0.2", "-o", str(tmp_path / "ok"), "riser_tensioner"],
-         fmu_dir, 0)
+    _cli(
+        ["run", "-q", "--stop-time", "0.2", "-o", str(tmp_path / "ok"), "riser_tensioner"],
+        fmu_dir,
+        0,
+    )
     said = _cli(["check", str(failing_scene)], fmu_dir, 1)
     assert said.count("precharge_pressure") == 1
     _cli(["run", "-q", "-o", str(tmp_path / "bad"), str(failing_scene)], fmu_dir, 1)
@@ -124,9 +141,23 @@ def test_command_line_runs_and_checks_exit_cleanly(tmp_path, fmu_dir, failing_sc
 def test_ctrl_c_ends_a_run_interrupted_with_exit_130_and_rows_kept(tmp_path, fmu_dir):
     out = tmp_path / "interrupted"
     process = subprocess.Popen(
-        [sys.executable, "-m", "wire_fmu.cli", "--fmu-dir", str(fmu_dir), "run", "-q", "-o",
-         str(out), "riser_tensioner"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-        text=True, env=_environment())
+        [
+            sys.executable,
+            "-m",
+            "wire_fmu.cli",
+            "--fmu-dir",
+            str(fmu_dir),
+            "run",
+            "-q",
+            "-o",
+            str(out),
+            "riser_tensioner",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+    )
     csv = out / "timeseries.csv"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and (not csv.exists() or csv.stat().st_size < 20_000):

@@ -19,8 +19,14 @@ LENGTH, STRETCH = 10.0, 1.0e-3  # m
 
 
 def slack(length_rate: float):
-    return rope_forces(ROPE, np.array([LENGTH + STRETCH]), np.array([LENGTH]),
-                       np.array([length_rate]), np.array([0.0]), np.array([False]))
+    return rope_forces(
+        ROPE,
+        np.array([LENGTH + STRETCH]),
+        np.array([LENGTH]),
+        np.array([length_rate]),
+        np.array([0.0]),
+        np.array([False]),
+    )
 
 
 def test_relaxing_slack_spring_drains_its_strain_energy_through_the_damper():

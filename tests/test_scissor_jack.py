@@ -65,8 +65,9 @@ def make_jack(effects: str = "", **params) -> ScissorJackUnit:
     return unit
 
 
-def run(unit: ScissorJackUnit, duration: float, step: float, drive=None,
-        record=("load.height",)) -> dict[str, np.ndarray]:
+def run(
+    unit: ScissorJackUnit, duration: float, step: float, drive=None, record=("load.height",)
+) -> dict[str, np.ndarray]:
     """Step ``unit``; ``drive(t, h, unit)`` sets inputs (the master's midpoint hold)."""
     n = int(round(duration / step))
     out = {name: [unit.values[name]] for name in record}
@@ -86,6 +87,7 @@ def run(unit: ScissorJackUnit, duration: float, step: float, drive=None,
 def ramp(rate: float):
     def drive(t, h, unit):
         unit.values["handle.torque_command"] = rate * (t + 0.5 * h)
+
     return drive
 
 
@@ -99,8 +101,12 @@ def test_paper_geometry_puts_the_rods_at_30_degrees():
 def test_driven_lift_follows_the_rhombus_kinematics():
     """2 rev/s for 10 s: 20 turns, 40 mm of screw travel, height from the rhombus."""
     unit = make_jack(handle_drive="speed", **{"handle.speed_command": HANDLE_SPEED})
-    rec = run(unit, 10.0, 0.01, record=("load.height", "screw.travel", "screw.displacement",
-                                        "handle.angle"))
+    rec = run(
+        unit,
+        10.0,
+        0.01,
+        record=("load.height", "screw.travel", "screw.displacement", "handle.angle"),
+    )
     travel = LEAD * 2.0 * rec["time"]
     expected = np.array([rhombus_height(s) for s in travel])
     np.testing.assert_allclose(rec["load.height"], expected, rtol=1e-13, atol=0)
@@ -114,8 +120,9 @@ def test_driven_lift_follows_the_rhombus_kinematics():
 def test_driven_lift_forces_and_handle_torque(effects, friction_factor):
     """F = (W + m y'') w / y with y'' by differences of the closed form; M = (h + r mu) F."""
     unit = make_jack(effects, handle_drive="speed", **{"handle.speed_command": HANDLE_SPEED})
-    rec = run(unit, 10.0, 0.1, record=("screw.axial_force", "handle.torque",
-                                       "thread.friction_torque"))
+    rec = run(
+        unit, 10.0, 0.1, record=("screw.axial_force", "handle.torque", "thread.friction_torque")
+    )
     t = rec["time"][1:-1]
     speed = LEAD * 2.0  # m/s of screw travel
     dt = 1e-3
@@ -124,10 +131,15 @@ def test_driven_lift_forces_and_handle_torque(effects, friction_factor):
     width = width0() - speed * t
     force = (WEIGHT + MASS * accel) * width / y[1]
     np.testing.assert_allclose(rec["screw.axial_force"][1:-1], force, rtol=1e-7)
-    np.testing.assert_allclose(rec["handle.torque"][1:-1],
-                               (H + friction_factor * R_MEAN * MU) * force, rtol=1e-7)
-    np.testing.assert_allclose(rec["thread.friction_torque"][1:-1],
-                               -friction_factor * R_MEAN * MU * force, rtol=1e-7, atol=1e-12)
+    np.testing.assert_allclose(
+        rec["handle.torque"][1:-1], (H + friction_factor * R_MEAN * MU) * force, rtol=1e-7
+    )
+    np.testing.assert_allclose(
+        rec["thread.friction_torque"][1:-1],
+        -friction_factor * R_MEAN * MU * force,
+        rtol=1e-7,
+        atol=1e-12,
+    )
     assert rec["handle.torque"][0] == pytest.approx(1.654 if not effects else 6.850, abs=1e-3)
 
 
@@ -141,17 +153,22 @@ def test_holding_torque_derived_from_geometry_lead_and_friction():
     assert lift == pytest.approx(torque, rel=1e-13)
     assert lower < 0.0  # self-locking: the load alone cannot turn the screw
     assert unit.values["thread.state"] == 2
-    assert unit.values["thread.friction_torque"] == pytest.approx(H * WEIGHT * math.sqrt(3),
-                                                                  rel=1e-13)
+    assert unit.values["thread.friction_torque"] == pytest.approx(
+        H * WEIGHT * math.sqrt(3), rel=1e-13
+    )
 
 
 def test_rising_torque_holds_the_load_exactly_until_the_derived_torque():
     """Exact stick: height and angle do not change by one bit until breakaway."""
     unit = make_jack("thread_friction", handle_drive="torque")
     rate, step = 0.75, 0.01
-    rec = run(unit, 10.0, step, ramp(rate), record=("load.height", "handle.angle",
-                                                    "thread.state", "handle.speed",
-                                                    "mode_changes"))
+    rec = run(
+        unit,
+        10.0,
+        step,
+        ramp(rate),
+        record=("load.height", "handle.angle", "thread.state", "handle.speed", "mode_changes"),
+    )
     moving = np.flatnonzero(rec["handle.angle"] != 0.0)
     first = moving[0]  # the record after the first step that moved
     held_torques = rate * (rec["time"][:first] + 0.5 * step)  # torques of the held steps
@@ -181,10 +198,17 @@ def test_regularised_thread_creeps_at_the_predicted_speed(shape):
     """Paper 003's regularised friction: held with no handle torque, the load creeps down
     at w1 x (linear) or w1 atanh(x) (tanh), x = h / (r mu) -- never truly holds."""
     w1 = 1e-6
-    unit = make_jack("thread_friction", handle_drive="torque", friction_model=shape,
-                     solver="radau", solver_max_step=0.05, friction_speed_scale=w1)
-    rec = run(unit, 2.0, 0.05, record=("handle.speed", "load.height", "handle.angle",
-                                       "thread.state"))
+    unit = make_jack(
+        "thread_friction",
+        handle_drive="torque",
+        friction_model=shape,
+        solver="radau",
+        solver_max_step=0.05,
+        friction_speed_scale=w1,
+    )
+    rec = run(
+        unit, 2.0, 0.05, record=("handle.speed", "load.height", "handle.angle", "thread.state")
+    )
     ratio = H / (R_MEAN * MU)
     creep = w1 * (ratio if shape == "linear" else math.atanh(ratio))
     assert rec["handle.speed"][-1] == pytest.approx(-creep, rel=1e-6)
@@ -196,20 +220,29 @@ def test_regularised_thread_creeps_at_the_predicted_speed(shape):
 
 def test_regularised_thread_needs_a_stiff_solver():
     with pytest.raises(ConfigurationError, match="radau"):
-        make_jack("thread_friction", handle_drive="torque", friction_model="linear",
-                  solver="rk4")
+        make_jack("thread_friction", handle_drive="torque", friction_model="linear", solver="rk4")
 
 
 # ================================================================= energy and configuration
-@pytest.mark.parametrize("effects, drive", [("", "speed"), ("thread_friction", "speed"),
-                                            ("thread_friction", "torque"), ("", "torque")])
+@pytest.mark.parametrize(
+    "effects, drive",
+    [("", "speed"), ("thread_friction", "speed"), ("thread_friction", "torque"), ("", "torque")],
+)
 def test_energy_ledger_closes(effects, drive):
     unit = make_jack(effects, handle_drive=drive, **{"handle.speed_command": HANDLE_SPEED})
-    torque = ramp(0.75) if effects else (lambda t, h, u: u.values.update(
-        {"handle.torque_command": 1.66}))  # just above the lead torque h W cot 30 deg
+    torque = (
+        ramp(0.75)
+        if effects
+        else (lambda t, h, u: u.values.update({"handle.torque_command": 1.66}))
+    )  # just above the lead torque h W cot 30 deg
     duration = 3.0 if drive == "torque" and not effects else 10.0  # unlocked: it speeds up
-    rec = run(unit, duration, 0.05, torque if drive == "torque" else None,
-              record=("energy_balance", "external_work", "dissipated_energy"))
+    rec = run(
+        unit,
+        duration,
+        0.05,
+        torque if drive == "torque" else None,
+        record=("energy_balance", "external_work", "dissipated_energy"),
+    )
     assert np.max(np.abs(rec["energy_balance"])) < 1e-8 * max(1.0, rec["external_work"][-1])
     if effects:
         assert rec["dissipated_energy"][-1] > 0.0
@@ -228,8 +261,9 @@ def test_light_handle_is_refused_painleve():
 
 def test_bad_parameters_are_all_reported():
     with pytest.raises(ConfigurationError) as info:
-        make_jack("thread_friction,nonsense", handle_drive="pedal", friction_model="glue",
-                  rod_length=0.05)
+        make_jack(
+            "thread_friction,nonsense", handle_drive="pedal", friction_model="glue", rod_length=0.05
+        )
     text = str(info.value)
     for word in ("nonsense", "pedal", "glue", "initial_height"):
         assert word in text
@@ -252,8 +286,9 @@ def test_declarations_are_sound():
 
 @pytest.mark.parametrize("drive", ["speed", "torque"])
 def test_declared_feedthrough_matches_the_numbers(drive):
-    unit = make_jack("thread_friction", handle_drive=drive,
-                     **{"handle.speed_command": HANDLE_SPEED})
+    unit = make_jack(
+        "thread_friction", handle_drive=drive, **{"handle.speed_command": HANDLE_SPEED}
+    )
     run(unit, 0.5, 0.05, ramp(8.0) if drive == "torque" else None)
     outputs = [v for v in ScissorJackUnit.VARIABLES if v.causality is Causality.output]
     state = json.dumps(unit.get_state())
@@ -271,8 +306,9 @@ def test_declared_feedthrough_matches_the_numbers(drive):
 
 
 def load_facade_class():
-    spec = importlib.util.spec_from_file_location("scissor_jack_facade",
-                                                  ROOT / "models" / "scissor_jack.py")
+    spec = importlib.util.spec_from_file_location(
+        "scissor_jack_facade", ROOT / "models" / "scissor_jack.py"
+    )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module.ScissorJack
@@ -308,8 +344,9 @@ def nut_on_fixed_screw(axis, stabilise=True, lead_per_radian=0.01):
     nut = RigidBody(2.0, inertia)
     s1, s2 = BodyState.at_rest(), BodyState.at_rest(0.5 * axis)
     joint = ScrewNutJoint(thread, (0, 0, 0), axis, s1, s2)
-    return ScrewNutSystem(ground, nut, joint, s1, s2, gravity=(0.0, 0.0, -9.81),
-                          stabilise=stabilise)
+    return ScrewNutSystem(
+        ground, nut, joint, s1, s2, gravity=(0.0, 0.0, -9.81), stabilise=stabilise
+    )
 
 
 @pytest.mark.parametrize("axis", [(0, 0, 1), (0, 1, 1)], ids=["c_x = 0 (vertical)", "tilted"])
@@ -377,16 +414,18 @@ def test_position_constraint_prevents_the_drift_of_the_velocity_form():
 
 
 # ================================================================= 3-D thread friction
-def nut_with_thread_friction(lead_per_radian: float, mu: float, axial_inertia: float,
-                             speed: float = 0.0) -> ScrewNutSystem:
+def nut_with_thread_friction(
+    lead_per_radian: float, mu: float, axial_inertia: float, speed: float = 0.0
+) -> ScrewNutSystem:
     """A 2 kg nut on a fixed vertical screw (r_mean 0.01 m), moving up at ``speed``."""
     thread = ScrewThread(2 * math.pi * lead_per_radian, 0.01, mu)
     ground = RigidBody(1.0, np.eye(3), fixed=True)
     nut = RigidBody(2.0, np.diag([5e-3, 5e-3, axial_inertia]))
     s1, s2 = BodyState.at_rest(), BodyState.at_rest((0.0, 0.0, 0.5))
     joint = ScrewNutJoint(thread, (0, 0, 0), (0, 0, 1), s1, s2)
-    system = ScrewNutSystem(ground, nut, joint, s1, s2, gravity=(0.0, 0.0, -9.81),
-                            thread_friction=True)
+    system = ScrewNutSystem(
+        ground, nut, joint, s1, s2, gravity=(0.0, 0.0, -9.81), thread_friction=True
+    )
     nut_state = system.states[1]
     nut_state.velocity[:] = (0.0, 0.0, speed)
     nut_state.angular_velocity[:] = (0.0, 0.0, speed / lead_per_radian)
@@ -402,8 +441,9 @@ def test_3d_thread_friction_slows_a_sliding_nut_as_the_closed_form():
     for _ in range(200):
         system.step(1e-3)
     acc = -2.0 * 9.81 / (2.0 + inertia / (h * (h - r_mu)))
-    assert system.states[1].position[2] == pytest.approx(0.5 + 0.5 * acc * system.time**2,
-                                                         abs=1e-11)
+    assert system.states[1].position[2] == pytest.approx(
+        0.5 + 0.5 * acc * system.time**2, abs=1e-11
+    )
     axial = system.last_multipliers[4]
     assert system.friction_torque == pytest.approx(r_mu * abs(axial), rel=1e-12)
 

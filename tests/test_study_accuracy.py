@@ -49,20 +49,55 @@ def fall_scene(**extra):
     data = {
         "name": "fall",
         "run": {"stop_time": 1.0, "step": 0.01},
-        "units": {"rope": {"fmu": "BlockTrain", "parameters": {
-            "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
-            "initial_equilibrium": False, "pretension": PRETENSION}}},
-        "study": {"key_outputs": ["rope.block_a.position"], "steps": [0.02, 0.01],
-                  "output_interval": 0.02},
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "parameters": {
+                    "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
+                    "initial_equilibrium": False,
+                    "pretension": PRETENSION,
+                },
+            }
+        },
+        "study": {
+            "key_outputs": ["rope.block_a.position"],
+            "steps": [0.02, 0.01],
+            "output_interval": 0.02,
+        },
     }
     data.update(extra)
     return parse_scene(data, base_dir=Path("."))
 
 
-def row(family: str, extrapolation: str, step: float, error: float, cost: float,
-        solver: str = "s", algorithm: str = "jacobi") -> RunRow:
-    return RunRow(family, algorithm, extrapolation, solver, step, "finished", error, "y", cost,
-                  1.0, cost, 1, 0, 10, 2, 0.9, 0.05, 0.05)
+def row(
+    family: str,
+    extrapolation: str,
+    step: float,
+    error: float,
+    cost: float,
+    solver: str = "s",
+    algorithm: str = "jacobi",
+) -> RunRow:
+    return RunRow(
+        family,
+        algorithm,
+        extrapolation,
+        solver,
+        step,
+        "finished",
+        error,
+        "y",
+        cost,
+        1.0,
+        cost,
+        1,
+        0,
+        10,
+        2,
+        0.9,
+        0.05,
+        0.05,
+    )
 
 
 # ------------------------------------------------------------------- no FMUs
@@ -77,8 +112,9 @@ def test_study_reference_matches_the_closed_form():
     exact = y_eq * (1 - np.cos(omega * reference.time))
     assert reference.time[1] == pytest.approx(0.02)
     np.testing.assert_allclose(reference.values["rope.block_a.position"], exact, atol=1e-10)
-    error, worst = output_error({"rope.block_a.position": exact}, reference.values,
-                                settings.key_outputs)
+    error, worst = output_error(
+        {"rope.block_a.position": exact}, reference.values, settings.key_outputs
+    )
     assert error < 1e-8 and worst == "rope.block_a.position"
 
 
@@ -99,21 +135,27 @@ def test_settings_from_the_study_table_and_defaults():
     assert settings.key_outputs == (VarRef("rope", "block_a.position"),)
     assert settings.steps == (0.02, 0.01)
     assert settings.stop_time == pytest.approx(1.0)
-    default = study_settings(fall_scene(study={}, plots=[{"title": "y", "variables": [
-        "rope.block_a.position"]}]))
+    default = study_settings(
+        fall_scene(study={}, plots=[{"title": "y", "variables": ["rope.block_a.position"]}])
+    )
     assert default.steps == pytest.approx((0.04, 0.02, 0.01, 0.005, 0.0025))
     assert default.output_interval == pytest.approx(0.04)
-    quick = study_settings(fall_scene(study={}, plots=[{"title": "y", "variables": [
-        "rope.block_a.position"]}]), quick=True)
+    quick = study_settings(
+        fall_scene(study={}, plots=[{"title": "y", "variables": ["rope.block_a.position"]}]),
+        quick=True,
+    )
     assert quick.quick and len(quick.steps) == 3 and quick.solvers == ()  # the scene's own
     assert quick.extrapolations == ("constant", "linear")
 
 
-@pytest.mark.parametrize("study, message", [
-    ({"key_outputs": ["x"]}, "not 'unit.variable'"),
-    ({"key_outputs": ["rope.block_a.position"], "steps": [0.03, 0.02]}, "not a multiple"),
-    ({"key_outputs": ["rope.block_a.position"], "colour": "red"}, "unknown keys"),
-])
+@pytest.mark.parametrize(
+    "study, message",
+    [
+        ({"key_outputs": ["x"]}, "not 'unit.variable'"),
+        ({"key_outputs": ["rope.block_a.position"], "steps": [0.03, 0.02]}, "not a multiple"),
+        ({"key_outputs": ["rope.block_a.position"], "colour": "red"}, "unknown keys"),
+    ],
+)
 def test_study_table_problems_are_reported(study, message):
     with pytest.raises(SceneError, match=message):
         study_settings(fall_scene(study=study))
@@ -150,16 +192,27 @@ def test_theory_of_held_efforts_signals_and_bonded_flows():
     scene = load_scene(COUPLED_FALLS)
     assert [theoretical_order(scene, e) for e in ("constant", "linear", "quadratic")] == [1, 2, 2]
     assert theoretical_order(fall_scene(), "constant") is None  # nothing held
-    bonded = parse_scene({"units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
-                          "bonds": [{"name": "rope", "kind": "rope",
-                                     "effort": "r.line_a.tension -> w.rope.tension",
-                                     "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
-                                     "position": "w.rope.payout -> r.line_a.payout"}]},
-                         base_dir=Path("."))
+    bonded = parse_scene(
+        {
+            "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
+            "bonds": [
+                {
+                    "name": "rope",
+                    "kind": "rope",
+                    "effort": "r.line_a.tension -> w.rope.tension",
+                    "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
+                    "position": "w.rope.payout -> r.line_a.payout",
+                }
+            ],
+        },
+        base_dir=Path("."),
+    )
     assert theoretical_order(bonded, "constant") == 1  # the held tension
     # the same bond with its effort not held (marked as exact like a position): only the flow
-    only_flow = replace(bonded, bonds=(replace(bonded.bonds[0], effort=replace(
-        bonded.bonds[0].effort, role="position")),))
+    only_flow = replace(
+        bonded,
+        bonds=(replace(bonded.bonds[0], effort=replace(bonded.bonds[0].effort, role="position")),),
+    )
     assert theoretical_order(only_flow, "constant") == 2  # a flow into an exact position
 
 
@@ -167,8 +220,28 @@ def test_orders_are_fitted_where_coupling_error_dominates():
     steps = [0.2, 0.04, 0.02, 0.01, 0.005]
     rows = [row("c", "constant", h, 3.0 * h, 1 / h) for h in steps]  # 0.6 at 0.2: too big
     rows += [row("l", "linear", h, 50.0 * h**2, 1 / h) for h in steps[1:]]
-    rows.append(RunRow("monolithic / s", "monolithic", "-", "s", math.nan, "finished", 5e-4,
-                       "y", 1.0, 1.0, 1.0, 1, 0, 0, 0, 1.0, 0.0, 0.0))
+    rows.append(
+        RunRow(
+            "monolithic / s",
+            "monolithic",
+            "-",
+            "s",
+            math.nan,
+            "finished",
+            5e-4,
+            "y",
+            1.0,
+            1.0,
+            1.0,
+            1,
+            0,
+            0,
+            0,
+            1.0,
+            0.0,
+            0.0,
+        )
+    )
     orders = {o.family: o for o in observed_orders(rows, load_scene(COUPLED_FALLS))}
     assert orders["c"].observed == pytest.approx(1.0) and orders["c"].points == 4
     assert orders["l"].observed == pytest.approx(2.0)
@@ -194,8 +267,13 @@ def test_observed_orders_match_theory_across_a_power_bond(tmp_path):
     """Winch and block train, tension one way, payout and its rate back: the held tension
     makes constant extrapolation first order, linear and quadratic second order."""
     scene = load_scene(WINCH_HOIST)
-    settings = replace(study_settings(scene), steps=(0.04, 0.02, 0.01, 0.005), stop_time=1.2,
-                       solvers=(), monolithic_rtols=())
+    settings = replace(
+        study_settings(scene),
+        steps=(0.04, 0.02, 0.01, 0.005),
+        stop_time=1.2,
+        solvers=(),
+        monolithic_rtols=(),
+    )
     study = run_accuracy_study(scene, tmp_path, settings=settings, progress=False)
     assert len(study.orders) == 6
     for order in study.orders:
@@ -205,8 +283,13 @@ def test_observed_orders_match_theory_across_a_power_bond(tmp_path):
     assert all(r.status == "finished" and r.error < 0.3 for r in cosim)
     assert all(r.do_step_calls == 2 * round(1.2 / r.step) for r in cosim)
     assert all(0.0 < r.physics_share < 1.0 and r.fmu_calls > r.do_step_calls for r in cosim)
-    for name in ("accuracy.csv", "accuracy.md", "accuracy.json", "work_precision.png",
-                 "convergence.png"):
+    for name in (
+        "accuracy.csv",
+        "accuracy.md",
+        "accuracy.json",
+        "work_precision.png",
+        "convergence.png",
+    ):
         assert (tmp_path / name).stat().st_size > 0
     assert "Observed convergence orders" in (tmp_path / "accuracy.md").read_text()
     assert study.comparison and study.comparison[0].cheapest
@@ -216,11 +299,11 @@ def test_observed_orders_match_theory_across_a_power_bond(tmp_path):
 def test_observed_orders_of_held_position_signals(tmp_path):
     """Two block trains each holding the other's block displacement: orders 1 and 2."""
     scene = load_scene(COUPLED_FALLS)
-    settings = replace(study_settings(scene, quick=True), steps=(0.04, 0.02, 0.01),
-                       stop_time=0.8)
+    settings = replace(study_settings(scene, quick=True), steps=(0.04, 0.02, 0.01), stop_time=0.8)
     study = run_accuracy_study(scene, tmp_path, settings=settings, progress=False)
     assert {(o.algorithm, o.extrapolation) for o in study.orders} == {
-        (a, e) for a in ("jacobi", "gauss_seidel") for e in ("constant", "linear")}
+        (a, e) for a in ("jacobi", "gauss_seidel") for e in ("constant", "linear")
+    }
     for order in study.orders:
         assert order.points == 3, order
         assert abs(order.observed - order.theory) < 0.3, order
@@ -231,15 +314,24 @@ def test_refused_and_blown_up_configurations_are_recorded(tmp_path):
     """A unit refusing its solver stops a run; quadratic extrapolation at w H ~ 5 blows up."""
     scene = load_scene(COUPLED_FALLS)
     bogus = SolverChoice("no such solver", {"solver": "no_such_solver"})
-    settings = replace(study_settings(scene), steps=(0.64, 0.32), output_interval=0.64,
-                       stop_time=1.28, algorithms=("jacobi",), extrapolations=("quadratic",),
-                       solvers=(bogus, RK4), monolithic_rtols=())
+    settings = replace(
+        study_settings(scene),
+        steps=(0.64, 0.32),
+        output_interval=0.64,
+        stop_time=1.28,
+        algorithms=("jacobi",),
+        extrapolations=("quadratic",),
+        solvers=(bogus, RK4),
+        monolithic_rtols=(),
+    )
     study = run_accuracy_study(scene, tmp_path, settings=settings, progress=False)
     own = scene_solver(scene).label
     assert own == "rk4 h=0.004 (scene)"
     assert {r.family for r in study.rows} == {  # RK4 is the scene's own: studied once
-        f"jacobi / quadratic / {own}", "gauss_seidel / linear / no such solver",
-        f"monolithic / {own}"}
+        f"jacobi / quadratic / {own}",
+        "gauss_seidel / linear / no such solver",
+        f"monolithic / {own}",
+    }
     refused = [r for r in study.rows if r.solver == bogus.label]
     assert len(refused) == 2
     assert all(r.status == "failed" and "no_such_solver" in r.message for r in refused)

@@ -22,22 +22,40 @@ EFFECTS = ["rope_damping", "sheave_inertia", "bearing_friction"]
 
 def hoist_scene(effects=EFFECTS):
     """A 4-line drilling block train, its fast line paid out and in by a sine."""
-    return parse_scene({
-        "name": "hoist",
-        "run": {"stop_time": 1.0, "step": 0.01},
-        "units": {"rope": {"fmu": "BlockTrain", "effects": list(effects),
-                           "parameters": {"reeving": drilling_block_train(4)}}},
-        "drivers": [{"target": "rope.line_a.payout", "rate_target": "rope.line_a.payout_rate",
-                     "kind": "sine", "amplitude": 0.2, "period": 2.0, "ramp_time": 0.5}],
-        "study": {"key_outputs": ["rope.block_a.position", "rope.line_a.tension"]},
-    }, base_dir=Path("."))
+    return parse_scene(
+        {
+            "name": "hoist",
+            "run": {"stop_time": 1.0, "step": 0.01},
+            "units": {
+                "rope": {
+                    "fmu": "BlockTrain",
+                    "effects": list(effects),
+                    "parameters": {"reeving": drilling_block_train(4)},
+                }
+            },
+            "drivers": [
+                {
+                    "target": "rope.line_a.payout",
+                    "rate_target": "rope.line_a.payout_rate",
+                    "kind": "sine",
+                    "amplitude": 0.2,
+                    "period": 2.0,
+                    "ramp_time": 0.5,
+                }
+            ],
+            "study": {"key_outputs": ["rope.block_a.position", "rope.line_a.tension"]},
+        },
+        base_dir=Path("."),
+    )
 
 
 def test_an_effect_goes_with_the_effects_that_need_it():
     cases = effect_cases(hoist_scene())
-    assert cases == [EffectCase("rope", "rope_damping"),
-                     EffectCase("rope", "sheave_inertia", ("bearing_friction",)),
-                     EffectCase("rope", "bearing_friction")]
+    assert cases == [
+        EffectCase("rope", "rope_damping"),
+        EffectCase("rope", "sheave_inertia", ("bearing_friction",)),
+        EffectCase("rope", "bearing_friction"),
+    ]
     assert without(hoist_scene(), cases[1]).units["rope"].effects == ("rope_damping",)
     assert cases[1].label == "rope: sheave_inertia (+ bearing_friction)"
     assert effect_cases(hoist_scene(effects=[])) == []

@@ -20,11 +20,19 @@ def fall_scene(**extra):
     data = {
         "name": "fall",
         "run": {"stop_time": 1.0, "step": 0.01},
-        "units": {"rope": {"fmu": "BlockTrain", "parameters": {
-            "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
-            "initial_equilibrium": False, "pretension": PRETENSION}}},
-        "outputs": {"variables": ["rope.block_a.position", "rope.line_a.tension",
-                                  "rope.energy_balance"]},
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "parameters": {
+                    "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
+                    "initial_equilibrium": False,
+                    "pretension": PRETENSION,
+                },
+            }
+        },
+        "outputs": {
+            "variables": ["rope.block_a.position", "rope.line_a.tension", "rope.energy_balance"]
+        },
     }
     data.update(extra)
     return parse_scene(data, base_dir=Path("."))
@@ -45,15 +53,21 @@ def stepped_positions(step: float) -> np.ndarray:
     """The core unit stepped like a master would: payout now, mean rate over the step."""
     from tests.block_train_helpers import make_unit
 
-    unit = make_unit(single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA), solver="rk4",
-                     solver_max_step=1e-4, initial_equilibrium=False, pretension=PRETENSION)
+    unit = make_unit(
+        single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
+        solver="rk4",
+        solver_max_step=1e-4,
+        initial_equilibrium=False,
+        pretension=PRETENSION,
+    )
     w, every = 2 * math.pi / 0.4, int(round(0.01 / step))
     positions = [unit.values["block_a.position"]]
     for i in range(int(round(1.0 / step))):
         t = i * step
         unit.values["line_a.payout"] = 0.02 * math.sin(w * t)
-        unit.values["line_a.payout_rate"] = 0.02 * (math.sin(w * (t + step)) - math.sin(w * t)
-                                                    ) / step
+        unit.values["line_a.payout_rate"] = (
+            0.02 * (math.sin(w * (t + step)) - math.sin(w * t)) / step
+        )
         assert unit.advance(t, step).success
         if (i + 1) % every == 0:
             positions.append(unit.values["block_a.position"])
@@ -63,8 +77,13 @@ def stepped_positions(step: float) -> np.ndarray:
 def test_driven_scene_is_the_limit_of_the_stepped_unit():
     """Payout driven by a sine, the rope going slack and snapping taut: the stepped unit
     converges to the reference at second order in the step."""
-    driver = {"target": "rope.line_a.payout", "rate_target": "rope.line_a.payout_rate",
-              "kind": "sine", "amplitude": 0.02, "period": 0.4}
+    driver = {
+        "target": "rope.line_a.payout",
+        "rate_target": "rope.line_a.payout_rate",
+        "kind": "sine",
+        "amplitude": 0.02,
+        "period": 0.4,
+    }
     result = run_monolithic(fall_scene(drivers=[driver]))
     assert result.events > 0  # slack and taut again
     reference = result.values["rope.block_a.position"]

@@ -34,19 +34,26 @@ from wire_fmu.sweep import SweepError, apply_case, expand, parse_sweep_spec, run
 
 pytestmark = pytest.mark.integration
 
-FIGURES = {"peak_b": "max(b.position)", "low_a": "min(a.position)",
-           "spread_a": "range(a.position)", "final_b": "final(b.position)",
-           "mean_b": "mean(b.position)", "residual": "final(bond.spring.energy_residual)"}
+FIGURES = {
+    "peak_b": "max(b.position)",
+    "low_a": "min(a.position)",
+    "spread_a": "range(a.position)",
+    "final_b": "final(b.position)",
+    "mean_b": "mean(b.position)",
+    "residual": "final(bond.spring.energy_residual)",
+}
 
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory) -> dict[str, Path]:
     out = tmp_path_factory.mktemp("fmus")
     return {
-        "osc": build_fmu(FACADES / "oscillator.py", out,
-                         extra_modules=[SUPPORT / "wire_fmu_test_units.py"]),
-        "mass": build_fmu(FACADES / "coupled_mass.py", out,
-                          extra_modules=[SUPPORT / "wire_fmu_master_units.py"]),
+        "osc": build_fmu(
+            FACADES / "oscillator.py", out, extra_modules=[SUPPORT / "wire_fmu_test_units.py"]
+        ),
+        "mass": build_fmu(
+            FACADES / "coupled_mass.py", out, extra_modules=[SUPPORT / "wire_fmu_master_units.py"]
+        ),
     }
 
 
@@ -55,40 +62,73 @@ def cluster(fmus):
     """A cluster of two single-thread worker processes, reached by its address."""
     from distributed import Client, LocalCluster
 
-    with (LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                       dashboard_address=":0") as local,
-          Client(local) as client):
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as local,
+        Client(local) as client,
+    ):
         yield client
 
 
 def two_mass(fmus, stop_time=1.0, outputs=("a.position",)):
-    return parse_scene({
-        "name": "two_mass",
-        "run": {"stop_time": stop_time, "step": 0.01},
-        "units": {
-            "a": {"fmu": str(fmus["osc"]), "parameters": {
-                "mass": 1.0, "stiffness": 40.0, "damping": 0.0, "x0": 0.1, "substeps": 50}},
-            "b": {"fmu": str(fmus["mass"]), "parameters": {
-                "mass": 2.0, "stiffness": 60.0, "damping": 0.0, "x0": 0.0, "substeps": 50}},
+    return parse_scene(
+        {
+            "name": "two_mass",
+            "run": {"stop_time": stop_time, "step": 0.01},
+            "units": {
+                "a": {
+                    "fmu": str(fmus["osc"]),
+                    "parameters": {
+                        "mass": 1.0,
+                        "stiffness": 40.0,
+                        "damping": 0.0,
+                        "x0": 0.1,
+                        "substeps": 50,
+                    },
+                },
+                "b": {
+                    "fmu": str(fmus["mass"]),
+                    "parameters": {
+                        "mass": 2.0,
+                        "stiffness": 60.0,
+                        "damping": 0.0,
+                        "x0": 0.0,
+                        "substeps": 50,
+                    },
+                },
+            },
+            "bonds": [
+                {
+                    "name": "spring",
+                    "kind": "translational",
+                    "effort": "b.force_on_flange -> a.force",
+                    "flow": "a.velocity -> b.flange.velocity",
+                    "position": "a.position -> b.flange.position",
+                }
+            ],
+            "outputs": {"variables": list(outputs)},  # the sweep adds what its figures read
         },
-        "bonds": [{
-            "name": "spring", "kind": "translational",
-            "effort": "b.force_on_flange -> a.force",
-            "flow": "a.velocity -> b.flange.velocity",
-            "position": "a.position -> b.flange.position",
-        }],
-        "outputs": {"variables": list(outputs)},  # the sweep adds what its figures read
-    }, base_dir=Path("."))
+        base_dir=Path("."),
+    )
 
 
 def sweep_spec(masses=(1.0, 2.0), stiffnesses=(40.0, 80.0), samples=2, **axes):
-    data = {"axes": [
-        {"target": "units.b.parameters.mass", "values": list(masses)},
-        {"target": "units.b.parameters.stiffness", "values": list(stiffnesses)},
-        {"target": "units.b.parameters.damping", "distribution": "uniform", "low": 0.0,
-         "high": 1.0},
-        *axes.values(),
-    ], "sampling": {"samples": samples, "seed": 11}, "figures": FIGURES}
+    data = {
+        "axes": [
+            {"target": "units.b.parameters.mass", "values": list(masses)},
+            {"target": "units.b.parameters.stiffness", "values": list(stiffnesses)},
+            {
+                "target": "units.b.parameters.damping",
+                "distribution": "uniform",
+                "low": 0.0,
+                "high": 1.0,
+            },
+            *axes.values(),
+        ],
+        "sampling": {"samples": samples, "seed": 11},
+        "figures": FIGURES,
+    }
     return parse_sweep_spec(data)
 
 
@@ -96,16 +136,22 @@ def serial_reference(scene, spec, tmp_path) -> dict[str, tuple[dict, bytes]]:
     """Each case run by run_scene here; figures by numpy; and the time series' bytes."""
     out = {}
     for case in expand(spec):
-        outcome = run_scene(apply_case(scene, case.values), tmp_path / case.case_id,
-                            plots=False)
+        outcome = run_scene(apply_case(scene, case.values), tmp_path / case.case_id, plots=False)
         assert outcome.result.status == "finished", outcome.result.message
         c = read_results(outcome.csv_path)
         t, a, b = c["time"], c["a.position"], c["b.position"]
-        figures = {"peak_b": np.max(b), "low_a": np.min(a), "spread_a": np.max(a) - np.min(a),
-                   "final_b": b[-1], "mean_b": np.trapezoid(b, t) / (t[-1] - t[0]),
-                   "residual": c["bond.spring.energy_residual"][-1]}
-        out[case.case_id] = ({k: float(v) for k, v in figures.items()},
-                             outcome.csv_path.read_bytes())
+        figures = {
+            "peak_b": np.max(b),
+            "low_a": np.min(a),
+            "spread_a": np.max(a) - np.min(a),
+            "final_b": b[-1],
+            "mean_b": np.trapezoid(b, t) / (t[-1] - t[0]),
+            "residual": c["bond.spring.energy_residual"][-1],
+        }
+        out[case.case_id] = (
+            {k: float(v) for k, v in figures.items()},
+            outcome.csv_path.read_bytes(),
+        )
     return out
 
 
@@ -132,15 +178,23 @@ def test_two_workers_equal_serial_runs_bit_for_bit(fmus, tmp_path):
 
 
 def test_a_case_that_raises_is_recorded_and_the_rest_complete(fmus, cluster, tmp_path):
-    spec = parse_sweep_spec({"axes": [
-        {"target": "units.a.parameters.mass", "values": [1.0, -1.0]},  # -1: refused
-        {"target": "units.a.parameters.max_position", "values": [1e3, 0.05]},  # 0.05: stops
-        {"target": "run.step", "values": [0.01, -0.01]},  # -0.01: not a valid setting
-    ], "figures": FIGURES})
-    result = run_sweep(two_mass(fmus), spec, tmp_path / "out", scheduler=cluster.scheduler.address,
-                       progress=False)
-    rows = {(r["units.a.parameters.mass"], r["units.a.parameters.max_position"],
-             r["run.step"]): r for r in result.rows}
+    spec = parse_sweep_spec(
+        {
+            "axes": [
+                {"target": "units.a.parameters.mass", "values": [1.0, -1.0]},  # -1: refused
+                {"target": "units.a.parameters.max_position", "values": [1e3, 0.05]},  # 0.05: stops
+                {"target": "run.step", "values": [0.01, -0.01]},  # -0.01: not a valid setting
+            ],
+            "figures": FIGURES,
+        }
+    )
+    result = run_sweep(
+        two_mass(fmus), spec, tmp_path / "out", scheduler=cluster.scheduler.address, progress=False
+    )
+    rows = {
+        (r["units.a.parameters.mass"], r["units.a.parameters.max_position"], r["run.step"]): r
+        for r in result.rows
+    }
     assert result.counts == {"finished": 1, "stopped": 1, "failed": 6}
     assert rows[1.0, 1e3, 0.01]["status"] == "finished"
     stopped = rows[1.0, 0.05, 0.01]
@@ -172,8 +226,14 @@ def test_a_worker_killed_mid_sweep_loses_no_case(fmus, cluster, tmp_path):
         killed["address"] = victim
         os.kill(pids[victim], signal.SIGKILL)
 
-    result = run_sweep(scene, spec, tmp_path / "out", scheduler=cluster.scheduler.address,
-                       progress=False, on_case=kill_the_other_worker)
+    result = run_sweep(
+        scene,
+        spec,
+        tmp_path / "out",
+        scheduler=cluster.scheduler.address,
+        progress=False,
+        on_case=kill_the_other_worker,
+    )
     assert killed["running"], "the worker killed was running a case"
     assert killed["address"] not in cluster.scheduler_info()["workers"]
     assert result.complete and result.executed == 8
@@ -199,8 +259,7 @@ def test_second_invocation_runs_only_what_is_missing(fmus, cluster, tmp_path):
             raise SimulatedInterruptError
 
     with pytest.raises(SimulatedInterruptError):
-        run_sweep(scene, spec, out, scheduler=address, progress=False,
-                  on_case=stop_after_three)
+        run_sweep(scene, spec, out, scheduler=address, progress=False, on_case=stop_after_three)
     on_disk = {p.stem for p in (out / "records").glob("*.parquet")}
     assert on_disk == set(seen)
     summary = pq.read_table(out / "summary.parquet").to_pylist()
@@ -221,11 +280,20 @@ def test_second_invocation_runs_only_what_is_missing(fmus, cluster, tmp_path):
 def test_a_grown_spec_runs_only_new_cases_and_adds_figures_from_stored_series(fmus, tmp_path):
     scene, out = two_mass(fmus), tmp_path / "out"
     axis = {"target": "units.b.parameters.mass", "values": [1.0, 2.0]}
-    first = run_sweep(scene, parse_sweep_spec({"axes": [axis], "figures": {
-        "peak_b": FIGURES["peak_b"]}}), out, workers=0, progress=False, plots=False)
-    grown = parse_sweep_spec({"axes": [{**axis, "values": [1.0, 2.0, 3.0]}],
-                              "figures": {"peak_b": FIGURES["peak_b"],
-                                          "low_a": FIGURES["low_a"]}})
+    first = run_sweep(
+        scene,
+        parse_sweep_spec({"axes": [axis], "figures": {"peak_b": FIGURES["peak_b"]}}),
+        out,
+        workers=0,
+        progress=False,
+        plots=False,
+    )
+    grown = parse_sweep_spec(
+        {
+            "axes": [{**axis, "values": [1.0, 2.0, 3.0]}],
+            "figures": {"peak_b": FIGURES["peak_b"], "low_a": FIGURES["low_a"]},
+        }
+    )
     second = run_sweep(scene, grown, out, workers=0, progress=False, plots=False)
     assert (first.executed, second.executed, second.reused) == (2, 1, 2)
     for row in second.rows:

@@ -23,8 +23,7 @@ def spec_data(**more):
         "axes": [
             {"target": "units.b.parameters.mass", "values": [1, 2.5, 4]},
             {"target": "units.b.parameters.stiffness", "linspace": [40.0, 80.0, 2]},
-            {"target": "drivers.0.amplitude", "distribution": "uniform", "low": 0.1,
-             "high": 0.3},
+            {"target": "drivers.0.amplitude", "distribution": "uniform", "low": 0.1, "high": 0.3},
         ],
         "sampling": {"samples": 3, "seed": 7},
         "figures": {"peak": "max(b.position)", "spread": 'range("a.position")'},
@@ -34,18 +33,26 @@ def spec_data(**more):
 
 
 def scene(**run):
-    return parse_scene({
-        "name": "s",
-        "run": {"stop_time": 1.0, "step": 0.01, **run},
-        "units": {
-            "a": {"fmu": "a.fmu", "parameters": {"mass": 1.0}},
-            "b": {"fmu": "b.fmu", "parameters": {
-                "mass": 2.0, "stiffness": 60.0,
-                "reeving": {"sheaves": [{"radius": 0.5}, {"radius": 0.7}], "rope": "wire"}}},
+    return parse_scene(
+        {
+            "name": "s",
+            "run": {"stop_time": 1.0, "step": 0.01, **run},
+            "units": {
+                "a": {"fmu": "a.fmu", "parameters": {"mass": 1.0}},
+                "b": {
+                    "fmu": "b.fmu",
+                    "parameters": {
+                        "mass": 2.0,
+                        "stiffness": 60.0,
+                        "reeving": {"sheaves": [{"radius": 0.5}, {"radius": 0.7}], "rope": "wire"},
+                    },
+                },
+            },
+            "drivers": [{"target": "a.force", "kind": "sine", "amplitude": 1.0, "period": 2.0}],
+            "events": [{"time": 0.5, "set": {"a.force": 0.0}}],
         },
-        "drivers": [{"target": "a.force", "kind": "sine", "amplitude": 1.0, "period": 2.0}],
-        "events": [{"time": 0.5, "set": {"a.force": 0.0}}],
-    }, base_dir=Path("."))
+        base_dir=Path("."),
+    )
 
 
 def test_grid_times_samples_first_axis_slowest():
@@ -64,10 +71,14 @@ def test_grid_times_samples_first_axis_slowest():
 
 
 def test_logspace_and_integer_axes():
-    spec = parse_sweep_spec({"axes": [
-        {"target": "run.step", "logspace": [1e-3, 1e-1, 3]},
-        {"target": "units.a.parameters.substeps", "linspace": [10, 20, 3], "integer": True},
-    ]})
+    spec = parse_sweep_spec(
+        {
+            "axes": [
+                {"target": "run.step", "logspace": [1e-3, 1e-1, 3]},
+                {"target": "units.a.parameters.substeps", "linspace": [10, 20, 3], "integer": True},
+            ]
+        }
+    )
     step, substeps = spec.axes
     assert step.values == pytest.approx((1e-3, 1e-2, 1e-1), rel=1e-12) and step.log_scale
     assert substeps.values == (10, 15, 20) and substeps.kind == "int"
@@ -75,22 +86,32 @@ def test_logspace_and_integer_axes():
 
 def test_every_problem_is_listed_at_once():
     with pytest.raises(SweepSpecError) as err:
-        parse_sweep_spec({
-            "colour": "red",
-            "axes": [
-                {"target": "units.b.parameters.mass", "values": [1.0, 1.0]},
-                {"target": "vessel.heave", "values": [1.0]},
-                {"target": "units.b.parameters.k", "values": [1.0], "linspace": [0, 1, 2]},
-                {"target": "drivers.0.amplitude", "distribution": "triangular"},
-                {"target": "run.step", "distribution": "log_uniform", "low": 0.0, "high": 1.0},
-            ],
-            "figures": {"peak": "peak(b.position)", "status": "max(b.position)", "x": "b"},
-        })
+        parse_sweep_spec(
+            {
+                "colour": "red",
+                "axes": [
+                    {"target": "units.b.parameters.mass", "values": [1.0, 1.0]},
+                    {"target": "vessel.heave", "values": [1.0]},
+                    {"target": "units.b.parameters.k", "values": [1.0], "linspace": [0, 1, 2]},
+                    {"target": "drivers.0.amplitude", "distribution": "triangular"},
+                    {"target": "run.step", "distribution": "log_uniform", "low": 0.0, "high": 1.0},
+                ],
+                "figures": {"peak": "peak(b.position)", "status": "max(b.position)", "x": "b"},
+            }
+        )
     text = "\n".join(err.value.problems)
-    for expected in ("unknown top-level key 'colour'", "appears twice", "must start with one of",
-                     "give exactly one of", "'distribution' must be one of",
-                     "needs 'low' > 0", "unknown function 'peak'", "reserved",
-                     "must read 'function(unit.variable)'", "needs [sampling]"):
+    for expected in (
+        "unknown top-level key 'colour'",
+        "appears twice",
+        "must start with one of",
+        "give exactly one of",
+        "'distribution' must be one of",
+        "needs 'low' > 0",
+        "unknown function 'peak'",
+        "reserved",
+        "must read 'function(unit.variable)'",
+        "needs [sampling]",
+    ):
         assert expected in text, expected
     assert len(err.value.problems) >= 10
 
@@ -126,14 +147,16 @@ def test_distributions_map_the_unit_interval():
     normal = Axis("run.step", distribution="normal", arguments=(10.0, 2.0))
     assert normal.draw(np.array([0.5, phi_1])) == pytest.approx([10.0, 12.0])
     assert Axis("x.y", distribution="uniform", arguments=(0, 10), integer=True).draw(
-        np.array([0.26])) == [3]
+        np.array([0.26])
+    ) == [3]
 
 
 def test_key_figures_against_closed_forms():
     t = np.linspace(0.0, 2 * math.pi, 2001)
     columns = {"time": t, "u.s": 1.0 + np.sin(t), "u.line": 3.0 * t - 1.0}
-    value = {f: Figure(f, f, "u.s").evaluate(columns)
-             for f in ("max", "min", "absmax", "range", "final")}
+    value = {
+        f: Figure(f, f, "u.s").evaluate(columns) for f in ("max", "min", "absmax", "range", "final")
+    }
     assert value["max"] == pytest.approx(2.0, abs=1e-5)
     assert value["min"] == pytest.approx(0.0, abs=1e-5)
     assert value["range"] == pytest.approx(2.0, abs=1e-5)
@@ -141,8 +164,9 @@ def test_key_figures_against_closed_forms():
     assert value["final"] == pytest.approx(1.0, abs=1e-12)
     assert Figure("m", "mean", "u.s").evaluate(columns) == pytest.approx(1.0, abs=1e-12)
     # the trapezoidal mean of a straight line is exact: 3 * pi - 1
-    assert Figure("m", "mean", "u.line").evaluate(columns) == pytest.approx(3 * math.pi - 1,
-                                                                            rel=1e-13)
+    assert Figure("m", "mean", "u.line").evaluate(columns) == pytest.approx(
+        3 * math.pi - 1, rel=1e-13
+    )
     uneven = {"time": np.array([0.0, 1.0, 3.0]), "u.s": np.array([0.0, 2.0, 2.0])}
     assert Figure("m", "mean", "u.s").evaluate(uneven) == pytest.approx((1.0 + 4.0) / 3.0)
     assert Figure("m", "max", "u.missing").evaluate(columns) is None
@@ -150,17 +174,20 @@ def test_key_figures_against_closed_forms():
 
 def test_apply_case_changes_a_copy_only():
     base = scene()
-    changed = apply_case(base, {
-        "units.b.parameters.mass": 3.0,
-        "units.b.parameters.reeving.sheaves.1.radius": 0.9,
-        "units.b.parameters.ground_stiffness": 5.0,
-        "units.a.effects": ["rope_damping", "sheave_inertia"],
-        "drivers.0.amplitude": 2.0,
-        "drivers.0.phase_deg": 90.0,
-        "events.0.time": 0.25,
-        "events.0.set.a.force": 7.0,
-        "run.step": 0.005,
-    })
+    changed = apply_case(
+        base,
+        {
+            "units.b.parameters.mass": 3.0,
+            "units.b.parameters.reeving.sheaves.1.radius": 0.9,
+            "units.b.parameters.ground_stiffness": 5.0,
+            "units.a.effects": ["rope_damping", "sheave_inertia"],
+            "drivers.0.amplitude": 2.0,
+            "drivers.0.phase_deg": 90.0,
+            "events.0.time": 0.25,
+            "events.0.set.a.force": 7.0,
+            "run.step": 0.005,
+        },
+    )
     b = changed.units["b"].parameters
     assert b["mass"] == 3.0 and b["ground_stiffness"] == 5.0
     assert b["reeving"]["sheaves"][1]["radius"] == 0.9
@@ -180,23 +207,32 @@ def test_apply_case_checks_run_settings():
 
 
 def test_check_targets_names_what_the_scene_lacks():
-    spec = parse_sweep_spec({
-        "axes": [
-            {"target": "units.c.parameters.mass", "values": [1.0]},
-            {"target": "units.b.parameters.reeving.sheaves.5.radius", "values": [1.0]},
-            {"target": "units.b.parameters.reeving.rope.grade", "values": [1.0]},
-            {"target": "drivers.3.amplitude", "values": [1.0]},
-            {"target": "drivers.0.significant_height", "values": [1.0]},
-            {"target": "events.2.time", "values": [1.0]},
-            {"target": "run.horizon", "values": [1.0]},
-        ],
-        "figures": {"peak": "max(c.position)", "bond": "final(bond.rod.power)"},
-    })
+    spec = parse_sweep_spec(
+        {
+            "axes": [
+                {"target": "units.c.parameters.mass", "values": [1.0]},
+                {"target": "units.b.parameters.reeving.sheaves.5.radius", "values": [1.0]},
+                {"target": "units.b.parameters.reeving.rope.grade", "values": [1.0]},
+                {"target": "drivers.3.amplitude", "values": [1.0]},
+                {"target": "drivers.0.significant_height", "values": [1.0]},
+                {"target": "events.2.time", "values": [1.0]},
+                {"target": "run.horizon", "values": [1.0]},
+            ],
+            "figures": {"peak": "max(c.position)", "bond": "final(bond.rod.power)"},
+        }
+    )
     problems = check_targets(spec, scene())
     text = "\n".join(problems)
-    for expected in ("no unit 'c'", "not an index of a list of 2", "is a value, not a table",
-                     "1 drivers, no index 3", "sets no 'significant_height'",
-                     "1 events, no index 2", "no run setting 'horizon'",
-                     "'c.position' is neither", "no bond 'rod'"):
+    for expected in (
+        "no unit 'c'",
+        "not an index of a list of 2",
+        "is a value, not a table",
+        "1 drivers, no index 3",
+        "sets no 'significant_height'",
+        "1 events, no index 2",
+        "no run setting 'horizon'",
+        "'c.position' is neither",
+        "no bond 'rod'",
+    ):
         assert expected in text, expected
     assert len(problems) == 9

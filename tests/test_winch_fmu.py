@@ -23,12 +23,12 @@ OUTPUTS = [v for v in WinchUnit.VARIABLES if v.causality is Causality.output]
 ALL = "drum_inertia,band_brake,motor_characteristic,elastic_drive_train,rope_layers"
 
 SCENES = {
-    "kinetostatic": ("band_brake,rope_layers", {"drum.speed_command": 3.0,
-                                                "brake.lever_force": 300.0,
-                                                "rope.tension": 1e5}),
+    "kinetostatic": (
+        "band_brake,rope_layers",
+        {"drum.speed_command": 3.0, "brake.lever_force": 300.0, "rope.tension": 1e5},
+    ),
     "held": ("drum_inertia,band_brake", {"brake.lever_force": 3000.0, "rope.tension": 1e5}),
-    "sliding": (ALL, {"brake.lever_force": 500.0, "rope.tension": 1.5e5,
-                      "motor.command": -500.0}),
+    "sliding": (ALL, {"brake.lever_force": 500.0, "rope.tension": 1.5e5, "motor.command": -500.0}),
     "free": ("drum_inertia,elastic_drive_train", {"rope.tension": 1e5, "motor.command": 1e3}),
 }
 
@@ -49,17 +49,35 @@ def test_declarations_are_sound():
             assert var.unit
     assert set(INPUTS) >= {"rope.tension", "brake.lever_force", "motor.command"}
     names = {v.name for v in OUTPUTS}
-    assert names >= {"rope.payout", "rope.payout_rate", "drum.speed", "brake.torque",
-                     "brake.state", "stored_energy", "dissipated_energy", "external_work",
-                     "energy_balance", "mode_changes"}
+    assert names >= {
+        "rope.payout",
+        "rope.payout_rate",
+        "drum.speed",
+        "brake.torque",
+        "brake.state",
+        "stored_energy",
+        "dissipated_energy",
+        "external_work",
+        "energy_balance",
+        "mode_changes",
+    }
     assert WinchUnit.variable("brake.state").type is int
     assert WinchUnit.variable("mode_changes").type is int
 
 
 def test_rope_port_outputs_come_from_the_drum_state():
     """The block train takes these as inputs: no feedthrough, so no algebraic loop."""
-    for name in ("rope.payout", "rope.payout_rate", "drum.speed", "drum.angle", "motor.speed",
-                 "stored_energy", "dissipated_energy", "external_work", "energy_balance"):
+    for name in (
+        "rope.payout",
+        "rope.payout_rate",
+        "drum.speed",
+        "drum.angle",
+        "motor.speed",
+        "stored_energy",
+        "dissipated_energy",
+        "external_work",
+        "energy_balance",
+    ):
         assert WinchUnit.variable(name).depends_on == (), name
 
 
@@ -116,8 +134,13 @@ def test_core_state_round_trips_bit_for_bit(name):
     saved = json.loads(json.dumps(unit.get_state()))
 
     def go(u):
-        return run(u, 0.3, 0.05, record=("rope.payout", "drum.speed", "brake.torque",
-                                         "energy_balance", "mode_changes"), start=0.2)
+        return run(
+            u,
+            0.3,
+            0.05,
+            record=("rope.payout", "drum.speed", "brake.torque", "energy_balance", "mode_changes"),
+            start=0.2,
+        )
 
     first = go(unit)
     unit.set_state(saved)
@@ -128,20 +151,28 @@ def test_core_state_round_trips_bit_for_bit(name):
 
 def test_bad_parameters_give_one_error_listing_every_problem():
     unit = WinchUnit("bad")
-    unit.values.update({
-        "effects": "drum_inertia,brake,elastic_drive_train,band_brake,rope_layers",
-        "solver": "energy",
-        "solver_max_step": 0.0,
-        "drive_train_masses": 7,
-        "brake_friction": -0.1,
-        "brake_efficiency": 1.5,
-        "rope_on_drum": 1e6,
-    })
+    unit.values.update(
+        {
+            "effects": "drum_inertia,brake,elastic_drive_train,band_brake,rope_layers",
+            "solver": "energy",
+            "solver_max_step": 0.0,
+            "drive_train_masses": 7,
+            "brake_friction": -0.1,
+            "brake_efficiency": 1.5,
+            "rope_on_drum": 1e6,
+        }
+    )
     with pytest.raises(ConfigurationError) as err:
         unit.configure()
     text = str(err.value)
-    for needle in ("unknown effect 'brake'", "solver_max_step", "drive_train_masses",
-                   "brake_friction", "brake_efficiency", "rope_on_drum"):
+    for needle in (
+        "unknown effect 'brake'",
+        "solver_max_step",
+        "drive_train_masses",
+        "brake_friction",
+        "brake_efficiency",
+        "rope_on_drum",
+    ):
         assert needle in text, needle
     assert len(err.value.problems) == 6
 
@@ -165,9 +196,12 @@ def test_energy_solver_needs_a_rigid_machine_and_other_solvers_are_listed():
 def test_an_unstable_explicit_solver_is_refused_before_it_runs():
     """A stiff shaft (1e10 N m/rad on a 1 kg m^2 rotor: 1e5 1/s) cannot be stepped by rk4
     at 1 ms; the message says what to do."""
-    stiff = json.dumps({"masses": [{"name": "rotor", "inertia": 1.0}, {"name": "drum",
-                                                                      "inertia": 100.0}],
-                        "shafts": [{"stiffness": 1e10}]})
+    stiff = json.dumps(
+        {
+            "masses": [{"name": "rotor", "inertia": 1.0}, {"name": "drum", "inertia": 100.0}],
+            "shafts": [{"stiffness": 1e10}],
+        }
+    )
     unit = WinchUnit("stiff")
     unit.values.update({"effects": "drum_inertia,elastic_drive_train", "drive_train": stiff})
     with pytest.raises(ConfigurationError, match="set solver_max_step below 2.4"):
@@ -230,13 +264,16 @@ def test_absent_effects_cost_nothing():
     assert len(full.get_state()["x"]) == 2 * 3 + 2  # the default chain has three masses
 
     def trajectory(**params):
-        unit = make_unit("drum_inertia", **params, **{"rope.tension": 1e5,
-                                                      "motor.command": -500.0})
+        unit = make_unit("drum_inertia", **params, **{"rope.tension": 1e5, "motor.command": -500.0})
         return run(unit, 0.3, 0.05, record=("rope.payout", "drum.speed", "energy_balance"))
 
     plain = trajectory()
-    for params in ({"brake__lever_force": 5e3}, {"motor_slope": 1.0}, {"rope_linear_mass": 50.0},
-                   {"drive_train_masses": 2}):
+    for params in (
+        {"brake__lever_force": 5e3},
+        {"motor_slope": 1.0},
+        {"rope_linear_mass": 50.0},
+        {"drive_train_masses": 2},
+    ):
         other = trajectory(**params)
         for key in plain:
             assert np.array_equal(plain[key], other[key]), (params, key)

@@ -23,8 +23,15 @@ pytestmark = pytest.mark.integration
 
 ROOT = Path(__file__).resolve().parents[1]
 EFFECTS = "drum_inertia,band_brake,motor_characteristic,elastic_drive_train,rope_layers"
-WATCH = ["rope.payout", "rope.payout_rate", "drum.speed", "brake.torque", "motor.torque",
-         "energy_balance", "dissipated_energy"]
+WATCH = [
+    "rope.payout",
+    "rope.payout_rate",
+    "drum.speed",
+    "brake.torque",
+    "motor.torque",
+    "energy_balance",
+    "dissipated_energy",
+]
 INTEGERS = ["brake.state", "mode_changes", "drum.layer"]
 STEP = 0.01
 
@@ -56,8 +63,10 @@ def step_fmu(loaded, fmu, first: int, count: int):
         values = inputs(i)
         fmu.setReal([loaded.vr(k) for k in values], list(values.values()))
         fmu.doStep(currentCommunicationPoint=i * STEP, communicationStepSize=STEP)
-        rows.append(fmu.getReal([loaded.vr(n) for n in WATCH])
-                    + fmu.getInteger([loaded.vr(n) for n in INTEGERS]))
+        rows.append(
+            fmu.getReal([loaded.vr(n) for n in WATCH])
+            + fmu.getInteger([loaded.vr(n) for n in INTEGERS])
+        )
     return rows
 
 
@@ -133,8 +142,11 @@ def test_libcosimpy_steps_the_winch(winch_fmu):
     assert execution.simulate_until(target_time=int(0.5e9))
     got = observer.last_real_values(index, [refs[n] for n in WATCH])
 
-    unit = make_unit("drum_inertia,band_brake", initial_drum_speed=8.0,
-                     **{"brake.lever_force": 1500.0, "rope.tension": 5.0e4})
+    unit = make_unit(
+        "drum_inertia,band_brake",
+        initial_drum_speed=8.0,
+        **{"brake.lever_force": 1500.0, "rope.tension": 5.0e4},
+    )
     for i in range(50):
         assert unit.advance(i * STEP, STEP).success
     assert got == pytest.approx([unit.values[n] for n in WATCH], rel=1e-12, abs=1e-9)

@@ -19,8 +19,13 @@ from wire_fmu.core.winch import BandBrake
 from .winch_helpers import make_unit, one_mass, run, two_mass
 
 # a test brake: capacity 22.6 N m per newton of lever force paying out, 4.36 hauling in
-BRAKE = {"brake_rim_radius": 0.6, "brake_lever_ratio": 10.0, "brake_efficiency": 0.9,
-         "brake_friction": 0.35, "brake_wrap_angle": 4.7}
+BRAKE = {
+    "brake_rim_radius": 0.6,
+    "brake_lever_ratio": 10.0,
+    "brake_efficiency": 0.9,
+    "brake_friction": 0.35,
+    "brake_wrap_angle": 4.7,
+}
 R = 0.5  # drum radius, m
 J = 1000.0  # drum inertia, kg m^2
 RIGID = {"drive_train": one_mass(J), "drum_radius": R, **BRAKE}
@@ -64,10 +69,26 @@ def test_band_brake_factors_are_eq_34_both_ways():
 def test_brake_holds_below_capacity_with_zero_speed_for_ever(solver):
     lever = 1000.0
     tension = 0.95 * capacities(lever)[0] / R
-    unit = make_unit("drum_inertia,band_brake", solver=solver, solver_max_step=0.25,
-                     **RIGID, **{"brake.lever_force": lever, "rope.tension": tension})
-    out = run(unit, 200.0, 1.0, record=("drum.speed", "drum.angle", "rope.payout",
-                                         "rope.payout_rate", "brake.state", "brake.torque"))
+    unit = make_unit(
+        "drum_inertia,band_brake",
+        solver=solver,
+        solver_max_step=0.25,
+        **RIGID,
+        **{"brake.lever_force": lever, "rope.tension": tension},
+    )
+    out = run(
+        unit,
+        200.0,
+        1.0,
+        record=(
+            "drum.speed",
+            "drum.angle",
+            "rope.payout",
+            "rope.payout_rate",
+            "brake.state",
+            "brake.torque",
+        ),
+    )
     for name in ("drum.speed", "drum.angle", "rope.payout", "rope.payout_rate"):
         assert np.all(out[name] == 0.0), name
     assert np.all(out["brake.state"] == 2)
@@ -96,9 +117,13 @@ def test_breakaway_time_on_an_elastic_drive_train_matches_the_closed_form():
     lever, jm, c, moment = 400.0, 20.0, 2.0e6, 1.0e4
     cap = capacities(lever)[0]
     rope_torque = cap - 0.6 * moment  # breakaway at 1 - cos W t = 0.6
-    unit = make_unit("drum_inertia,band_brake,elastic_drive_train", solver="rk4",
-                     solver_max_step=1e-4, **{**RIGID, "drive_train": two_mass(jm, J, c)},
-                     **{"brake.lever_force": lever, "rope.tension": rope_torque / R})
+    unit = make_unit(
+        "drum_inertia,band_brake,elastic_drive_train",
+        solver="rk4",
+        solver_max_step=1e-4,
+        **{**RIGID, "drive_train": two_mass(jm, J, c)},
+        **{"brake.lever_force": lever, "rope.tension": rope_torque / R},
+    )
     unit.values["motor.command"] = moment
     omega = math.sqrt(c / jm)
     expected = math.acos(1.0 - 0.6) / omega
@@ -118,14 +143,20 @@ def test_sliding_deceleration_and_clean_restick(solver):
     lever, w0, tension = 1000.0, 10.0, 2000.0
     cap = capacities(lever)[0]
     decel = (cap - tension * R) / J
-    unit = make_unit("drum_inertia,band_brake", solver=solver, initial_drum_speed=w0,
-                     **RIGID, **{"brake.lever_force": lever, "rope.tension": tension})
+    unit = make_unit(
+        "drum_inertia,band_brake",
+        solver=solver,
+        initial_drum_speed=w0,
+        **RIGID,
+        **{"brake.lever_force": lever, "rope.tension": tension},
+    )
     assert unit.values["brake.state"] == 1 and unit.values["brake.torque"] == -cap
     stop = w0 / decel
     out = run(unit, 1.0, 0.01, record=("drum.speed", "rope.payout", "brake.state"))
     sliding = out["time"] < stop
-    np.testing.assert_allclose(out["drum.speed"][sliding], w0 - decel * out["time"][sliding],
-                               rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(
+        out["drum.speed"][sliding], w0 - decel * out["time"][sliding], rtol=1e-9, atol=1e-9
+    )
     assert np.all(out["drum.speed"][~sliding] == 0.0)
     assert np.all(out["brake.state"][~sliding] == 2)
     held = out["rope.payout"][~sliding]
@@ -139,8 +170,12 @@ def test_reverse_direction_slides_on_the_weak_side_and_holds_on_the_strong_one()
     lever, w0, tension = 1000.0, -10.0, 2000.0
     plus, minus = capacities(lever)
     decel = (minus + tension * R) / J  # both the brake and the rope slow the haul-in
-    unit = make_unit("drum_inertia,band_brake", initial_drum_speed=w0, **RIGID,
-                     **{"brake.lever_force": lever, "rope.tension": tension})
+    unit = make_unit(
+        "drum_inertia,band_brake",
+        initial_drum_speed=w0,
+        **RIGID,
+        **{"brake.lever_force": lever, "rope.tension": tension},
+    )
     assert unit.values["brake.torque"] == pytest.approx(minus, rel=1e-14)
     stop = step_until(unit, "brake holding", 0.01, 3.0)
     assert stop == pytest.approx(-w0 / decel, abs=1e-8)
@@ -163,16 +198,25 @@ def test_holding_capacity_depends_on_direction(direction):
 
 
 # ----------------------------------------------------------------- motor
-@pytest.mark.parametrize("solver, rel", [("ros2", 1e-5), ("rk4", 1e-9), ("energy", 1e-6),
-                                         ("energy1", 3e-3)])
+@pytest.mark.parametrize(
+    "solver, rel", [("ros2", 1e-5), ("rk4", 1e-9), ("energy", 1e-6), ("energy1", 3e-3)]
+)
 def test_motor_spin_up_follows_the_exponential(solver, rel):
     """M = a - b omega through a 6:1 gearbox: omega_ss + (omega0 - omega_ss) e^(-b t / J)."""
     jm, jd, ratio, a, b, tension = 2.0, 100.0, 6.0, 600.0, 5.0, 400.0
-    train = ('{"masses": [{"name": "motor", "inertia": 2.0, "ratio": 6.0},'
-             ' {"name": "drum", "inertia": 100.0}], "shafts": [{"stiffness": 1e6}]}')
-    unit = make_unit("drum_inertia,motor_characteristic", solver=solver, drive_train=train,
-                     drum_radius=R, motor_slope=b, initial_drum_speed=1.0,
-                     **{"motor.command": a, "rope.tension": tension})
+    train = (
+        '{"masses": [{"name": "motor", "inertia": 2.0, "ratio": 6.0},'
+        ' {"name": "drum", "inertia": 100.0}], "shafts": [{"stiffness": 1e6}]}'
+    )
+    unit = make_unit(
+        "drum_inertia,motor_characteristic",
+        solver=solver,
+        drive_train=train,
+        drum_radius=R,
+        motor_slope=b,
+        initial_drum_speed=1.0,
+        **{"motor.command": a, "rope.tension": tension},
+    )
     j_red, b_red = jm * ratio**2 + jd, b * ratio**2
     w_ss = (ratio * a + tension * R) / b_red
     out = run(unit, 3.0, 0.05, record=("drum.speed", "motor.speed", "motor.torque"))
@@ -183,9 +227,15 @@ def test_motor_spin_up_follows_the_exponential(solver, rel):
 
 
 # ---------------------------------------------------------- drum and layers
-LAYERED = {"drive_train": one_mass(200.0), "drum_radius": 0.5, "rope_diameter": 0.1,
-           "rope_linear_mass": 50.0, "drum_wraps_per_layer": 3, "drum_layers": 4,
-           "rope_on_drum": 25.0}
+LAYERED = {
+    "drive_train": one_mass(200.0),
+    "drum_radius": 0.5,
+    "rope_diameter": 0.1,
+    "rope_linear_mass": 50.0,
+    "drum_wraps_per_layer": 3,
+    "drum_layers": 4,
+    "rope_on_drum": 25.0,
+}
 
 
 def hand_layers(phi: np.ndarray, rope: float = 25.0) -> tuple[np.ndarray, np.ndarray]:
@@ -210,11 +260,14 @@ def hand_layers(phi: np.ndarray, rope: float = 25.0) -> tuple[np.ndarray, np.nda
 @pytest.mark.parametrize("solver, rel", [("energy", 1e-11), ("ros2", 1e-6)])
 def test_free_drum_keeps_i_omega_squared_and_steps_rope_speed_at_layer_changes(solver, rel):
     w0 = 20.0
-    unit = make_unit("drum_inertia,rope_layers", solver=solver, initial_drum_speed=w0,
-                     **LAYERED)
+    unit = make_unit("drum_inertia,rope_layers", solver=solver, initial_drum_speed=w0, **LAYERED)
     assert unit.values["drum.layer"] == 3
-    out = run(unit, 1.5, 0.01, record=("drum.angle", "drum.speed", "rope.payout_rate",
-                                        "drum.layer", "drum.radius"))
+    out = run(
+        unit,
+        1.5,
+        0.01,
+        record=("drum.angle", "drum.speed", "rope.payout_rate", "drum.layer", "drum.radius"),
+    )
     radius, inertia = hand_layers(out["drum.angle"])
     i0 = hand_layers(np.array([0.0]))[1][0]
     np.testing.assert_allclose(inertia * out["drum.speed"] ** 2, i0 * w0**2, rtol=rel)
@@ -225,8 +278,9 @@ def test_free_drum_keeps_i_omega_squared_and_steps_rope_speed_at_layer_changes(s
     for k in changes:  # across a change the rope speed steps by r_new / r_old, omega smooth
         jump = out["rope.payout_rate"][k + 1] / out["rope.payout_rate"][k]
         smooth = out["drum.speed"][k + 1] / out["drum.speed"][k]
-        assert jump / smooth == pytest.approx(out["drum.radius"][k + 1] / out["drum.radius"][k],
-                                              rel=1e-12)
+        assert jump / smooth == pytest.approx(
+            out["drum.radius"][k + 1] / out["drum.radius"][k], rel=1e-12
+        )
         assert jump / smooth < 0.9 and abs(smooth - 1.0) < 0.02
 
 
@@ -238,16 +292,21 @@ def test_payout_is_continuous_through_layer_changes_and_matches_the_geometry():
     radius, _ = hand_layers(phi)
     # payout = integral of r dphi; the hand radius is piecewise constant in phi
     grid = np.linspace(0.0, phi[-1], 200001)
-    arc = np.concatenate(([0.0], np.cumsum(0.5 * np.diff(grid) * (hand_layers(grid)[0][1:]
-                                                                   + hand_layers(grid)[0][:-1]))))
+    arc = np.concatenate(
+        (
+            [0.0],
+            np.cumsum(0.5 * np.diff(grid) * (hand_layers(grid)[0][1:] + hand_layers(grid)[0][:-1])),
+        )
+    )
     np.testing.assert_allclose(out["rope.payout"], np.interp(phi, grid, arc), atol=1e-4)
     assert out["drum.layer"][0] == 3 and out["drum.layer"][-1] == 1
     assert radius[-1] == 0.5
 
 
 def test_rope_running_off_the_drum_refuses_the_step():
-    unit = make_unit("drum_inertia,rope_layers", initial_drum_speed=20.0,
-                     **{**LAYERED, "rope_on_drum": 2.0})
+    unit = make_unit(
+        "drum_inertia,rope_layers", initial_drum_speed=20.0, **{**LAYERED, "rope_on_drum": 2.0}
+    )
     before = dict(unit.values)
     result = unit.advance(0.0, 0.5)
     assert not result.success and "run off the drum" in result.message
@@ -258,18 +317,23 @@ def test_rope_running_off_the_drum_refuses_the_step():
 def test_two_mass_chain_response_to_a_torque_step():
     """Free 2-mass chain: rigid-body ramp plus the shaft mode at sqrt(c (J1+J2)/(J1 J2))."""
     j1, j2, c, moment = 10.0, 40.0, 4.0e4, 500.0
-    unit = make_unit("drum_inertia,elastic_drive_train", solver="rk4", solver_max_step=2.5e-4,
-                     drive_train=two_mass(j1, j2, c))
+    unit = make_unit(
+        "drum_inertia,elastic_drive_train",
+        solver="rk4",
+        solver_max_step=2.5e-4,
+        drive_train=two_mass(j1, j2, c),
+    )
     unit.values["motor.command"] = moment  # a step at t = 0, from a relaxed shaft
     out = run(unit, 1.0, 0.005, record=("motor.speed", "drum.speed"))
     t = out["time"]
     w = math.sqrt(c * (j1 + j2) / (j1 * j2))
     ramp = moment * t / (j1 + j2)
     np.testing.assert_allclose(
-        out["motor.speed"], ramp + moment * j2 / (j1 * (j1 + j2) * w) * np.sin(w * t),
-        atol=1e-7)
+        out["motor.speed"], ramp + moment * j2 / (j1 * (j1 + j2) * w) * np.sin(w * t), atol=1e-7
+    )
     np.testing.assert_allclose(
-        out["drum.speed"], ramp - moment / ((j1 + j2) * w) * np.sin(w * t), atol=1e-7)
+        out["drum.speed"], ramp - moment / ((j1 + j2) * w) * np.sin(w * t), atol=1e-7
+    )
 
 
 @pytest.mark.parametrize("frequency", [4.0, 25.0])
@@ -277,13 +341,15 @@ def test_steady_sinusoidal_response_matches_the_input_impedance(frequency):
     """Motor speed per motor torque in steady state is 1/Z_in(j omega) (paper 002)."""
     j, ground = [10.0, 5.0, 40.0], [40.0, 10.0, 160.0]
     c, links = [4.0e4, 9.0e4], [15.0, 30.0]
-    train = {"masses": [{"name": f"m{i}", "inertia": j[i], "damping": ground[i]}
-                        for i in range(3)],
-             "shafts": [{"stiffness": c[i], "damping": links[i]} for i in range(2)]}
+    train = {
+        "masses": [{"name": f"m{i}", "inertia": j[i], "damping": ground[i]} for i in range(3)],
+        "shafts": [{"stiffness": c[i], "damping": links[i]} for i in range(2)],
+    }
     import json
 
-    unit = make_unit("drum_inertia,elastic_drive_train", solver="rk4",
-                     drive_train=json.dumps(train))
+    unit = make_unit(
+        "drum_inertia,elastic_drive_train", solver="rk4", drive_train=json.dumps(train)
+    )
     omega, amplitude, h = 2 * math.pi * frequency, 100.0, 1e-3
 
     def drive(t, u):  # hold the value at the middle of the step: second order in h
@@ -307,16 +373,27 @@ def lively(t: float, unit) -> None:
     unit.values["motor.command"] = -2.2e3 if t > 1.6 else 0.0
 
 
-@pytest.mark.parametrize("effects, solver, tolerance", [
-    ("drum_inertia,band_brake,motor_characteristic,elastic_drive_train,rope_layers", "rk4",
-     1e-8),
-    ("drum_inertia,band_brake,elastic_drive_train,rope_layers", "ros2", 1e-4),
-    ("drum_inertia,band_brake,rope_layers", "energy", 1e-9),
-])
+@pytest.mark.parametrize(
+    "effects, solver, tolerance",
+    [
+        (
+            "drum_inertia,band_brake,motor_characteristic,elastic_drive_train,rope_layers",
+            "rk4",
+            1e-8,
+        ),
+        ("drum_inertia,band_brake,elastic_drive_train,rope_layers", "ros2", 1e-4),
+        ("drum_inertia,band_brake,rope_layers", "energy", 1e-9),
+    ],
+)
 def test_energy_ledger_closes(effects, solver, tolerance):
     unit = make_unit(effects, solver=solver, rope_on_drum=105.0, motor_slope=50.0)
-    out = run(unit, 3.0, 0.01, lively, record=("energy_balance", "external_work",
-                                                "dissipated_energy", "mode_changes"))
+    out = run(
+        unit,
+        3.0,
+        0.01,
+        lively,
+        record=("energy_balance", "external_work", "dissipated_energy", "mode_changes"),
+    )
     scale = np.abs(out["external_work"]).max() + out["dissipated_energy"][-1]
     assert np.abs(out["energy_balance"]).max() < tolerance * scale
     assert out["mode_changes"][-1] >= 3  # the scenario really switched modes
@@ -326,13 +403,25 @@ def test_energy_ledger_closes(effects, solver, tolerance):
 def test_friction_never_injects_energy():
     """No dampers at all: every joule dissipated is the brake's, and it only ever grows;
     the brake torque never has the sign of the drum speed."""
-    train = ('{"masses": [{"name": "motor", "inertia": 30.0}, {"name": "drum", '
-             '"inertia": 900.0}], "shafts": [{"stiffness": 3e6}]}')
-    unit = make_unit("drum_inertia,band_brake,elastic_drive_train", solver="rk4",
-                     drive_train=train)
-    out = run(unit, 3.0, 0.005, lively, record=("dissipated_energy", "brake.torque",
-                                                 "drum.speed", "energy_balance",
-                                                 "brake.state", "external_work"))
+    train = (
+        '{"masses": [{"name": "motor", "inertia": 30.0}, {"name": "drum", '
+        '"inertia": 900.0}], "shafts": [{"stiffness": 3e6}]}'
+    )
+    unit = make_unit("drum_inertia,band_brake,elastic_drive_train", solver="rk4", drive_train=train)
+    out = run(
+        unit,
+        3.0,
+        0.005,
+        lively,
+        record=(
+            "dissipated_energy",
+            "brake.torque",
+            "drum.speed",
+            "energy_balance",
+            "brake.state",
+            "external_work",
+        ),
+    )
     assert np.all(np.diff(out["dissipated_energy"]) >= 0.0)
     assert np.all(out["brake.torque"] * out["drum.speed"] <= 0.0)
     assert set(out["brake.state"]) == {0, 1, 2}
@@ -344,12 +433,19 @@ def test_kinetostatic_drum_follows_eq_32():
     """No inertia: the drive imposes the speed and the motor torque is what (32) needs."""
     lever, tension, ratio = 300.0, 3.0e4, 6.0
     plus, minus = capacities(lever)
-    train = ('{"masses": [{"name": "motor", "inertia": 1.0, "damping": 2.0, "ratio": 6.0},'
-             ' {"name": "drum", "inertia": 1.0, "damping": 40.0}],'
-             ' "shafts": [{"stiffness": 1e6, "ratio": 6.0}]}')
+    train = (
+        '{"masses": [{"name": "motor", "inertia": 1.0, "damping": 2.0, "ratio": 6.0},'
+        ' {"name": "drum", "inertia": 1.0, "damping": 40.0}],'
+        ' "shafts": [{"stiffness": 1e6, "ratio": 6.0}]}'
+    )
     beta = 2.0 * ratio**2 + 40.0
-    unit = make_unit("band_brake", drive_train=train, **BRAKE, drum_radius=R,
-                     **{"brake.lever_force": lever, "rope.tension": tension})
+    unit = make_unit(
+        "band_brake",
+        drive_train=train,
+        **BRAKE,
+        drum_radius=R,
+        **{"brake.lever_force": lever, "rope.tension": tension},
+    )
     rope = tension * R
     cases = [(4.0, -plus), (-2.0, minus), (0.0, -min(rope, plus))]
     for i, (speed, brake) in enumerate(cases):
@@ -358,8 +454,9 @@ def test_kinetostatic_drum_follows_eq_32():
         assert unit.advance(float(i), 1.0).success
         assert unit.values["rope.payout"] - payout == pytest.approx(R * speed, abs=1e-12)
         assert unit.values["brake.torque"] == pytest.approx(brake, rel=1e-14)
-        assert unit.values["motor.torque"] == pytest.approx((beta * speed - rope - brake) / ratio,
-                                                            rel=1e-12, abs=1e-9)
+        assert unit.values["motor.torque"] == pytest.approx(
+            (beta * speed - rope - brake) / ratio, rel=1e-12, abs=1e-9
+        )
         assert unit.values["brake.state"] == (2 if speed == 0.0 else 1)
         assert unit.values["stored_energy"] == 0.0
         assert abs(unit.values["energy_balance"]) < 1e-9 * unit.values["dissipated_energy"]
@@ -396,9 +493,14 @@ def test_energy_form_solver_order_in_the_winch():
     for solver, order in (("energy1", 1), ("energy", 2)):
         errors = []
         for max_step in (4e-3, 2e-3, 1e-3):
-            unit = make_unit("drum_inertia,motor_characteristic,rope_layers", solver=solver,
-                             solver_max_step=max_step, initial_drum_speed=w0, **params,
-                             **{"rope.tension": tension, "motor.command": a})
+            unit = make_unit(
+                "drum_inertia,motor_characteristic,rope_layers",
+                solver=solver,
+                solver_max_step=max_step,
+                initial_drum_speed=w0,
+                **params,
+                **{"rope.tension": tension, "motor.command": a},
+            )
             run(unit, span, 0.1)
             assert unit.values["drum.layer"] == 3  # stayed on one layer
             errors.append(abs(unit.values["drum.speed"] - ref.y[1, -1]))
@@ -409,9 +511,11 @@ def test_energy_form_solver_order_in_the_winch():
 # ------------------------------------------------------------ initial state
 def test_starts_in_equilibrium_when_the_brake_holds():
     """Motor torque on at the start, brake holding: the shafts carry it, nothing moves."""
-    unit = make_unit("drum_inertia,band_brake,elastic_drive_train", solver="rk4",
-                     **{"brake.lever_force": 2000.0, "rope.tension": 1.0e5,
-                        "motor.command": -1.0e3})
+    unit = make_unit(
+        "drum_inertia,band_brake,elastic_drive_train",
+        solver="rk4",
+        **{"brake.lever_force": 2000.0, "rope.tension": 1.0e5, "motor.command": -1.0e3},
+    )
     out = run(unit, 1.0, 0.01, record=("motor.speed", "drum.speed", "brake.state"))
     assert np.all(out["drum.speed"] == 0.0) and np.all(out["brake.state"] == 2)
     assert np.abs(out["motor.speed"]).max() < 1e-9
@@ -420,17 +524,23 @@ def test_starts_in_equilibrium_when_the_brake_holds():
 
 def test_starts_accelerating_without_shaft_vibration():
     """Free drum under motor and rope torque: the preloaded chain accelerates as one body."""
-    train = ('{"masses": [{"name": "motor", "inertia": 12.0, "ratio": 6.0},'
-             ' {"name": "gearbox", "inertia": 150.0}, {"name": "drum", "inertia": 1200.0}],'
-             ' "shafts": [{"stiffness": 2e5, "ratio": 6.0}, {"stiffness": 1.5e7}]}')
+    train = (
+        '{"masses": [{"name": "motor", "inertia": 12.0, "ratio": 6.0},'
+        ' {"name": "gearbox", "inertia": 150.0}, {"name": "drum", "inertia": 1200.0}],'
+        ' "shafts": [{"stiffness": 2e5, "ratio": 6.0}, {"stiffness": 1.5e7}]}'
+    )
     moment, tension = 2.0e3, 5.0e4
-    unit = make_unit("drum_inertia,elastic_drive_train", solver="rk4", drive_train=train,
-                     drum_radius=R, **{"motor.command": moment, "rope.tension": tension})
+    unit = make_unit(
+        "drum_inertia,elastic_drive_train",
+        solver="rk4",
+        drive_train=train,
+        drum_radius=R,
+        **{"motor.command": moment, "rope.tension": tension},
+    )
     out = run(unit, 0.5, 0.01, record=("motor.speed", "drum.speed"))
     acc = (6.0 * moment + tension * R) / (12.0 * 36 + 150 + 1200)
     np.testing.assert_allclose(out["drum.speed"], acc * out["time"], rtol=1e-9, atol=1e-12)
-    np.testing.assert_allclose(out["motor.speed"], 6.0 * acc * out["time"], rtol=1e-9,
-                               atol=1e-12)
+    np.testing.assert_allclose(out["motor.speed"], 6.0 * acc * out["time"], rtol=1e-9, atol=1e-12)
 
 
 # ------------------------------------------------------- monolithic ODE view

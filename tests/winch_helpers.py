@@ -12,18 +12,31 @@ from wire_fmu.core.winch_unit import WinchUnit
 
 def one_mass(inertia: float, damping: float = 0.0, motor_ratio: float = 1.0) -> str:
     """A rigid drive train: the drum alone (motor acting on it through ``motor_ratio``)."""
-    return json.dumps({"masses": [{"name": "drum", "inertia": inertia, "damping": damping,
-                                   "ratio": 1.0}], "shafts": []})
+    return json.dumps(
+        {
+            "masses": [{"name": "drum", "inertia": inertia, "damping": damping, "ratio": 1.0}],
+            "shafts": [],
+        }
+    )
 
 
-def two_mass(j_motor: float, j_drum: float, stiffness: float, damping: float = 0.0,
-             ground: tuple[float, float] = (0.0, 0.0)) -> str:
+def two_mass(
+    j_motor: float,
+    j_drum: float,
+    stiffness: float,
+    damping: float = 0.0,
+    ground: tuple[float, float] = (0.0, 0.0),
+) -> str:
     """Motor rotor and drum on one shaft, both at drum speed (ratio 1)."""
-    return json.dumps({
-        "masses": [{"name": "motor", "inertia": j_motor, "damping": ground[0]},
-                   {"name": "drum", "inertia": j_drum, "damping": ground[1]}],
-        "shafts": [{"name": "shaft", "stiffness": stiffness, "damping": damping}],
-    })
+    return json.dumps(
+        {
+            "masses": [
+                {"name": "motor", "inertia": j_motor, "damping": ground[0]},
+                {"name": "drum", "inertia": j_drum, "damping": ground[1]},
+            ],
+            "shafts": [{"name": "shaft", "stiffness": stiffness, "damping": damping}],
+        }
+    )
 
 
 def make_unit(effects: str = "", **params) -> WinchUnit:

@@ -20,8 +20,13 @@ logger = logging.getLogger(__name__)
 
 STEP = 0.01  # s, communication step
 SPEED = 0.5  # m/s, fast line while lowering
-OUTPUTS = ("line_a.tension", "block_a.position", "block_a.velocity", "stored_energy",
-           "energy_balance")
+OUTPUTS = (
+    "line_a.tension",
+    "block_a.position",
+    "block_a.velocity",
+    "stored_energy",
+    "energy_balance",
+)
 
 
 def effect_sets() -> list[str]:
@@ -35,16 +40,21 @@ def effect_sets() -> list[str]:
 def lowering(i: int) -> dict[str, float]:
     """Fast line paid out at SPEED for 100 steps, then held."""
     moving = min(i, 100)
-    return {"line_a.payout": SPEED * STEP * moving,
-            "line_a.payout_rate": SPEED if i < 100 else 0.0}
+    return {"line_a.payout": SPEED * STEP * moving, "line_a.payout_rate": SPEED if i < 100 else 0.0}
 
 
 def cases() -> list[Case]:
     """One case per effect set."""
     reeving = json.dumps(drilling_block_train(10))
     return [
-        Case(effects or "(none)", BlockTrainUnit, {"reeving": reeving, "effects": effects},
-             inputs=lowering, outputs=OUTPUTS, step=STEP)
+        Case(
+            effects or "(none)",
+            BlockTrainUnit,
+            {"reeving": reeving, "effects": effects},
+            inputs=lowering,
+            outputs=OUTPUTS,
+            step=STEP,
+        )
         for effects in effect_sets()
     ]
 
@@ -52,9 +62,12 @@ def cases() -> list[Case]:
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases("BlockTrain", cases(), args.steps,
-                     f"10-line block train, ros2, max internal step 1 ms, "
-                     f"communication step {STEP:g} s")
+    text = run_cases(
+        "BlockTrain",
+        cases(),
+        args.steps,
+        f"10-line block train, ros2, max internal step 1 ms, communication step {STEP:g} s",
+    )
     if args.out:
         args.out.write_text(text + "\n")
 

@@ -134,11 +134,18 @@ def time_fmu(fmu_path: Path, case: Case, steps: int) -> tuple[float, float]:
 
     md = read_model_description(str(fmu_path))
     refs = {v.name: v.valueReference for v in md.modelVariables}
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu_path)),
-                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
+    fmu = FMU2Slave(
+        guid=md.guid,
+        unzipDirectory=extract(str(fmu_path)),
+        modelIdentifier=md.coSimulation.modelIdentifier,
+        instanceName="bench",
+    )
     fmu.instantiate()
-    for setter, values in ((fmu.setString, case.strings), (fmu.setReal, case.reals),
-                           (fmu.setBoolean, case.booleans)):
+    for setter, values in (
+        (fmu.setString, case.strings),
+        (fmu.setReal, case.reals),
+        (fmu.setBoolean, case.booleans),
+    ):
         if values:
             setter([refs[k] for k in values], list(values.values()))
     fmu.setupExperiment(startTime=0.0)
@@ -178,8 +185,10 @@ def table(rows: list[Row]) -> str:
         "|---|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
-        lines.append(f"| {r.label} | {r.states} | {r.core_ms:.3f} | {r.fmu_ms:.3f} | "
-                     f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |")
+        lines.append(
+            f"| {r.label} | {r.states} | {r.core_ms:.3f} | {r.fmu_ms:.3f} | "
+            f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |"
+        )
     return "\n".join(lines)
 
 
@@ -206,8 +215,9 @@ def run_cases(unit: str, cases: Sequence[Case], steps: int, title: str) -> str:
         fmu = build_fmu(unit_type(unit).facade_path, Path(tmp))
         for case in cases:
             rows.append(measure(fmu, case, steps))
-            logger.info("%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms,
-                        rows[-1].fmu_ms)
+            logger.info(
+                "%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms, rows[-1].fmu_ms
+            )
     text = table(rows)
     logger.info("\n%s:\n%s", title, text)
     return text

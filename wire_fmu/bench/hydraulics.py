@@ -21,8 +21,14 @@ from wire_fmu.core.hydraulics_unit import DEFAULT_ROD_FORCE, HydraulicsUnit
 logger = logging.getLogger(__name__)
 
 STEP = 0.01  # s, communication step
-OUTPUTS = ("rod.position", "rod.velocity", "chamber.pressure", "gas.pressure",
-           "stored_energy", "energy_balance")
+OUTPUTS = (
+    "rod.position",
+    "rod.velocity",
+    "chamber.pressure",
+    "gas.pressure",
+    "stored_energy",
+    "energy_balance",
+)
 
 
 def effect_sets() -> list[str]:
@@ -45,21 +51,40 @@ def impact(i: int) -> dict[str, float]:
 
 def cases() -> list[Case]:
     """One heave case per effect set, and the stop impact with every effect."""
-    out = [Case(effects or "(none)", HydraulicsUnit, {"effects": effects}, inputs=heave,
-                outputs=OUTPUTS, step=STEP)
-           for effects in effect_sets()]
+    out = [
+        Case(
+            effects or "(none)",
+            HydraulicsUnit,
+            {"effects": effects},
+            inputs=heave,
+            outputs=OUTPUTS,
+            step=STEP,
+        )
+        for effects in effect_sets()
+    ]
     everything = effect_sets()[-1]
-    out.append(Case("all effects, impact on the stop", HydraulicsUnit,
-                    {"effects": everything}, inputs=impact, outputs=OUTPUTS, step=STEP))
+    out.append(
+        Case(
+            "all effects, impact on the stop",
+            HydraulicsUnit,
+            {"effects": everything},
+            inputs=impact,
+            outputs=OUTPUTS,
+            step=STEP,
+        )
+    )
     return out
 
 
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases("Hydraulics", cases(), args.steps,
-                     f"Riser-tensioner cylinder, ros2, max internal step 1 ms, "
-                     f"communication step {STEP:g} s")
+    text = run_cases(
+        "Hydraulics",
+        cases(),
+        args.steps,
+        f"Riser-tensioner cylinder, ros2, max internal step 1 ms, communication step {STEP:g} s",
+    )
     if args.out:
         args.out.write_text(text + "\n")
 

@@ -53,18 +53,21 @@ def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
     if result.status != "finished":
         raise RuntimeError(f"{name}: {result.status}: {result.message}")
     fmi = sum(sum(s.seconds.values()) for s in sim.slaves.values())
-    return SceneFigures(name, len(sim.slaves), result.steps, result.end_time, result.wall_time,
-                        fmi)
+    return SceneFigures(name, len(sim.slaves), result.steps, result.end_time, result.wall_time, fmi)
 
 
 def table(rows: list[SceneFigures]) -> str:
     """Markdown table of the figures."""
-    lines = ["| scene | units | macro steps | simulated s | wall s | real-time factor | "
-             "master overhead per unit per step |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        "| scene | units | macro steps | simulated s | wall s | real-time factor | "
+        "master overhead per unit per step |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in rows:
-        lines.append(f"| {r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
-                     f"{r.real_time_factor:.3g} | {r.overhead_us:.0f} µs |")
+        lines.append(
+            f"| {r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
+            f"{r.real_time_factor:.3g} | {r.overhead_us:.0f} µs |"
+        )
     return "\n".join(lines)
 
 
@@ -79,8 +82,12 @@ def main(argv: list[str] | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for name in shipped_scenes():
             rows.append(measure(name, args.stop_time, Path(tmp)))
-            logger.info("%s: RTF %.3g, overhead %.0f µs per unit per step", name,
-                        rows[-1].real_time_factor, rows[-1].overhead_us)
+            logger.info(
+                "%s: RTF %.3g, overhead %.0f µs per unit per step",
+                name,
+                rows[-1].real_time_factor,
+                rows[-1].overhead_us,
+            )
     text = table(rows)
     logger.info("\n%s", text)
     if args.out:

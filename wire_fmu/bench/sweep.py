@@ -67,61 +67,105 @@ def two_mass_scene(fmu_dir: Path, stop_time: float) -> Scene:
     from wire_fmu.export.builder import build_fmu
 
     if not SUPPORT.is_dir():
-        raise SystemExit(f"the test units are not here ({SUPPORT}); run from a source tree or "
-                         "give --scene and --spec")
+        raise SystemExit(
+            f"the test units are not here ({SUPPORT}); run from a source tree or "
+            "give --scene and --spec"
+        )
     sys.path.insert(0, str(SUPPORT))
-    osc = build_fmu(SUPPORT / "facades" / "oscillator.py", fmu_dir,
-                    extra_modules=[SUPPORT / "wire_fmu_test_units.py"])
-    mass = build_fmu(SUPPORT / "facades" / "coupled_mass.py", fmu_dir,
-                     extra_modules=[SUPPORT / "wire_fmu_master_units.py"])
-    return parse_scene({
-        "name": "two_mass",
-        "run": {"stop_time": stop_time, "step": 0.01},
-        "units": {
-            "a": {"fmu": str(osc), "parameters": {"mass": 1.0, "stiffness": 40.0,
-                                                  "damping": 0.1, "x0": 0.1, "substeps": 50}},
-            "b": {"fmu": str(mass), "parameters": {"mass": 2.0, "stiffness": 60.0,
-                                                   "damping": 0.1, "substeps": 50}},
+    osc = build_fmu(
+        SUPPORT / "facades" / "oscillator.py",
+        fmu_dir,
+        extra_modules=[SUPPORT / "wire_fmu_test_units.py"],
+    )
+    mass = build_fmu(
+        SUPPORT / "facades" / "coupled_mass.py",
+        fmu_dir,
+        extra_modules=[SUPPORT / "wire_fmu_master_units.py"],
+    )
+    return parse_scene(
+        {
+            "name": "two_mass",
+            "run": {"stop_time": stop_time, "step": 0.01},
+            "units": {
+                "a": {
+                    "fmu": str(osc),
+                    "parameters": {
+                        "mass": 1.0,
+                        "stiffness": 40.0,
+                        "damping": 0.1,
+                        "x0": 0.1,
+                        "substeps": 50,
+                    },
+                },
+                "b": {
+                    "fmu": str(mass),
+                    "parameters": {"mass": 2.0, "stiffness": 60.0, "damping": 0.1, "substeps": 50},
+                },
+            },
+            "bonds": [
+                {
+                    "name": "spring",
+                    "kind": "translational",
+                    "effort": "b.force_on_flange -> a.force",
+                    "flow": "a.velocity -> b.flange.velocity",
+                    "position": "a.position -> b.flange.position",
+                }
+            ],
+            "outputs": {"variables": ["a.position", "b.position"]},
         },
-        "bonds": [{"name": "spring", "kind": "translational",
-                   "effort": "b.force_on_flange -> a.force",
-                   "flow": "a.velocity -> b.flange.velocity",
-                   "position": "a.position -> b.flange.position"}],
-        "outputs": {"variables": ["a.position", "b.position"]},
-    }, base_dir=fmu_dir)
+        base_dir=fmu_dir,
+    )
 
 
 def two_mass_spec() -> SweepSpec:
     """Mass x stiffness of unit b: 40 cases, three key figures."""
-    return parse_sweep_spec({
-        "name": "bench",
-        "axes": [{"target": "units.b.parameters.mass", "values": MASSES},
-                 {"target": "units.b.parameters.stiffness", "values": STIFFNESSES}],
-        "figures": {"peak_b": "max(b.position)", "range_a": "range(a.position)",
-                    "residual": "final(bond.spring.energy_residual)"},
-    })
+    return parse_sweep_spec(
+        {
+            "name": "bench",
+            "axes": [
+                {"target": "units.b.parameters.mass", "values": MASSES},
+                {"target": "units.b.parameters.stiffness", "values": STIFFNESSES},
+            ],
+            "figures": {
+                "peak_b": "max(b.position)",
+                "range_a": "range(a.position)",
+                "residual": "final(bond.spring.energy_residual)",
+            },
+        }
+    )
 
 
 def _figures(result: SweepResult, spec: SweepSpec) -> dict[str, tuple]:
     return {r["case_id"]: tuple(r[f.name] for f in spec.figures) for r in result.rows}
 
 
-def _fastest(scene: Scene | str, spec: SweepSpec, workers: int, out: Path,
-             repeat: int) -> SweepResult:
+def _fastest(
+    scene: Scene | str, spec: SweepSpec, workers: int, out: Path, repeat: int
+) -> SweepResult:
     """The fastest of ``repeat`` complete runs (each into a fresh folder)."""
     results = []
     for i in range(repeat):
-        result = run_sweep(scene, spec, out / f"{workers}_workers_{i}", workers=workers,
-                           progress=False, plots=False)
-        logger.info("%s: %.2f s (cluster start %.2f s)",
-                    f"{workers} workers" if workers else "serial", result.wall_time,
-                    result.startup_time)
+        result = run_sweep(
+            scene,
+            spec,
+            out / f"{workers}_workers_{i}",
+            workers=workers,
+            progress=False,
+            plots=False,
+        )
+        logger.info(
+            "%s: %.2f s (cluster start %.2f s)",
+            f"{workers} workers" if workers else "serial",
+            result.wall_time,
+            result.startup_time,
+        )
         results.append(result)
     return min(results, key=lambda r: r.wall_time)
 
 
-def measure(scene: Scene | str, spec: SweepSpec, workers: int, out: Path,
-            repeat: int = 1) -> Timing:
+def measure(
+    scene: Scene | str, spec: SweepSpec, workers: int, out: Path, repeat: int = 1
+) -> Timing:
     """Run the sweep serially, then on ``workers`` workers; check both agree."""
     load = os.getloadavg()[0]
     serial = _fastest(scene, spec, 0, out, repeat)
@@ -130,9 +174,17 @@ def measure(scene: Scene | str, spec: SweepSpec, workers: int, out: Path,
         raise SystemExit("serial and parallel key figures differ")
     if not (serial.complete and parallel.complete):
         raise SystemExit(f"cases did not finish: {serial.counts} / {parallel.counts}")
-    return Timing(len(serial.rows), workers, os.cpu_count() or 0, serial.wall_time,
-                  parallel.wall_time, parallel.startup_time, _mean_case(serial),
-                  _mean_case(parallel), (load, os.getloadavg()[0]))
+    return Timing(
+        len(serial.rows),
+        workers,
+        os.cpu_count() or 0,
+        serial.wall_time,
+        parallel.wall_time,
+        parallel.startup_time,
+        _mean_case(serial),
+        _mean_case(parallel),
+        (load, os.getloadavg()[0]),
+    )
 
 
 def _mean_case(result: SweepResult) -> float:
@@ -141,28 +193,39 @@ def _mean_case(result: SweepResult) -> float:
 
 def table(t: Timing) -> str:
     """Markdown table of the figures."""
-    return "\n".join([
-        f"| cases | one case, serial | one case, {t.workers} workers | serial | "
-        f"{t.workers} workers | of it cluster start | speed-up | speed-up, cluster up |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|",
-        f"| {t.cases} | {t.mean_case:.2f} s | {t.mean_case_parallel:.2f} s | {t.serial:.1f} s | "
-        f"{t.parallel:.1f} s | {t.startup:.1f} s | {t.speedup:.2f} | {t.speedup_running:.2f} |",
-        "",
-        f"Machine: {t.cores} cores; load average (1 min) {t.load[0]:.1f} before, "
-        f"{t.load[1]:.1f} after (other processes than the benchmark's count in it).",
-    ])
+    return "\n".join(
+        [
+            f"| cases | one case, serial | one case, {t.workers} workers | serial | "
+            f"{t.workers} workers | of it cluster start | speed-up | speed-up, cluster up |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|",
+            f"| {t.cases} | {t.mean_case:.2f} s | {t.mean_case_parallel:.2f} s | "
+            f"{t.serial:.1f} s | "
+            f"{t.parallel:.1f} s | {t.startup:.1f} s | {t.speedup:.2f} | {t.speedup_running:.2f} |",
+            "",
+            f"Machine: {t.cores} cores; load average (1 min) {t.load[0]:.1f} before, "
+            f"{t.load[1]:.1f} after (other processes than the benchmark's count in it).",
+        ]
+    )
 
 
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--stop-time", type=float, default=4.0,
-                        help="simulated s per case of the two-mass sweep (default: %(default)s)")
+    parser.add_argument(
+        "--stop-time",
+        type=float,
+        default=4.0,
+        help="simulated s per case of the two-mass sweep (default: %(default)s)",
+    )
     parser.add_argument("--workers", type=int, default=2, help="default: %(default)s")
     parser.add_argument("--scene", help="a shipped scene or scene file (with --spec)")
     parser.add_argument("--spec", type=Path, help="the sweep spec for --scene")
-    parser.add_argument("--repeat", type=int, default=1,
-                        help="runs of each; the fastest counts (default: %(default)s)")
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=1,
+        help="runs of each; the fastest counts (default: %(default)s)",
+    )
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")

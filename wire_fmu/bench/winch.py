@@ -26,8 +26,14 @@ logger = logging.getLogger(__name__)
 
 STEP = 0.01  # s, communication step
 STOP_STEP = 100  # the brake is applied here (t = 1 s)
-OUTPUTS = ("rope.payout", "rope.payout_rate", "drum.speed", "brake.torque", "stored_energy",
-           "energy_balance")
+OUTPUTS = (
+    "rope.payout",
+    "rope.payout_rate",
+    "drum.speed",
+    "brake.torque",
+    "stored_energy",
+    "energy_balance",
+)
 SOLVERS = ("rk4", "ros2", "radau", "energy", "energy1")
 SOLVER_EFFECTS = "drum_inertia,motor_characteristic,rope_layers"
 SOLVER_REALS = {"motor_slope": 50.0}  # a soft characteristic: the drum really spins up
@@ -55,25 +61,49 @@ def lowering_then_stop(i: int) -> dict[str, float]:
 
 def cases() -> list[Case]:
     """One case per effect set (default solver), then one per solver on the rigid drum."""
-    out = [Case(effects or "(none: kinetostatic)", WinchUnit, {"effects": effects},
-                inputs=lowering_then_stop, outputs=OUTPUTS, step=STEP)
-           for effects in effect_sets()]
-    out += [Case(f"{SOLVER_EFFECTS} [{solver}]", WinchUnit,
-                 {"effects": SOLVER_EFFECTS, "solver": solver}, SOLVER_REALS,
-                 inputs=lowering_then_stop, outputs=OUTPUTS, step=STEP)
-            for solver in SOLVERS]
+    out = [
+        Case(
+            effects or "(none: kinetostatic)",
+            WinchUnit,
+            {"effects": effects},
+            inputs=lowering_then_stop,
+            outputs=OUTPUTS,
+            step=STEP,
+        )
+        for effects in effect_sets()
+    ]
+    out += [
+        Case(
+            f"{SOLVER_EFFECTS} [{solver}]",
+            WinchUnit,
+            {"effects": SOLVER_EFFECTS, "solver": solver},
+            SOLVER_REALS,
+            inputs=lowering_then_stop,
+            outputs=OUTPUTS,
+            step=STEP,
+        )
+        for solver in SOLVERS
+    ]
     return out
 
 
-def _payout_after(solver: str, max_step: float, steps: int, rtol: float = 1e-6) -> tuple[float,
-                                                                                      float]:
+def _payout_after(
+    solver: str, max_step: float, steps: int, rtol: float = 1e-6
+) -> tuple[float, float]:
     """Rope paid out after ``steps`` steps of the manoeuvre, and core ms per step."""
     import time
 
     unit = WinchUnit("accuracy")
-    unit.values.update({"effects": SOLVER_EFFECTS, "solver": solver,
-                        "solver_max_step": max_step, "solver_rtol": rtol,
-                        "solver_atol": rtol * 1e-3, **SOLVER_REALS})
+    unit.values.update(
+        {
+            "effects": SOLVER_EFFECTS,
+            "solver": solver,
+            "solver_max_step": max_step,
+            "solver_rtol": rtol,
+            "solver_atol": rtol * 1e-3,
+            **SOLVER_REALS,
+        }
+    )
     unit.configure()
     unit.initialize(0.0)
     start = time.perf_counter()
@@ -99,12 +129,20 @@ def accuracy_table(steps: int) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Command-line entry point."""
     args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases("Winch", cases(), args.steps,
-                     f"Winch (default drawworks drive train), max internal step 1 ms, "
-                     f"communication step {STEP:g} s")
+    text = run_cases(
+        "Winch",
+        cases(),
+        args.steps,
+        f"Winch (default drawworks drive train), max internal step 1 ms, "
+        f"communication step {STEP:g} s",
+    )
     accuracy = accuracy_table(args.steps)
-    logger.info("\nAccuracy of the internal solvers on %s after %d steps:\n%s",
-                SOLVER_EFFECTS, args.steps, accuracy)
+    logger.info(
+        "\nAccuracy of the internal solvers on %s after %d steps:\n%s",
+        SOLVER_EFFECTS,
+        args.steps,
+        accuracy,
+    )
     text += "\n\n" + accuracy
     if args.out:
         args.out.write_text(text + "\n")

@@ -125,8 +125,10 @@ class BlockTrainModel:
         if "rope_slip" in effects and not self.rope.linear_mass > 0.0:
             raise ConfigurationError(
                 "block train",
-                ["effect 'rope_slip' needs rope 'linear_mass' > 0 kg/m (the rope on a groove "
-                 "is the mass that slips)"],
+                [
+                    "effect 'rope_slip' needs rope 'linear_mass' > 0 kg/m (the rope on a groove "
+                    "is the mass that slips)"
+                ],
             )
         if "rope_damping" not in effects:
             from dataclasses import replace
@@ -272,14 +274,23 @@ class BlockTrainModel:
         dof_of_node, dirs = [], []
         for b, name in enumerate(self.body_dof):
             d = self.reeving.bodies[name].direction
-            dirs.append((sum(a * c for a, c in zip(d, frame.u, strict=True)),
-                         sum(a * c for a, c in zip(d, frame.v, strict=True))))
+            dirs.append(
+                (
+                    sum(a * c for a, c in zip(d, frame.u, strict=True)),
+                    sum(a * c for a, c in zip(d, frame.v, strict=True)),
+                )
+            )
             del b
         for k in range(self.n_nodes):
             carriers = self.reeving.carriers(self.reeving.node_body(self.nodes[k]))
             dof_of_node.append(tuple(self.body_dof.index(b) for b in carriers))
-        self._planar = (xy0, np.array(frame.signed_radii), dof_of_node, dirs,
-                        tuple(n.circle.name for n in nodes))
+        self._planar = (
+            xy0,
+            np.array(frame.signed_radii),
+            dof_of_node,
+            dirs,
+            tuple(n.circle.name for n in nodes),
+        )
 
     def _planar_segment_lengths(self, y) -> np.ndarray:
         xy0, radii, dof_of_node, dirs, names = self._planar
@@ -296,8 +307,11 @@ class BlockTrainModel:
 
     def _require_planar(self, geo) -> None:
         fleet = np.asarray(geo.fleet_angles)
-        axes = {tuple(np.round(self.reeving.sheaves[n.name].axis, 9))
-                for n in self.nodes if n.kind == "sheave"}
+        axes = {
+            tuple(np.round(self.reeving.sheaves[n.name].axis, 9))
+            for n in self.nodes
+            if n.kind == "sheave"
+        }
         problems = []
         if fleet.size and np.max(np.abs(fleet)) > 1e-9:
             k = int(np.argmax(np.max(np.abs(fleet), axis=1)))
@@ -307,9 +321,7 @@ class BlockTrainModel:
                 "add the effect 'spatial_geometry' for a non-planar reeving"
             )
         if len({tuple(abs(c) for c in a) for a in axes}) > 1:
-            problems.append(
-                "sheave axes are not all parallel; add the effect 'spatial_geometry'"
-            )
+            problems.append("sheave axes are not all parallel; add the effect 'spatial_geometry'")
         if problems:
             raise ConfigurationError("block train", problems)
 
@@ -341,10 +353,12 @@ class BlockTrainModel:
                 self._bearing_c[i] = (1.0 - s.efficiency) / (1.0 + s.efficiency)
             else:
                 self._capstan[i] = math.expm1(s.groove_friction * self.wrap_angles[k])
-        self._link_span_in = np.array([self.span_of_segment[k - 1] for _, k in self.link_kind],
-                                      dtype=int)
-        self._link_span_out = np.array([self.span_of_segment[k] for _, k in self.link_kind],
-                                       dtype=int)
+        self._link_span_in = np.array(
+            [self.span_of_segment[k - 1] for _, k in self.link_kind], dtype=int
+        )
+        self._link_span_out = np.array(
+            [self.span_of_segment[k] for _, k in self.link_kind], dtype=int
+        )
 
     @property
     def broken(self) -> list[bool]:
@@ -384,10 +398,12 @@ class BlockTrainModel:
                     flow[i, n + LINE_PORTS.index(self.nodes[node].name)] += sign
         self.flow_matrix = flow
         self.driver_ports = [b.port for b in self.drivers]
-        self.block_weight = np.array([
-            b.mass * float(np.array(self.reeving.gravity) @ np.array(b.direction))
-            for b in self.blocks
-        ])
+        self.block_weight = np.array(
+            [
+                b.mass * float(np.array(self.reeving.gravity) @ np.array(b.direction))
+                for b in self.blocks
+            ]
+        )
 
     def set_inputs(self, t: float, inputs: BlockTrainInputs) -> None:
         """Hold ``inputs`` from time ``t`` on (positions advance with their rates)."""
@@ -434,8 +450,14 @@ class BlockTrainModel:
             i = int(np.argmin(small_l))
             raise FloatingPointError(f"rope span {i} has no unstretched rope left")
         intact = ~self.broken_mask
-        rf = rope_forces(self.rope, big_l, small_l, dl_dy @ ydot, self.flow_matrix @ flow_rate,
-                         self.taut_mask & intact)
+        rf = rope_forces(
+            self.rope,
+            big_l,
+            small_l,
+            dl_dy @ ydot,
+            self.flow_matrix @ flow_rate,
+            self.taut_mask & intact,
+        )
         tension = rf.tension * intact
         g_big = rf.force_on_length * intact
         g_small = rf.force_on_unstretched * intact
@@ -482,8 +504,11 @@ class BlockTrainModel:
 
     def _capacities(self, tension: np.ndarray) -> np.ndarray:
         t_in, t_out = tension[self._link_span_in], tension[self._link_span_out]
-        return (self._bearing_m0 + self._bearing_c * (t_in + t_out)
-                + self._capstan * np.minimum(t_in, t_out))
+        return (
+            self._bearing_m0
+            + self._bearing_c * (t_in + t_out)
+            + self._capstan * np.minimum(t_in, t_out)
+        )
 
     def _external_power(self, ev: dict) -> float:
         """Power delivered into the block train through its ports, W."""
@@ -645,10 +670,9 @@ class BlockTrainModel:
         flow = np.concatenate((self.q, self._line_s0))
         self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
         self.taut_mask = np.full(len(self.spans), tension > 0.0)
-        self.contact_mask = np.array([
-            b.floor is not None and b.position < b.floor.position
-            for b in self.blocks
-        ], dtype=bool)
+        self.contact_mask = np.array(
+            [b.floor is not None and b.position < b.floor.position for b in self.blocks], dtype=bool
+        )
         self.friction.set_mode([0] * len(self.friction.links))
         self.state = self._settle_modes(t0, self.state, [])
         return tension
@@ -670,14 +694,18 @@ class BlockTrainModel:
             listed = ", ".join(f"{n!r} needs {t:.6g} N" for n, t in needed)
             raise ConfigurationError(
                 "block train",
-                [f"initial_equilibrium: no single rope tension holds every block ({listed}); "
-                 "set initial_equilibrium false or change the masses"],
+                [
+                    f"initial_equilibrium: no single rope tension holds every block ({listed}); "
+                    "set initial_equilibrium false or change the masses"
+                ],
             )
         if tensions[0] < 0.0:
             raise ConfigurationError(
                 "block train",
-                [f"initial_equilibrium: block {needed[0][0]!r} would need the rope to push "
-                 f"({tensions[0]:.6g} N)"],
+                [
+                    f"initial_equilibrium: block {needed[0][0]!r} would need the rope to push "
+                    f"({tensions[0]:.6g} N)"
+                ],
             )
         return tensions[0]
 

@@ -48,16 +48,35 @@ _KINEMATIC_INPUTS = tuple(
 
 def _variables():
     params = (
-        parameter("reeving", json.dumps(drilling_block_train(4)), "",
-                  "Reeving as JSON text: bodies, sheaves, anchors, rope path", type=str),
-        parameter("effects", "", "",
-                  "Effects to include, comma separated: " + ", ".join(BLOCK_TRAIN_EFFECTS.names),
-                  type=str),
+        parameter(
+            "reeving",
+            json.dumps(drilling_block_train(4)),
+            "",
+            "Reeving as JSON text: bodies, sheaves, anchors, rope path",
+            type=str,
+        ),
+        parameter(
+            "effects",
+            "",
+            "",
+            "Effects to include, comma separated: " + ", ".join(BLOCK_TRAIN_EFFECTS.names),
+            type=str,
+        ),
         *solver_parameters("ros2", 1e-3),
-        parameter("initial_equilibrium", True, "",
-                  "Start with every block hanging at rest where the reeving puts it", type=bool),
-        parameter("pretension", 1.0e3, "N",
-                  "Initial rope tension when not set by block equilibrium", min=0.0),
+        parameter(
+            "initial_equilibrium",
+            True,
+            "",
+            "Start with every block hanging at rest where the reeving puts it",
+            type=bool,
+        ),
+        parameter(
+            "pretension",
+            1.0e3,
+            "N",
+            "Initial rope tension when not set by block equilibrium",
+            min=0.0,
+        ),
     )
     inputs = []
     for port in LINE_PORTS:
@@ -70,34 +89,52 @@ def _variables():
             input_(f"{port}.position", 0.0, "m", f"Displacement of driven body {port}"),
             input_(f"{port}.velocity", 0.0, "m/s", f"Velocity of driven body {port}"),
         ]
-    inputs.append(input_("break_segment", 0, "", "Break this rope segment (1-based) now; 0: none",
-                         type=int))
+    inputs.append(
+        input_("break_segment", 0, "", "Break this rope segment (1-based) now; 0: none", type=int)
+    )
     deps = _KINEMATIC_INPUTS
-    outputs = [output(f"{p}.tension", "N", f"Rope tension at line end {p}", depends_on=deps)
-               for p in LINE_PORTS]
-    outputs += [output(f"{p}.force", "N", f"Rope force on driven body {p} along its direction",
-                       depends_on=deps) for p in MOVER_PORTS]
+    outputs = [
+        output(f"{p}.tension", "N", f"Rope tension at line end {p}", depends_on=deps)
+        for p in LINE_PORTS
+    ]
+    outputs += [
+        output(
+            f"{p}.force", "N", f"Rope force on driven body {p} along its direction", depends_on=deps
+        )
+        for p in MOVER_PORTS
+    ]
     for p in BLOCK_PORTS:
         outputs += [
             output(f"{p}.position", "m", f"Position of block {p} along its direction"),
             output(f"{p}.velocity", "m/s", f"Velocity of block {p} along its direction"),
         ]
     outputs += [
-        output("path_start.tension", "N", "Rope tension at the first node of the path",
-               depends_on=deps),
-        output("path_end.tension", "N", "Rope tension at the last node of the path",
-               depends_on=deps),
+        output(
+            "path_start.tension", "N", "Rope tension at the first node of the path", depends_on=deps
+        ),
+        output(
+            "path_end.tension", "N", "Rope tension at the last node of the path", depends_on=deps
+        ),
         output("tension_max", "N", "Largest rope tension in any span", depends_on=deps),
         output("slack_spans", "", "Number of slack rope spans", type=int, depends_on=deps),
         output("broken", "", "Whether any rope span has broken", type=bool),
-        output("stored_energy", "J", "Kinetic, strain, gravitational and contact energy",
-               depends_on=deps),
+        output(
+            "stored_energy",
+            "J",
+            "Kinetic, strain, gravitational and contact energy",
+            depends_on=deps,
+        ),
         output("dissipated_energy", "J", "Energy dissipated since the start"),
         output("external_work", "J", "Work done on the block train through its ports"),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work", depends_on=deps),
-        output("mode_changes", "", "Number of mode events so far (stick/slip, slack, break)",
-               type=int),
+        output(
+            "energy_balance",
+            "J",
+            "Ledger residual: stored change + dissipated - external work",
+            depends_on=deps,
+        ),
+        output(
+            "mode_changes", "", "Number of mode events so far (stick/slip, slack, break)", type=int
+        ),
     ]
     return params + tuple(inputs) + tuple(outputs)
 
@@ -150,12 +187,20 @@ class BlockTrainUnit(Unit):
         model = self._require_model()
         segment = self.values["break_segment"]
         if not 0 <= segment <= model.n_segments:
-            raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", [
-                f"break_segment {segment} does not exist: 0 for none, 1..{model.n_segments} "
-                "for a segment of this reeving"])
+            raise ConfigurationError(
+                f"{self.NAME} {self.instance_name!r}",
+                [
+                    f"break_segment {segment} does not exist: 0 for none, 1..{model.n_segments} "
+                    "for a segment of this reeving"
+                ],
+            )
         try:
-            model.initialize(start_time, self._inputs(), equilibrium=bool(
-                self.values["initial_equilibrium"]), pretension=float(self.values["pretension"]))
+            model.initialize(
+                start_time,
+                self._inputs(),
+                equilibrium=bool(self.values["initial_equilibrium"]),
+                pretension=float(self.values["pretension"]),
+            )
         except ConfigurationError as err:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
         self.time = start_time
@@ -167,15 +212,21 @@ class BlockTrainUnit(Unit):
         model = self._require_model()
         if model.settings.method != "rk4":
             return []
-        model.initialize(0.0, self._inputs(), equilibrium=bool(
-            self.values["initial_equilibrium"]), pretension=float(self.values["pretension"]))
+        model.initialize(
+            0.0,
+            self._inputs(),
+            equilibrium=bool(self.values["initial_equilibrium"]),
+            pretension=float(self.values["pretension"]),
+        )
         rate = fastest_mode(model, 0.0, model.state)
         if rate * model.settings.max_step < RK4_STABILITY:
             return []
-        return [f"parameter 'solver_max_step' = {model.settings.max_step:g} s is unstable with "
-                f"solver 'rk4' for the stiffest mode (|lambda| = {rate:.4g} 1/s): set "
-                f"solver_max_step below {RK4_STABILITY / rate:.3g} s, or use solver 'ros2' "
-                "(L-stable)"]
+        return [
+            f"parameter 'solver_max_step' = {model.settings.max_step:g} s is unstable with "
+            f"solver 'rk4' for the stiffest mode (|lambda| = {rate:.4g} 1/s): set "
+            f"solver_max_step below {RK4_STABILITY / rate:.3g} s, or use solver 'ros2' "
+            "(L-stable)"
+        ]
 
     def advance(self, time: float, step: float) -> StepResult:
         """Advance by ``step`` seconds with the inputs held."""
@@ -184,14 +235,20 @@ class BlockTrainUnit(Unit):
         inputs = self._inputs()
         segment = int(self.values["break_segment"])
         if not 0 <= segment <= model.n_segments:
-            return StepResult(False, f"{self.NAME} {self.instance_name!r}: break_segment "
-                              f"{segment} does not exist (0 for none, 1..{model.n_segments})")
+            return StepResult(
+                False,
+                f"{self.NAME} {self.instance_name!r}: break_segment "
+                f"{segment} does not exist (0 for none, 1..{model.n_segments})",
+            )
         try:
             model.advance(time, step, inputs, segment - 1 if segment else None)
         except (IntegrationError, FloatingPointError, ValueError) as err:
             self.set_state(saved)
-            return StepResult(False, f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s: "
-                              f"step of {step:.3g} s refused: {err}")
+            return StepResult(
+                False,
+                f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s: "
+                f"step of {step:.3g} s refused: {err}",
+            )
         self.time = time + step
         self._update_outputs()
         return StepResult(True, events=tuple(model.last_events))
@@ -287,8 +344,9 @@ class BlockTrainUnit(Unit):
         out["stored_energy"] = float(stored)
         out["dissipated_energy"] = float(m.state[2 * n])
         out["external_work"] = float(m.state[2 * n + 1])
-        out["energy_balance"] = float(stored - self.initial_energy + out["dissipated_energy"]
-                                 - out["external_work"])
+        out["energy_balance"] = float(
+            stored - self.initial_energy + out["dissipated_energy"] - out["external_work"]
+        )
         out["mode_changes"] = int(m.mode_changes)
         if not all(math.isfinite(out[k]) for k in ("stored_energy", "tension_max")):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")

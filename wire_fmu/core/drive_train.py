@@ -176,8 +176,12 @@ class DriveChain:
     def rigid(self) -> DriveChain:
         """All masses locked together: one mass, every inertia and ground damper summed."""
         return DriveChain(
-            (math.fsum(self.inertias),), (math.fsum(self.dampings),), (), (),
-            (" + ".join(self.names),), self.motor_ratio,
+            (math.fsum(self.inertias),),
+            (math.fsum(self.dampings),),
+            (),
+            (),
+            (" + ".join(self.names),),
+            self.motor_ratio,
         )
 
     def reduced(self, masses: int) -> DriveChain:
@@ -309,8 +313,14 @@ def default_drive_train() -> dict[str, Any]:
     }
 
 
-def _number(item: Mapping[str, Any], key: str, default: float | None, where: str,
-            problems: list[str], positive: bool) -> float:
+def _number(
+    item: Mapping[str, Any],
+    key: str,
+    default: float | None,
+    where: str,
+    problems: list[str],
+    positive: bool,
+) -> float:
     value = item.get(key, default)
     try:
         number = float(value)

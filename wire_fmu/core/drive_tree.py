@@ -108,10 +108,18 @@ class DriveTree:
     @classmethod
     def from_chain(cls, chain: DriveChain, motors: tuple[int, ...] = (0,)) -> DriveTree:
         """The chain as a tree (motor at mass 0, load at the last mass)."""
-        shafts = tuple(Shaft(k, k + 1, c, b, f"shaft {k + 1}-{k + 2}") for k, (c, b) in
-                       enumerate(zip(chain.stiffnesses, chain.link_dampings, strict=True)))
-        return cls(tuple(chain.inertias), tuple(chain.dampings), shafts, tuple(chain.names),
-                   motors, chain.n - 1)
+        shafts = tuple(
+            Shaft(k, k + 1, c, b, f"shaft {k + 1}-{k + 2}")
+            for k, (c, b) in enumerate(zip(chain.stiffnesses, chain.link_dampings, strict=True))
+        )
+        return cls(
+            tuple(chain.inertias),
+            tuple(chain.dampings),
+            shafts,
+            tuple(chain.names),
+            motors,
+            chain.n - 1,
+        )
 
     def is_chain(self) -> bool:
         """Whether shaft ``k`` joins masses ``k`` and ``k + 1`` for every ``k``."""
@@ -120,11 +128,17 @@ class DriveTree:
     def to_chain(self) -> DriveChain:
         """The equivalent :class:`DriveChain` (raises ValueError unless :meth:`is_chain`)."""
         if not self.is_chain():
-            raise ValueError("only a chain (shaft k joins masses k and k+1) converts to a "
-                             "DriveChain; this drive is branched")
-        return DriveChain(self.inertias, self.dampings,
-                          tuple(s.stiffness for s in self.shafts),
-                          tuple(s.damping for s in self.shafts), self.names)
+            raise ValueError(
+                "only a chain (shaft k joins masses k and k+1) converts to a "
+                "DriveChain; this drive is branched"
+            )
+        return DriveChain(
+            self.inertias,
+            self.dampings,
+            tuple(s.stiffness for s in self.shafts),
+            tuple(s.damping for s in self.shafts),
+            self.names,
+        )
 
     # ------------------------------------------------------------ matrices
     def mass_matrix(self) -> np.ndarray:
@@ -137,8 +151,9 @@ class DriveTree:
 
     def damping_matrix(self) -> np.ndarray:
         """Shaft dampings' Laplacian plus the ground dampers on the diagonal, N m s/rad."""
-        return self._laplacian([s.damping for s in self.shafts],
-                               np.asarray(self.dampings, dtype=float))
+        return self._laplacian(
+            [s.damping for s in self.shafts], np.asarray(self.dampings, dtype=float)
+        )
 
     def _laplacian(self, values: Sequence[float], ground: np.ndarray) -> np.ndarray:
         out = np.diag(ground.astype(float))
@@ -303,12 +318,27 @@ def two_motor_drive() -> dict[str, Any]:
             {"name": "machine", "inertia": 4.0, "damping": 1.0},
         ],
         "shafts": [
-            {"name": "coupling 1", "from": "motor 1", "to": "gear", "stiffness": 1.2e4,
-             "damping": 2.0},
-            {"name": "coupling 2", "from": "motor 2", "to": "gear", "stiffness": 1.0e4,
-             "damping": 2.0},
-            {"name": "output shaft", "from": "gear", "to": "machine", "stiffness": 6.0e3,
-             "damping": 3.0},
+            {
+                "name": "coupling 1",
+                "from": "motor 1",
+                "to": "gear",
+                "stiffness": 1.2e4,
+                "damping": 2.0,
+            },
+            {
+                "name": "coupling 2",
+                "from": "motor 2",
+                "to": "gear",
+                "stiffness": 1.0e4,
+                "damping": 2.0,
+            },
+            {
+                "name": "output shaft",
+                "from": "gear",
+                "to": "machine",
+                "stiffness": 6.0e3,
+                "damping": 3.0,
+            },
         ],
         "motors": ["motor 1", "motor 2"],
         "load": "machine",
@@ -316,8 +346,9 @@ def two_motor_drive() -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------- parsing
-def _number(item: Mapping[str, Any], key: str, default: float | None, where: str,
-            problems: list[str]) -> float:
+def _number(
+    item: Mapping[str, Any], key: str, default: float | None, where: str, problems: list[str]
+) -> float:
     value = item.get(key, default)
     try:
         return float(value)
@@ -368,13 +399,20 @@ def _shafts(data: Any, names: list[str], problems: list[str]) -> list[Shaft]:
             continue
         unknown = sorted(set(item) - {"name", "from", "to", "stiffness", "damping"})
         if unknown:
-            problems.append(f"{where}: unknown keys {unknown}; known: name, from, to, "
-                            "stiffness, damping")
+            problems.append(
+                f"{where}: unknown keys {unknown}; known: name, from, to, stiffness, damping"
+            )
         a = _index(item.get("from", i), names, f"{where} 'from'", problems) if names else 0
         b = _index(item.get("to", i + 1), names, f"{where} 'to'", problems) if names else 0
-        out.append(Shaft(a, b, _number(item, "stiffness", None, where, problems),
-                         _number(item, "damping", 0.0, where, problems),
-                         str(item.get("name", f"shaft {i + 1}"))))
+        out.append(
+            Shaft(
+                a,
+                b,
+                _number(item, "stiffness", None, where, problems),
+                _number(item, "damping", 0.0, where, problems),
+                str(item.get("name", f"shaft {i + 1}")),
+            )
+        )
     return out
 
 
@@ -408,8 +446,9 @@ def parse_drive(data: Any) -> tuple[DriveTree | None, list[str]]:
     if not isinstance(motors_data, list) or not 1 <= len(motors_data) <= 2:
         problems.append(f"drive: 'motors' must list one or two masses, got {motors_data!r}")
         motors_data = [0]
-    motors = tuple(_index(m, names, "drive 'motors'", problems) for m in motors_data) \
-        if names else (0,)
+    motors = (
+        tuple(_index(m, names, "drive 'motors'", problems) for m in motors_data) if names else (0,)
+    )
     load = _index(data.get("load", -1), names, "drive 'load'", problems) if names else 0
     if problems:
         return None, problems

@@ -66,26 +66,54 @@ MODES_REPORTED = 3
 RK4_STABILITY = 2.5
 """Largest ``|lambda| h`` accepted for ``rk4`` (its limit on the imaginary axis is 2.83)."""
 
-DRIVE_EFFECTS = EffectCatalogue("MultiMassDrive", (
-    Effect("motor_characteristic", "motor torque input",
-           "M = a - b omega with the input as a and b = motor_slope"),
-))
+DRIVE_EFFECTS = EffectCatalogue(
+    "MultiMassDrive",
+    (
+        Effect(
+            "motor_characteristic",
+            "motor torque input",
+            "M = a - b omega with the input as a and b = motor_slope",
+        ),
+    ),
+)
 
 _MOTOR_INPUTS = ("motor.torque", "motor2.torque")
 
 
 def _parameters():
     return (
-        parameter("effects", "", "", "Effects to include, comma separated: "
-                  + ", ".join(DRIVE_EFFECTS.names), type=str),
-        parameter("drive", json.dumps(default_multimass_drive()), "", "Drive as JSON: masses "
-                  "(name, inertia, damping), shafts (name, from, to, stiffness, damping), "
-                  "motors, load; all reduced to the motor shaft (a four-mass estimated drive "
-                  "by default)", type=str),
-        parameter("masses_kept", 0, "", "Masses kept: 0 the full drive, 2.. a chain reduced "
-                  "by delta-star elimination (paper 002)", type=int),
-        parameter("motor_slope", 0.0, "N.m.s/rad", "Slope b of each motor's characteristic "
-                  "a - b omega (motor_characteristic)", min=0.0),
+        parameter(
+            "effects",
+            "",
+            "",
+            "Effects to include, comma separated: " + ", ".join(DRIVE_EFFECTS.names),
+            type=str,
+        ),
+        parameter(
+            "drive",
+            json.dumps(default_multimass_drive()),
+            "",
+            "Drive as JSON: masses "
+            "(name, inertia, damping), shafts (name, from, to, stiffness, damping), "
+            "motors, load; all reduced to the motor shaft (a four-mass estimated drive "
+            "by default)",
+            type=str,
+        ),
+        parameter(
+            "masses_kept",
+            0,
+            "",
+            "Masses kept: 0 the full drive, 2.. a chain reduced "
+            "by delta-star elimination (paper 002)",
+            type=int,
+        ),
+        parameter(
+            "motor_slope",
+            0.0,
+            "N.m.s/rad",
+            "Slope b of each motor's characteristic a - b omega (motor_characteristic)",
+            min=0.0,
+        ),
         parameter("initial_speed", 0.0, "rad/s", "Speed of every mass at the start"),
         *solver_parameters("rk4", 5e-4, rtol=1e-8, atol=1e-10),
     )
@@ -93,11 +121,19 @@ def _parameters():
 
 def _inputs():
     return (
-        input_("motor.torque", 0.0, "N.m", "Torque of the (first) motor, or a of a - b omega "
-               "with motor_characteristic"),
+        input_(
+            "motor.torque",
+            0.0,
+            "N.m",
+            "Torque of the (first) motor, or a of a - b omega with motor_characteristic",
+        ),
         input_("motor2.torque", 0.0, "N.m", "Torque of the second motor (two-motor drives)"),
-        input_("load.torque", 0.0, "N.m", "Load torque M_c on the load mass, positive "
-               "opposing positive rotation"),
+        input_(
+            "load.torque",
+            0.0,
+            "N.m",
+            "Load torque M_c on the load mass, positive opposing positive rotation",
+        ),
     )
 
 
@@ -105,31 +141,49 @@ def _outputs():
     outs = [
         output("motor.speed", "rad/s", "Speed of the (first) motor's mass"),
         output("motor.angle", "rad", "Angle of the (first) motor's mass"),
-        output("motor.drive_torque", "N.m", "Torque the (first) motor develops",
-               depends_on=("motor.torque",)),
+        output(
+            "motor.drive_torque",
+            "N.m",
+            "Torque the (first) motor develops",
+            depends_on=("motor.torque",),
+        ),
         output("motor2.speed", "rad/s", "Speed of the second motor's mass (0 if none)"),
-        output("motor2.drive_torque", "N.m", "Torque the second motor develops (0 if none)",
-               depends_on=("motor2.torque",)),
+        output(
+            "motor2.drive_torque",
+            "N.m",
+            "Torque the second motor develops (0 if none)",
+            depends_on=("motor2.torque",),
+        ),
         output("load.speed", "rad/s", "Speed of the load mass"),
         output("load.angle", "rad", "Angle of the load mass"),
     ]
-    outs += [output(f"mass_{k}.speed", "rad/s", f"Speed of mass {k} (0 if the drive has fewer)")
-             for k in range(1, MAX_MASSES + 1)]
-    outs += [output(f"shaft_{k}.torque", "N.m", f"Torque in shaft {k} (0 if the drive has "
-                    "fewer)") for k in range(1, MAX_MASSES)]
+    outs += [
+        output(f"mass_{k}.speed", "rad/s", f"Speed of mass {k} (0 if the drive has fewer)")
+        for k in range(1, MAX_MASSES + 1)
+    ]
+    outs += [
+        output(f"shaft_{k}.torque", "N.m", f"Torque in shaft {k} (0 if the drive has fewer)")
+        for k in range(1, MAX_MASSES)
+    ]
     for k in range(1, MODES_REPORTED + 1):
-        outs += [output(f"mode_{k}.frequency", "Hz", f"Damped natural frequency of oscillatory "
-                        f"mode {k} of the simulated drive, motor characteristic included "
-                        "(0 if none)"),
-                 output(f"mode_{k}.damping_ratio", "1", f"Damping ratio of mode {k}")]
+        outs += [
+            output(
+                f"mode_{k}.frequency",
+                "Hz",
+                f"Damped natural frequency of oscillatory "
+                f"mode {k} of the simulated drive, motor characteristic included "
+                "(0 if none)",
+            ),
+            output(f"mode_{k}.damping_ratio", "1", f"Damping ratio of mode {k}"),
+        ]
     outs += [
         output("stored_energy", "J", "Kinetic energy of the masses plus shaft strain energy"),
         output("dissipated_energy", "J", "Energy dissipated by ground and shaft dampers"),
         output("external_work", "J", "Work done on the drive by the motors and the load"),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work"),
-        output("mode_changes", "", "Mode events so far (always 0: the drive is smooth)",
-               type=int),
+        output(
+            "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
+        ),
+        output("mode_changes", "", "Mode events so far (always 0: the drive is smooth)", type=int),
     ]
     return tuple(outs)
 
@@ -177,19 +231,23 @@ class DriveModel:
 
     def shaft_torques(self, x: np.ndarray) -> np.ndarray:
         """Torque in each shaft (drives its second mass forward), N m."""
-        theta, omega = x[:self.n], x[self.n:2 * self.n]
-        return np.array([s.stiffness * (theta[s.a] - theta[s.b])
-                         + s.damping * (omega[s.a] - omega[s.b]) for s in self.tree.shafts])
+        theta, omega = x[: self.n], x[self.n : 2 * self.n]
+        return np.array(
+            [
+                s.stiffness * (theta[s.a] - theta[s.b]) + s.damping * (omega[s.a] - omega[s.b])
+                for s in self.tree.shafts
+            ]
+        )
 
     # -- HybridSystem ---------------------------------------------------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """``[theta', omega', dissipated', external work']``."""
         n = self.n
-        theta, omega = x[:n], x[n:2 * n]
+        theta, omega = x[:n], x[n : 2 * n]
         external = self._torques(omega)
         out = np.empty_like(x)
         out[:n] = omega
-        out[n:2 * n] = (external - self.stiffness @ theta - self.damping @ omega) / self.inertia
+        out[n : 2 * n] = (external - self.stiffness @ theta - self.damping @ omega) / self.inertia
         out[2 * n] = float(omega @ self.damping @ omega)
         out[2 * n + 1] = float(external @ omega)
         return out
@@ -231,7 +289,7 @@ class DriveModel:
     def stored_energy(self, x: np.ndarray | None = None) -> float:
         """``omega^T J omega / 2 + theta^T K theta / 2``, J."""
         x = self.state if x is None else x
-        theta, omega = x[:self.n], x[self.n:2 * self.n]
+        theta, omega = x[: self.n], x[self.n : 2 * self.n]
         return 0.5 * float(self.inertia @ omega**2) + 0.5 * float(theta @ self.stiffness @ theta)
 
     def state_matrix(self) -> np.ndarray:
@@ -303,8 +361,9 @@ class DriveUnit(Unit):
         """Advance by ``step`` seconds with the torques held."""
         model = self._require_model()
         who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = [n for n in (*_MOTOR_INPUTS, "load.torque") if not math.isfinite(
-            float(self.values[n]))]
+        bad = [
+            n for n in (*_MOTOR_INPUTS, "load.torque") if not math.isfinite(float(self.values[n]))
+        ]
         if bad:
             return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
         saved = self.get_state()
@@ -365,7 +424,7 @@ class DriveUnit(Unit):
 
     def _bind(self, model: DriveModel) -> None:
         v = self.values
-        model.commands = np.array([float(v[name]) for name in _MOTOR_INPUTS[:len(model.motors)]])
+        model.commands = np.array([float(v[name]) for name in _MOTOR_INPUTS[: len(model.motors)]])
         model.load_torque = float(v["load.torque"])
 
     def _tree(self, problems: list[str]) -> DriveTree | None:
@@ -385,12 +444,16 @@ class DriveUnit(Unit):
             return tree
         if not tree.is_chain() or keep < 2:
             what = "a branched drive" if not tree.is_chain() else f"{keep} masses"
-            problems.append(f"parameter 'masses_kept': delta-star reduction keeps 2..{tree.n} "
-                            f"masses of a chain (motor first, load last); got {what}")
+            problems.append(
+                f"parameter 'masses_kept': delta-star reduction keeps 2..{tree.n} "
+                f"masses of a chain (motor first, load last); got {what}"
+            )
             return tree
         if tree.motors != (0,) or tree.load_index != tree.n - 1:
-            problems.append("parameter 'masses_kept': a reduced chain needs its motor on the "
-                            "first mass and its load on the last")
+            problems.append(
+                "parameter 'masses_kept': a reduced chain needs its motor on the "
+                "first mass and its load on the last"
+            )
             return tree
         return DriveTree.from_chain(tree.to_chain().reduced(keep))
 
@@ -398,7 +461,7 @@ class DriveUnit(Unit):
         m = self._require_model()
         x = m.state
         n = m.n
-        omega = x[n:2 * n]
+        omega = x[n : 2 * n]
         motor_torques = m.motor_torques(omega)
         out = self.values
         first = m.motors[0]
@@ -423,8 +486,7 @@ class DriveUnit(Unit):
         out["stored_energy"] = stored
         out["dissipated_energy"] = float(x[2 * n])
         out["external_work"] = float(x[2 * n + 1])
-        out["energy_balance"] = stored - self.initial_energy + float(x[2 * n]) - float(
-            x[2 * n + 1])
+        out["energy_balance"] = stored - self.initial_energy + float(x[2 * n]) - float(x[2 * n + 1])
         out["mode_changes"] = 0
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"{self.instance_name}: non-finite state")
@@ -435,10 +497,12 @@ def _stability_problems(model: DriveModel, max_step: float) -> list[str]:
     rate = model.fastest_rate()
     if rate * max_step < RK4_STABILITY:
         return []
-    return [f"parameter 'solver_max_step': rk4 with steps of {max_step:.3g} s is unstable for "
-            f"this drive (fastest eigenvalue {rate:.4g} 1/s; rk4 needs |lambda| h < "
-            f"{RK4_STABILITY}): set solver_max_step below {RK4_STABILITY / rate:.3g} s, reduce "
-            "the drive (masses_kept) or choose the L-stable 'ros2'"]
+    return [
+        f"parameter 'solver_max_step': rk4 with steps of {max_step:.3g} s is unstable for "
+        f"this drive (fastest eigenvalue {rate:.4g} 1/s; rk4 needs |lambda| h < "
+        f"{RK4_STABILITY}): set solver_max_step below {RK4_STABILITY / rate:.3g} s, reduce "
+        "the drive (masses_kept) or choose the L-stable 'ros2'"
+    ]
 
 
 class _DriveOde(ModelOdeView):

@@ -139,8 +139,9 @@ class Drum:
         slopes = [-self.rope_linear_mass * r**3 for r in radii]
         theta0 = self.initial_wound_angle
         p, q = [0.0] * n, [0.0] * n
-        q[k0] = self.rope_linear_mass * (self._below(k0, 3) + (theta0 - k0 * self.layer_angle)
-                                         * radii[k0] ** 3)
+        q[k0] = self.rope_linear_mass * (
+            self._below(k0, 3) + (theta0 - k0 * self.layer_angle) * radii[k0] ** 3
+        )
         for k in range(k0 + 1, n):  # boundary between k - 1 and k at phi_low(k - 1)
             edge = self.phi_bounds(k - 1)[0]
             p[k] = p[k - 1] + (radii[k - 1] - radii[k]) * edge
@@ -181,8 +182,9 @@ class Drum:
         if not (self.rope_diameter > 0 and math.isfinite(self.rope_diameter)):
             out.append(f"parameter 'rope_diameter' must be > 0 m, got {self.rope_diameter}")
         if not (self.rope_linear_mass >= 0 and math.isfinite(self.rope_linear_mass)):
-            out.append(f"parameter 'rope_linear_mass' must be >= 0 kg/m, "
-                       f"got {self.rope_linear_mass}")
+            out.append(
+                f"parameter 'rope_linear_mass' must be >= 0 kg/m, got {self.rope_linear_mass}"
+            )
         if self.wraps_per_layer < 1:
             out.append(f"parameter 'drum_wraps_per_layer' must be >= 1, got {self.wraps_per_layer}")
         if self.max_layers < 1:

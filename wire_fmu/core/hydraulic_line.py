@@ -69,13 +69,18 @@ class HydraulicLine:
     def problems(self) -> list[str]:
         """Every problem with the parameters, as sentences (parameter names as in the unit)."""
         out = []
-        for name, value in (("line_length", self.length), ("line_diameter", self.diameter),
-                            ("oil_density", self.density)):
+        for name, value in (
+            ("line_length", self.length),
+            ("line_diameter", self.diameter),
+            ("oil_density", self.density),
+        ):
             if not (value > 0.0 and math.isfinite(value)):
                 out.append(f"parameter {name!r} must be > 0, got {value}")
-        for name, value in (("oil_viscosity", self.viscosity),
-                            ("line_friction_factor", self.friction_factor),
-                            ("line_loss_coefficient", self.loss_coefficient)):
+        for name, value in (
+            ("oil_viscosity", self.viscosity),
+            ("line_friction_factor", self.friction_factor),
+            ("line_loss_coefficient", self.loss_coefficient),
+        ):
             if not (value >= 0.0 and math.isfinite(value)):
                 out.append(f"parameter {name!r} must be >= 0, got {value}")
         return out

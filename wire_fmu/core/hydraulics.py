@@ -158,16 +158,26 @@ logger = logging.getLogger(__name__)
 HYDRAULICS_EFFECTS = EffectCatalogue(
     "hydraulics",
     (
-        Effect("polytropic_gas", "isothermal gas (n = 1)",
-               "polytropic gas p V^n = const (n = polytropic_exponent, 1.4 adiabatic)"),
+        Effect(
+            "polytropic_gas",
+            "isothermal gas (n = 1)",
+            "polytropic gas p V^n = const (n = polytropic_exponent, 1.4 adiabatic)",
+        ),
         Effect("line_losses", "lossless line", "laminar + turbulent line resistance"),
         Effect("line_inertance", "massless line oil", "oil inertia in the line (L dq/dt)"),
-        Effect("oil_compressibility", "incompressible oil",
-               "compressible oil column (bulk modulus)"),
-        Effect("seal_friction", "frictionless seals",
-               "Coulomb + viscous (+ Stribeck) seal friction with stick"),
-        Effect("end_stops", "no end stops (leaving the stroke refuses the step)",
-               "hydraulic cushions and stiff end stops"),
+        Effect(
+            "oil_compressibility", "incompressible oil", "compressible oil column (bulk modulus)"
+        ),
+        Effect(
+            "seal_friction",
+            "frictionless seals",
+            "Coulomb + viscous (+ Stribeck) seal friction with stick",
+        ),
+        Effect(
+            "end_stops",
+            "no end stops (leaving the stroke refuses the step)",
+            "hydraulic cushions and stiff end stops",
+        ),
     ),
 )
 
@@ -258,14 +268,19 @@ class CylinderSpec:
         _positive("chamber_dead_volume", self.chamber_dead_volume, out, "m3", zero_ok=True)
         _positive("ambient_pressure", self.ambient_pressure, out, "Pa", zero_ok=True)
         if self.rod_diameter >= self.bore_diameter > 0.0:
-            out.append(f"parameter 'rod_diameter' ({self.rod_diameter} m) must be smaller than "
-                       f"'bore_diameter' ({self.bore_diameter} m)")
+            out.append(
+                f"parameter 'rod_diameter' ({self.rod_diameter} m) must be smaller than "
+                f"'bore_diameter' ({self.bore_diameter} m)"
+            )
         if self.pressurised_side not in ("bore", "annulus"):
-            out.append("parameter 'pressurised_side' must be 'bore' (push cylinder) or "
-                       f"'annulus' (pull cylinder), got {self.pressurised_side!r}")
+            out.append(
+                "parameter 'pressurised_side' must be 'bore' (push cylinder) or "
+                f"'annulus' (pull cylinder), got {self.pressurised_side!r}"
+            )
         if not math.isfinite(self.gravity_along_rod):
-            out.append("parameter 'gravity_along_rod' must be finite, got "
-                       f"{self.gravity_along_rod}")
+            out.append(
+                f"parameter 'gravity_along_rod' must be finite, got {self.gravity_along_rod}"
+            )
         return out
 
     @property
@@ -323,18 +338,22 @@ class AccumulatorSpec:
         out: list[str] = []
         _positive("accumulator_volume", self.accumulator_volume, out, "m3")
         _positive("gas_bank_volume", self.gas_bank_volume, out, "m3", zero_ok=True)
-        _positive("accumulator_dead_volume", self.accumulator_dead_volume, out, "m3",
-                  zero_ok=True)
+        _positive("accumulator_dead_volume", self.accumulator_dead_volume, out, "m3", zero_ok=True)
         _positive("precharge_pressure", self.precharge_pressure, out, "Pa")
         if self.accumulator_dead_volume >= self.accumulator_volume > 0.0:
-            out.append("parameter 'accumulator_dead_volume' must be smaller than "
-                       "'accumulator_volume'")
+            out.append(
+                "parameter 'accumulator_dead_volume' must be smaller than 'accumulator_volume'"
+            )
         if not self.dead_volume > 0.0:
-            out.append("the gas needs a dead volume > 0 m3: set 'gas_bank_volume' or "
-                       "'accumulator_dead_volume' > 0 (gas cannot be compressed to nothing)")
+            out.append(
+                "the gas needs a dead volume > 0 m3: set 'gas_bank_volume' or "
+                "'accumulator_dead_volume' > 0 (gas cannot be compressed to nothing)"
+            )
         if not (1.0 <= self.polytropic_exponent <= 2.0):
-            out.append("parameter 'polytropic_exponent' must lie in [1, 2] (1 isothermal, "
-                       f"1.4 adiabatic), got {self.polytropic_exponent}")
+            out.append(
+                "parameter 'polytropic_exponent' must lie in [1, 2] (1 isothermal, "
+                f"1.4 adiabatic), got {self.polytropic_exponent}"
+            )
         return out
 
     @property
@@ -406,8 +425,10 @@ class SealSpec:
         _positive("seal_viscous_friction", self.viscous, out, "N.s/m", zero_ok=True)
         _positive("seal_stribeck_velocity", self.stribeck_velocity, out, "m/s", zero_ok=True)
         if self.coulomb > self.static:
-            out.append(f"parameter 'seal_coulomb_friction' ({self.coulomb} N) must not exceed "
-                       f"'seal_static_friction' ({self.static} N)")
+            out.append(
+                f"parameter 'seal_coulomb_friction' ({self.coulomb} N) must not exceed "
+                f"'seal_static_friction' ({self.static} N)"
+            )
         return out
 
     def sliding(self, velocity: float) -> float:
@@ -448,8 +469,10 @@ class EndStopSpec:
         if not (0.0 < self.restitution <= 1.0):
             out.append(f"parameter 'stop_restitution' must lie in (0, 1], got {self.restitution}")
         if 2.0 * self.cushion_length >= stroke > 0.0:
-            out.append(f"parameter 'cushion_length' ({self.cushion_length} m) must be less than "
-                       f"half the stroke ({stroke} m)")
+            out.append(
+                f"parameter 'cushion_length' ({self.cushion_length} m) must be less than "
+                f"half the stroke ({stroke} m)"
+            )
         return out
 
     def damping(self, mass: float) -> float:
@@ -471,9 +494,14 @@ class HydraulicsSpec:
 
     def problems(self) -> list[str]:
         """Every problem with every part, as sentences."""
-        return (self.cylinder.problems() + self.accumulator.problems() + self.line.problems()
-                + self.oil.problems() + self.seal.problems()
-                + self.stops.problems(self.cylinder.stroke))
+        return (
+            self.cylinder.problems()
+            + self.accumulator.problems()
+            + self.line.problems()
+            + self.oil.problems()
+            + self.seal.problems()
+            + self.stops.problems(self.cylinder.stroke)
+        )
 
 
 # ------------------------------------------------------- restitution helpers
@@ -503,8 +531,13 @@ def damping_ratio_for_restitution(restitution: float) -> float:
     upper = 1.0
     while restitution_of_damping_ratio(upper) > restitution:
         upper *= 4.0
-    return brentq(lambda z: restitution_of_damping_ratio(z) - restitution, 0.0, upper,
-                  xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    return brentq(
+        lambda z: restitution_of_damping_ratio(z) - restitution,
+        0.0,
+        upper,
+        xtol=1e-15,
+        rtol=4 * np.finfo(float).eps,
+    )
 
 
 # ------------------------------------------------------------------ the model
@@ -551,8 +584,9 @@ class HydraulicsModel:
         Internal solver used by :meth:`advance`.
     """
 
-    def __init__(self, spec: HydraulicsSpec, effects: frozenset[str],
-                 solver: SolverSettings) -> None:
+    def __init__(
+        self, spec: HydraulicsSpec, effects: frozenset[str], solver: SolverSettings
+    ) -> None:
         self.spec = spec
         self.effects = effects
         self.settings = solver
@@ -572,15 +606,17 @@ class HydraulicsModel:
         self._build_friction()
         self.stop_damping = spec.stops.damping(self.mass) if self.stops_on else 0.0
         self._guard_kinds = self._build_guards()
-        self._directions = np.array([0.0 if kind == "pad" else -1.0
-                                     for kind, _ in self._guard_kinds])
+        self._directions = np.array(
+            [0.0 if kind == "pad" else -1.0 for kind, _ in self._guard_kinds]
+        )
         self.solver = make_solver(solver)
         self.contact_solver = self._make_contact_solver(solver)
         self._current_resolution = "coarse"
         self._integrating = False
         self.contact_since = -math.inf
-        self.gas = PolytropicGas(spec.accumulator.precharge_pressure,
-                                 spec.accumulator.full_volume, self.exponent)
+        self.gas = PolytropicGas(
+            spec.accumulator.precharge_pressure, spec.accumulator.full_volume, self.exponent
+        )
         self.compliance = 0.0
         self.oil_constant = 0.0
         self.state = np.zeros(self.layout.size)
@@ -632,8 +668,9 @@ class HydraulicsModel:
             return None
         omega = math.sqrt(self.spec.stops.stiffness / self.mass)
         zeta = damping_ratio_for_restitution(self.spec.stops.restitution)
-        self.contact_transient = max(4.0 * math.pi / omega,
-                                     5.0 / (zeta * omega) if zeta > 0.0 else math.inf)
+        self.contact_transient = max(
+            4.0 * math.pi / omega, 5.0 / (zeta * omega) if zeta > 0.0 else math.inf
+        )
         fine = min(settings.max_step, CONTACT_STEP_FACTOR / omega)
         if fine >= settings.max_step:
             return None
@@ -676,10 +713,28 @@ class HydraulicsModel:
         force = self.force + hydraulic + weight + stop_force - self._viscous * vel
         loss += stop_loss + self._viscous * vel * vel
         if energy:
-            stored += (0.5 * self.mass * vel * vel + self.gas.energy(max(v_gas, 0.5 * dead))
-                       + stop_energy + self.sa * self.cyl.ambient_pressure * pos - weight * pos)
-        return _Point(pos, vel, v_gas, p_g, p_c, flow, force, hydraulic, stop_force, depth,
-                      trial, loss, stored)
+            stored += (
+                0.5 * self.mass * vel * vel
+                + self.gas.energy(max(v_gas, 0.5 * dead))
+                + stop_energy
+                + self.sa * self.cyl.ambient_pressure * pos
+                - weight * pos
+            )
+        return _Point(
+            pos,
+            vel,
+            v_gas,
+            p_g,
+            p_c,
+            flow,
+            force,
+            hydraulic,
+            stop_force,
+            depth,
+            trial,
+            loss,
+            stored,
+        )
 
     def _oil_side(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
         """Chamber pressure, line flow, line loss and oil/line stored energy."""
@@ -770,14 +825,16 @@ class HydraulicsModel:
         """Seal stick/slip, limits, stop contact and cushion zones (see :meth:`_guard`)."""
         point = self.evaluate(x)
         acc, link, _ = self._accelerate(point)
-        return np.array([self._guard(kind, end, point, acc, link)
-                         for kind, end in self._guard_kinds])
+        return np.array(
+            [self._guard(kind, end, point, acc, link) for kind, end in self._guard_kinds]
+        )
 
     def _guard(self, kind: str, end: int, point: _Point, acc: float, link: float) -> float:
         acc_dead = self.spec.accumulator
         if kind == "seal":
-            return float(self.friction.guards(np.array([point.v]), np.array([link]),
-                                              self._capacity)[0])
+            return float(
+                self.friction.guards(np.array([point.v]), np.array([link]), self._capacity)[0]
+            )
         if kind == "gas_dead":
             return point.gas_volume - acc_dead.dead_volume
         if kind == "gas_empty":
@@ -838,22 +895,30 @@ class HydraulicsModel:
         acc = self.spec.accumulator
         v_gas = self.gas_volume(x)
         if kind == "gas_dead":
-            return (f"gas volume {v_gas:.6g} m3 reached its dead volume {acc.dead_volume:.6g} m3 "
-                    f"at t = {t:.9g} s (accumulator full of oil; gas pressure "
-                    f"{self.gas.pressure(max(v_gas, acc.dead_volume)):.6g} Pa): "
-                    "the rod is driven towards zero gas volume")
+            return (
+                f"gas volume {v_gas:.6g} m3 reached its dead volume {acc.dead_volume:.6g} m3 "
+                f"at t = {t:.9g} s (accumulator full of oil; gas pressure "
+                f"{self.gas.pressure(max(v_gas, acc.dead_volume)):.6g} Pa): "
+                "the rod is driven towards zero gas volume"
+            )
         if kind == "gas_empty":
-            return (f"gas volume {v_gas:.6g} m3 reached the empty-accumulator volume "
-                    f"{acc.full_volume:.6g} m3 at t = {t:.9g} s: no oil left to feed the cylinder")
+            return (
+                f"gas volume {v_gas:.6g} m3 reached the empty-accumulator volume "
+                f"{acc.full_volume:.6g} m3 at t = {t:.9g} s: no oil left to feed the cylinder"
+            )
         if kind == "cavitation":
             point = self.evaluate(x)
             p_c = self.chamber_pressure(point, self._accelerate(point)[0])
-            return (f"chamber pressure {p_c:.6g} Pa fell to the cavitation pressure "
-                    f"{self.spec.oil.cavitation_pressure:.6g} Pa at t = {t:.9g} s "
-                    f"(rod velocity {x[1]:.6g} m/s)")
+            return (
+                f"chamber pressure {p_c:.6g} Pa fell to the cavitation pressure "
+                f"{self.spec.oil.cavitation_pressure:.6g} Pa at t = {t:.9g} s "
+                f"(rod velocity {x[1]:.6g} m/s)"
+            )
         where = "below 0 m" if end == RETRACTED else f"beyond the stroke {self.cyl.stroke:.6g} m"
-        return (f"rod extension {x[0]:.6g} m went {where} at t = {t:.9g} s; "
-                "add the effect 'end_stops' to model cushions and stops")
+        return (
+            f"rod extension {x[0]:.6g} m went {where} at t = {t:.9g} s; "
+            "add the effect 'end_stops' to model cushions and stops"
+        )
 
     def project(self, x: np.ndarray) -> np.ndarray:
         """Hold a stuck rod exactly where it stuck, at rest."""
@@ -893,8 +958,9 @@ class HydraulicsModel:
         weight = self.cyl.moving_mass * self.cyl.gravity_along_rod
         return self.cyl.ambient_pressure - (force + weight) / self.sa
 
-    def initialize(self, force: float, *, position: float, velocity: float,
-                   gas_pressure: float | None) -> None:
+    def initialize(
+        self, force: float, *, position: float, velocity: float, gas_pressure: float | None
+    ) -> None:
         """Set the state; ``gas_pressure`` None means static equilibrium with ``force``.
 
         The gas was charged slowly (isothermally) from the pre-charge to the
@@ -910,8 +976,9 @@ class HydraulicsModel:
         p0 = self.equilibrium_pressure(force) if gas_pressure is None else float(gas_pressure)
         self._check_start(p0, position, velocity)
         acc = self.spec.accumulator
-        v0 = min(isothermal_charge_volume(acc.precharge_pressure, acc.full_volume, p0),
-                 acc.full_volume)
+        v0 = min(
+            isothermal_charge_volume(acc.precharge_pressure, acc.full_volume, p0), acc.full_volume
+        )
         self.gas = PolytropicGas(p0, v0, self.exponent)
         oil = self.spec.oil.volume or (self.cyl.chamber_volume(position) + self.line.volume)
         self.compliance = oil / self.spec.oil.bulk_modulus
@@ -919,8 +986,10 @@ class HydraulicsModel:
         self.state = self._initial_state(position, velocity, p0, v0)
         self.contact = [False, False]
         self.contact_since = -math.inf
-        self.in_cushion = [self.stops_on and position < self._cushion_boundary(RETRACTED),
-                           self.stops_on and position > self._cushion_boundary(EXTENDED)]
+        self.in_cushion = [
+            self.stops_on and position < self._cushion_boundary(RETRACTED),
+            self.stops_on and position > self._cushion_boundary(EXTENDED),
+        ]
         if self.stops_on and self.spec.stops.cushion_length <= 0.0:
             self.in_cushion = [False, False]
         moving = int(math.copysign(1, velocity)) if velocity != 0.0 else 0
@@ -936,27 +1005,36 @@ class HydraulicsModel:
         problems = []
         acc = self.spec.accumulator
         if not (pressure > 0.0 and math.isfinite(pressure)):
-            problems.append(f"initial gas pressure must be > 0 Pa, got {pressure:.6g} Pa (the "
-                            "rod force would pull the rod out against vacuum)")
+            problems.append(
+                f"initial gas pressure must be > 0 Pa, got {pressure:.6g} Pa (the "
+                "rod force would pull the rod out against vacuum)"
+            )
         elif pressure < acc.precharge_pressure * (1.0 - 1e-12):
-            problems.append(f"initial gas pressure {pressure:.6g} Pa is below the pre-charge "
-                            f"{acc.precharge_pressure:.6g} Pa: the accumulator would hold no oil; "
-                            "lower 'precharge_pressure' or raise the load")
-        elif isothermal_charge_volume(acc.precharge_pressure, acc.full_volume,
-                                      pressure) <= acc.dead_volume:
-            problems.append(f"initial gas pressure {pressure:.6g} Pa needs more oil than the "
-                            f"accumulator holds (pre-charge {acc.precharge_pressure:.6g} Pa); "
-                            "raise 'precharge_pressure' or lower the load")
+            problems.append(
+                f"initial gas pressure {pressure:.6g} Pa is below the pre-charge "
+                f"{acc.precharge_pressure:.6g} Pa: the accumulator would hold no oil; "
+                "lower 'precharge_pressure' or raise the load"
+            )
+        elif (
+            isothermal_charge_volume(acc.precharge_pressure, acc.full_volume, pressure)
+            <= acc.dead_volume
+        ):
+            problems.append(
+                f"initial gas pressure {pressure:.6g} Pa needs more oil than the "
+                f"accumulator holds (pre-charge {acc.precharge_pressure:.6g} Pa); "
+                "raise 'precharge_pressure' or lower the load"
+            )
         if not (0.0 <= position <= self.cyl.stroke):
-            problems.append(f"parameter 'initial_position' must lie in [0, stroke = "
-                            f"{self.cyl.stroke:.6g}] m, got {position}")
+            problems.append(
+                f"parameter 'initial_position' must lie in [0, stroke = "
+                f"{self.cyl.stroke:.6g}] m, got {position}"
+            )
         if not math.isfinite(velocity):
             problems.append(f"parameter 'initial_velocity' must be finite, got {velocity}")
         if problems:
             raise ConfigurationError("hydraulics", problems)
 
-    def _initial_state(self, position: float, velocity: float, p0: float,
-                       v0: float) -> np.ndarray:
+    def _initial_state(self, position: float, velocity: float, p0: float, v0: float) -> np.ndarray:
         lay = self.layout
         state = np.zeros(lay.size)
         state[0], state[1] = position, velocity
@@ -1044,8 +1122,11 @@ class HydraulicsModel:
         if self._current_resolution == "contact" and self.contact_solver is not None:
             solver = self.contact_solver
             settled = self.contact_since + self.contact_transient
-            return solver, min(t_end, t + CONTACT_CHUNK_STEPS * solver.settings.max_step,
-                               max(settled, t + solver.settings.max_step))
+            return solver, min(
+                t_end,
+                t + CONTACT_CHUNK_STEPS * solver.settings.max_step,
+                max(settled, t + solver.settings.max_step),
+            )
         if self._current_resolution == "cushion":
             c = self.spec.stops.cushion_coefficient
             h = CUSHION_STEP_FACTOR * self.mass / (c * self._cushion_speed(x))

@@ -123,75 +123,165 @@ _FEEDTHROUGH = ("rod.force",)
 
 def _physical_parameters():
     return (
-        parameter("pressurised_side", "bore", "", "Oil-filled side: 'bore' (gas pushes the rod "
-                  "out) or 'annulus' (gas pulls it in); the other side is vented", type=str),
+        parameter(
+            "pressurised_side",
+            "bore",
+            "",
+            "Oil-filled side: 'bore' (gas pushes the rod "
+            "out) or 'annulus' (gas pulls it in); the other side is vented",
+            type=str,
+        ),
         parameter("bore_diameter", 0.356, "m", "Piston (bore) diameter", min=0.0),
         parameter("rod_diameter", 0.229, "m", "Rod diameter", min=0.0),
         parameter("stroke", 3.81, "m", "Stroke", min=0.0),
-        parameter("moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries",
-                  min=0.0),
-        parameter("chamber_dead_volume", 0.01, "m3",
-                  "Oil in the pressurised chamber at zero working length", min=0.0),
-        parameter("gravity_along_rod", -9.81, "m/s2",
-                  "Gravity along the extension direction (-9.81: vertical, rod extends up)"),
-        parameter("ambient_pressure", 101325.0, "Pa",
-                  "Absolute pressure on the vented side and the rod's outer end", min=0.0),
-        parameter("accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)",
-                  min=0.0),
+        parameter(
+            "moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries", min=0.0
+        ),
+        parameter(
+            "chamber_dead_volume",
+            0.01,
+            "m3",
+            "Oil in the pressurised chamber at zero working length",
+            min=0.0,
+        ),
+        parameter(
+            "gravity_along_rod",
+            -9.81,
+            "m/s2",
+            "Gravity along the extension direction (-9.81: vertical, rod extends up)",
+        ),
+        parameter(
+            "ambient_pressure",
+            101325.0,
+            "Pa",
+            "Absolute pressure on the vented side and the rod's outer end",
+            min=0.0,
+        ),
+        parameter(
+            "accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)", min=0.0
+        ),
         parameter("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels", min=0.0),
-        parameter("accumulator_dead_volume", 0.01, "m3",
-                  "Gas left in the accumulator when it is full of oil", min=0.0),
-        parameter("precharge_pressure", 13.5e6, "Pa",
-                  "Absolute gas pressure with no oil in the accumulator", min=0.0),
-        parameter("polytropic_exponent", 1.4, "1",
-                  "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)",
-                  min=1.0, max=2.0),
+        parameter(
+            "accumulator_dead_volume",
+            0.01,
+            "m3",
+            "Gas left in the accumulator when it is full of oil",
+            min=0.0,
+        ),
+        parameter(
+            "precharge_pressure",
+            13.5e6,
+            "Pa",
+            "Absolute gas pressure with no oil in the accumulator",
+            min=0.0,
+        ),
+        parameter(
+            "polytropic_exponent",
+            1.4,
+            "1",
+            "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)",
+            min=1.0,
+            max=2.0,
+        ),
         parameter("line_length", 15.0, "m", "Length of the oil line", min=0.0),
         parameter("line_diameter", 0.1524, "m", "Inner diameter of the oil line", min=0.0),
         parameter("oil_density", 870.0, "kg/m3", "Oil density", min=0.0),
         parameter("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity", min=0.0),
-        parameter("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent",
-                  min=0.0),
-        parameter("line_loss_coefficient", 5.0, "1",
-                  "Sum of minor-loss coefficients (valves, bends, entry, exit)", min=0.0),
+        parameter("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent", min=0.0),
+        parameter(
+            "line_loss_coefficient",
+            5.0,
+            "1",
+            "Sum of minor-loss coefficients (valves, bends, entry, exit)",
+            min=0.0,
+        ),
         parameter("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus", min=0.0),
-        parameter("oil_volume", 0.0, "m3", "Oil volume whose compressibility is modelled "
-                  "(0: chamber at the initial position plus line)", min=0.0),
-        parameter("cavitation_pressure", 1.0e4, "Pa",
-                  "Absolute chamber pressure at which the step is refused (cavitation)", min=0.0),
+        parameter(
+            "oil_volume",
+            0.0,
+            "m3",
+            "Oil volume whose compressibility is modelled "
+            "(0: chamber at the initial position plus line)",
+            min=0.0,
+        ),
+        parameter(
+            "cavitation_pressure",
+            1.0e4,
+            "Pa",
+            "Absolute chamber pressure at which the step is refused (cavitation)",
+            min=0.0,
+        ),
         parameter("seal_static_friction", 25.0e3, "N", "Seal breakaway force", min=0.0),
-        parameter("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force",
-                  min=0.0),
-        parameter("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient",
-                  min=0.0),
-        parameter("seal_stribeck_velocity", 0.01, "m/s",
-                  "Stribeck velocity (0: no Stribeck decay)", min=0.0),
-        parameter("cushion_length", 0.15, "m", "Length of the cushion zone at each end",
-                  min=0.0),
-        parameter("cushion_coefficient", 1.0e5, "N.s2/m2",
-                  "Cushion force coefficient c in F = c v^2", min=0.0),
+        parameter("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force", min=0.0),
+        parameter("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient", min=0.0),
+        parameter(
+            "seal_stribeck_velocity",
+            0.01,
+            "m/s",
+            "Stribeck velocity (0: no Stribeck decay)",
+            min=0.0,
+        ),
+        parameter("cushion_length", 0.15, "m", "Length of the cushion zone at each end", min=0.0),
+        parameter(
+            "cushion_coefficient",
+            1.0e5,
+            "N.s2/m2",
+            "Cushion force coefficient c in F = c v^2",
+            min=0.0,
+        ),
         parameter("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness", min=0.0),
-        parameter("stop_restitution", 0.3, "1", "Coefficient of restitution at an end stop",
-                  min=0.0, max=1.0),
+        parameter(
+            "stop_restitution",
+            0.3,
+            "1",
+            "Coefficient of restitution at an end stop",
+            min=0.0,
+            max=1.0,
+        ),
     )
 
 
 def _variables():
     params = (
-        parameter("effects", "", "", "Effects to include, comma separated: "
-                  + ", ".join(HYDRAULICS_EFFECTS.names), type=str),
+        parameter(
+            "effects",
+            "",
+            "",
+            "Effects to include, comma separated: " + ", ".join(HYDRAULICS_EFFECTS.names),
+            type=str,
+        ),
         *solver_parameters("ros2", 1e-3),
         *_physical_parameters(),
-        parameter("initial_equilibrium", True, "", "Start at rest in static equilibrium with "
-                  "the initial rod.force", type=bool),
+        parameter(
+            "initial_equilibrium",
+            True,
+            "",
+            "Start at rest in static equilibrium with the initial rod.force",
+            type=bool,
+        ),
         parameter("initial_position", 1.905, "m", "Initial extension from fully retracted"),
-        parameter("initial_velocity", 0.0, "m/s",
-                  "Initial rod velocity (0 required with initial_equilibrium)"),
-        parameter("initial_gas_pressure", 14.75e6, "Pa",
-                  "Initial absolute gas pressure when initial_equilibrium is false", min=0.0),
+        parameter(
+            "initial_velocity",
+            0.0,
+            "m/s",
+            "Initial rod velocity (0 required with initial_equilibrium)",
+        ),
+        parameter(
+            "initial_gas_pressure",
+            14.75e6,
+            "Pa",
+            "Initial absolute gas pressure when initial_equilibrium is false",
+            min=0.0,
+        ),
     )
-    inputs = (input_("rod.force", DEFAULT_ROD_FORCE, "N",
-                     "External force on the rod along extension (positive pushes it out)"),)
+    inputs = (
+        input_(
+            "rod.force",
+            DEFAULT_ROD_FORCE,
+            "N",
+            "External force on the rod along extension (positive pushes it out)",
+        ),
+    )
     deps = _FEEDTHROUGH
     outputs = (
         output("rod.position", "m", "Rod extension from fully retracted"),
@@ -199,27 +289,36 @@ def _variables():
         output("rod.displacement", "m", "Rod extension since the start"),
         output("rod.acceleration", "m/s2", "Rod acceleration along extension", depends_on=deps),
         output("rod.stiffness", "N/m", "Quasi-static spring rate of gas and oil at the rod"),
-        output("chamber.pressure", "Pa", "Absolute pressure at the cylinder port",
-               depends_on=deps),
-        output("hydraulic_force", "N", "Oil force on the rod along extension (gauge pressure "
-               "times area)", depends_on=deps),
+        output("chamber.pressure", "Pa", "Absolute pressure at the cylinder port", depends_on=deps),
+        output(
+            "hydraulic_force",
+            "N",
+            "Oil force on the rod along extension (gauge pressure times area)",
+            depends_on=deps,
+        ),
         output("gas.pressure", "Pa", "Absolute gas pressure"),
         output("gas.volume", "m3", "Gas volume (accumulator gas side plus gas bank)"),
         output("line.flow", "m3/s", "Oil flow from the accumulator to the cylinder"),
         output("accumulator.oil_volume", "m3", "Oil in the accumulator"),
         output("stroke_used", "1", "Rod extension as a fraction of the stroke"),
-        output("seal.friction_force", "N", "Seal friction on the rod along extension",
-               depends_on=deps),
+        output(
+            "seal.friction_force", "N", "Seal friction on the rod along extension", depends_on=deps
+        ),
         output("seal.stuck", "", "Whether the seals hold the rod (stick)", type=bool),
         output("end_stop.force", "N", "Cushion and stop force on the rod along extension"),
         output("end_stop.contact", "", "Whether the rod is on an end stop", type=bool),
         output("stored_energy", "J", "Kinetic, gas, oil, stop-pad and potential energy"),
         output("dissipated_energy", "J", "Energy dissipated since the start"),
         output("external_work", "J", "Work done on the unit through the rod since the start"),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work"),
-        output("mode_changes", "", "Number of mode events so far (stick/slip, end stops, "
-               "cushions)", type=int),
+        output(
+            "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
+        ),
+        output(
+            "mode_changes",
+            "",
+            "Number of mode events so far (stick/slip, end stops, cushions)",
+            type=int,
+        ),
     )
     return params + inputs + outputs
 
@@ -267,35 +366,60 @@ class HydraulicsUnit(Unit):
     def spec(self) -> HydraulicsSpec:
         """The physical parameters now in :attr:`values`, unvalidated."""
         v = {k: val for k, val in self.values.items()}
-        f = {k: float(val) for k, val in v.items()
-             if not isinstance(val, str | bool)}
+        f = {k: float(val) for k, val in v.items() if not isinstance(val, str | bool)}
         return HydraulicsSpec(
-            cylinder=CylinderSpec(f["bore_diameter"], f["rod_diameter"], f["stroke"],
-                                  f["moving_mass"], str(v["pressurised_side"]),
-                                  f["chamber_dead_volume"], f["gravity_along_rod"],
-                                  f["ambient_pressure"]),
-            accumulator=AccumulatorSpec(f["accumulator_volume"], f["gas_bank_volume"],
-                                        f["accumulator_dead_volume"], f["precharge_pressure"],
-                                        f["polytropic_exponent"]),
-            line=HydraulicLine(f["line_length"], f["line_diameter"], f["oil_density"],
-                               f["oil_viscosity"], f["line_friction_factor"],
-                               f["line_loss_coefficient"]),
+            cylinder=CylinderSpec(
+                f["bore_diameter"],
+                f["rod_diameter"],
+                f["stroke"],
+                f["moving_mass"],
+                str(v["pressurised_side"]),
+                f["chamber_dead_volume"],
+                f["gravity_along_rod"],
+                f["ambient_pressure"],
+            ),
+            accumulator=AccumulatorSpec(
+                f["accumulator_volume"],
+                f["gas_bank_volume"],
+                f["accumulator_dead_volume"],
+                f["precharge_pressure"],
+                f["polytropic_exponent"],
+            ),
+            line=HydraulicLine(
+                f["line_length"],
+                f["line_diameter"],
+                f["oil_density"],
+                f["oil_viscosity"],
+                f["line_friction_factor"],
+                f["line_loss_coefficient"],
+            ),
             oil=OilSpec(f["bulk_modulus"], f["oil_volume"], f["cavitation_pressure"]),
-            seal=SealSpec(f["seal_static_friction"], f["seal_coulomb_friction"],
-                          f["seal_viscous_friction"], f["seal_stribeck_velocity"]),
-            stops=EndStopSpec(f["cushion_length"], f["cushion_coefficient"],
-                              f["stop_stiffness"], f["stop_restitution"]),
+            seal=SealSpec(
+                f["seal_static_friction"],
+                f["seal_coulomb_friction"],
+                f["seal_viscous_friction"],
+                f["seal_stribeck_velocity"],
+            ),
+            stops=EndStopSpec(
+                f["cushion_length"],
+                f["cushion_coefficient"],
+                f["stop_stiffness"],
+                f["stop_restitution"],
+            ),
         )
 
     def _initial_problems(self) -> list[str]:
         v = self.values
         out = []
         if bool(v["initial_equilibrium"]) and float(v["initial_velocity"]) != 0.0:
-            out.append("parameter 'initial_velocity' must be 0 with initial_equilibrium "
-                       f"(static equilibrium is at rest), got {v['initial_velocity']}")
+            out.append(
+                "parameter 'initial_velocity' must be 0 with initial_equilibrium "
+                f"(static equilibrium is at rest), got {v['initial_velocity']}"
+            )
         if not bool(v["initial_equilibrium"]) and not float(v["initial_gas_pressure"]) > 0.0:
-            out.append("parameter 'initial_gas_pressure' must be > 0 Pa, got "
-                       f"{v['initial_gas_pressure']}")
+            out.append(
+                f"parameter 'initial_gas_pressure' must be > 0 Pa, got {v['initial_gas_pressure']}"
+            )
         return out
 
     def initialize(self, start_time: float) -> None:
@@ -304,8 +428,12 @@ class HydraulicsUnit(Unit):
         v = self.values
         pressure = None if bool(v["initial_equilibrium"]) else float(v["initial_gas_pressure"])
         try:
-            model.initialize(float(v["rod.force"]), position=float(v["initial_position"]),
-                             velocity=float(v["initial_velocity"]), gas_pressure=pressure)
+            model.initialize(
+                float(v["rod.force"]),
+                position=float(v["initial_position"]),
+                velocity=float(v["initial_velocity"]),
+                gas_pressure=pressure,
+            )
         except ConfigurationError as err:
             raise ConfigurationError(self.who, err.problems) from None
         except ModelError as err:
@@ -322,8 +450,14 @@ class HydraulicsUnit(Unit):
             model.advance(time, step, float(self.values["rod.force"]))
             self.time = time + step
             self._update_outputs()
-        except (ModelError, IntegrationError, FloatingPointError, ValueError,
-                ZeroDivisionError, OverflowError) as err:
+        except (
+            ModelError,
+            IntegrationError,
+            FloatingPointError,
+            ValueError,
+            ZeroDivisionError,
+            OverflowError,
+        ) as err:
             self.set_state(saved)
             message = f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
             logger.debug("%s", message)
@@ -419,8 +553,12 @@ class HydraulicsUnit(Unit):
         out["stored_energy"] = r["stored_energy"]
         out["dissipated_energy"] = m.dissipated_energy
         out["external_work"] = float(m.external_work)
-        out["energy_balance"] = (r["stored_energy"] - self.initial_energy
-                                 + out["dissipated_energy"] - out["external_work"])
+        out["energy_balance"] = (
+            r["stored_energy"]
+            - self.initial_energy
+            + out["dissipated_energy"]
+            - out["external_work"]
+        )
         out["mode_changes"] = int(m.mode_changes)
         if not all(math.isfinite(value) for value in r.values()):
             raise FloatingPointError(f"{self.who}: non-finite outputs {r}")

@@ -141,7 +141,12 @@ def parameter(
 
 
 def input_(
-    name: str, start: Any, unit: str, description: str, *, type: type = float  # noqa: A002
+    name: str,
+    start: Any,
+    unit: str,
+    description: str,
+    *,
+    type: type = float,  # noqa: A002
 ) -> Variable:
     """Declare an input."""
     variability = Variability.continuous if type is float else Variability.discrete
@@ -306,9 +311,7 @@ class Unit(ABC):
     def outputs(self) -> dict[str, Any]:
         """Current output values by name."""
         return {
-            v.name: self.values[v.name]
-            for v in self.VARIABLES
-            if v.causality is Causality.output
+            v.name: self.values[v.name] for v in self.VARIABLES if v.causality is Causality.output
         }
 
 

@@ -192,8 +192,10 @@ class FourierInertia:
         """The inertia must stay positive for every angle."""
         if self.series.mean - self.series.amplitude_bound() > 0.0:
             return []
-        return [f"inertia: the Fourier series may reach zero or below (mean "
-                f"{self.series.mean}, harmonics up to {self.series.amplitude_bound()} kg m^2)"]
+        return [
+            f"inertia: the Fourier series may reach zero or below (mean "
+            f"{self.series.mean}, harmonics up to {self.series.amplitude_bound()} kg m^2)"
+        ]
 
 
 @dataclass(frozen=True)
@@ -268,8 +270,13 @@ def crank_press() -> dict[str, Any]:
     1.5 s period, ``50 sin(2 pi t / 1.5)`` N m.
     """
     return {
-        "inertia": {"kind": "crank_slider", "base": 50.0, "crank": 0.1, "rod": 0.5,
-                    "slider_mass": 200.0},
+        "inertia": {
+            "kind": "crank_slider",
+            "base": 50.0,
+            "crank": 0.1,
+            "rod": 0.5,
+            "slider_mass": 200.0,
+        },
         "resistance_angle": {"mean": 550.0, "cos": [450.0, 150.0]},
         "resistance_speed": {"coefficients": [0.0, 20.0, 1.0]},
         "resistance_time": {"mean": 0.0, "sin": [50.0], "period": 1.5},
@@ -290,8 +297,9 @@ def _floats(value: Any, where: str, problems: list[str]) -> tuple[float, ...]:
     return out
 
 
-def _float(item: Mapping[str, Any], key: str, default: float | None, where: str,
-           problems: list[str]) -> float:
+def _float(
+    item: Mapping[str, Any], key: str, default: float | None, where: str, problems: list[str]
+) -> float:
     value = item.get(key, default)
     try:
         out = float(value)
@@ -314,29 +322,41 @@ def _table(data: Mapping[str, Any], key: str, known: set[str], problems: list[st
     return dict(item)
 
 
-def _series(item: Mapping[str, Any], where: str, period: float,
-            problems: list[str]) -> FourierSeries:
-    series = FourierSeries(_float(item, "mean", 0.0, where, problems),
-                           _floats(item.get("cos"), f"{where} 'cos'", problems),
-                           _floats(item.get("sin"), f"{where} 'sin'", problems),
-                           _float(item, "period", period, where, problems))
+def _series(
+    item: Mapping[str, Any], where: str, period: float, problems: list[str]
+) -> FourierSeries:
+    series = FourierSeries(
+        _float(item, "mean", 0.0, where, problems),
+        _floats(item.get("cos"), f"{where} 'cos'", problems),
+        _floats(item.get("sin"), f"{where} 'sin'", problems),
+        _float(item, "period", period, where, problems),
+    )
     if not series.period > 0.0:
         problems.append(f"{where}: 'period' must be > 0, got {series.period}")
     return series
 
 
 def _inertia(data: Mapping[str, Any], problems: list[str]):
-    item = _table(data, "inertia", {"kind", "base", "crank", "rod", "slider_mass", "mean",
-                                    "cos", "sin"}, problems)
+    item = _table(
+        data,
+        "inertia",
+        {"kind", "base", "crank", "rod", "slider_mass", "mean", "cos", "sin"},
+        problems,
+    )
     kind = item.get("kind", "crank_slider")
     if kind == "crank_slider":
-        law = CrankSliderInertia(*(_float(item, k, None, "machine inertia", problems)
-                                   for k in ("base", "crank", "rod", "slider_mass")))
+        law = CrankSliderInertia(
+            *(
+                _float(item, k, None, "machine inertia", problems)
+                for k in ("base", "crank", "rod", "slider_mass")
+            )
+        )
     elif kind == "fourier":
         law = FourierInertia(_series(item, "machine inertia", _TWO_PI, problems))
     else:
-        problems.append(f"machine inertia: 'kind' must be 'crank_slider' or 'fourier', "
-                        f"got {kind!r}")
+        problems.append(
+            f"machine inertia: 'kind' must be 'crank_slider' or 'fourier', got {kind!r}"
+        )
         return None
     if not problems:
         problems += law.problems()
@@ -348,17 +368,25 @@ def parse_machine(data: Any) -> tuple[MachineSpec | None, list[str]]:
     if not isinstance(data, Mapping):
         return None, [f"machine must be a table, got {data!r}"]
     problems: list[str] = []
-    unknown = sorted(set(data) - {"inertia", "resistance_angle", "resistance_speed",
-                                  "resistance_time"})
+    unknown = sorted(
+        set(data) - {"inertia", "resistance_angle", "resistance_speed", "resistance_time"}
+    )
     if unknown:
-        problems.append(f"machine: unknown keys {unknown}; known: inertia, resistance_angle, "
-                        "resistance_speed, resistance_time")
+        problems.append(
+            f"machine: unknown keys {unknown}; known: inertia, resistance_angle, "
+            "resistance_speed, resistance_time"
+        )
     fourier = {"mean", "cos", "sin"}
-    angle = _series(_table(data, "resistance_angle", fourier, problems),
-                    "machine resistance_angle", _TWO_PI, problems)
+    angle = _series(
+        _table(data, "resistance_angle", fourier, problems),
+        "machine resistance_angle",
+        _TWO_PI,
+        problems,
+    )
     speed_item = _table(data, "resistance_speed", {"coefficients"}, problems)
-    speed = Polynomial(_floats(speed_item.get("coefficients"),
-                               "machine resistance_speed 'coefficients'", problems))
+    speed = Polynomial(
+        _floats(speed_item.get("coefficients"), "machine resistance_speed 'coefficients'", problems)
+    )
     time_item = _table(data, "resistance_time", fourier | {"period"}, problems)
     time_law = _series(time_item, "machine resistance_time", 1.0, problems)
     inertia = _inertia(data, problems)
@@ -408,8 +436,9 @@ class MachineDriveModel:
         m = self._machine
         phi, omega = float(x[0]), float(x[1])
         dissipated = m.resistance_speed(omega) * omega
-        external = (m.driving_torque(omega) - m.resistance_angle(phi)
-                    - m.resistance_time(t)) * omega
+        external = (
+            m.driving_torque(omega) - m.resistance_angle(phi) - m.resistance_time(t)
+        ) * omega
         return np.array([omega, m.acceleration(t, phi, omega), dissipated, external])
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -465,8 +494,11 @@ class CycleStatistics:
     start_time: float = 0.0
     omega_max: float = -math.inf
     omega_min: float = math.inf
-    last: dict[str, float] = field(default_factory=lambda: dict.fromkeys(
-        ("period", "omega_mean", "omega_max", "omega_min", "delta"), 0.0))
+    last: dict[str, float] = field(
+        default_factory=lambda: dict.fromkeys(
+            ("period", "omega_mean", "omega_max", "omega_min", "delta"), 0.0
+        )
+    )
     _turn: int = field(default=0, repr=False)
 
     def start(self, t: float, phi: float, omega: float) -> None:
@@ -492,15 +524,25 @@ class CycleStatistics:
     def _close(self, t_end: float) -> None:
         period = t_end - self.start_time
         mean = _TWO_PI / period
-        self.last = {"period": period, "omega_mean": mean, "omega_max": self.omega_max,
-                     "omega_min": self.omega_min,
-                     "delta": (self.omega_max - self.omega_min) / mean}
+        self.last = {
+            "period": period,
+            "omega_mean": mean,
+            "omega_max": self.omega_max,
+            "omega_min": self.omega_min,
+            "delta": (self.omega_max - self.omega_min) / mean,
+        }
         self.count += 1
 
     def get_state(self) -> dict[str, Any]:
         """Plain data."""
-        return {"count": self.count, "start_time": self.start_time, "omega_max": self.omega_max,
-                "omega_min": self.omega_min, "last": dict(self.last), "turn": self._turn}
+        return {
+            "count": self.count,
+            "start_time": self.start_time,
+            "omega_max": self.omega_max,
+            "omega_min": self.omega_min,
+            "last": dict(self.last),
+            "turn": self._turn,
+        }
 
     def set_state(self, data: Mapping[str, Any]) -> None:
         """Restore :meth:`get_state`."""
@@ -512,16 +554,21 @@ class CycleStatistics:
         self._turn = int(data["turn"])
 
 
-def _crossing_time(t0: float, x0: Sequence[float], t1: float, x1: Sequence[float],
-                   level: float) -> float:
+def _crossing_time(
+    t0: float, x0: Sequence[float], t1: float, x1: Sequence[float], level: float
+) -> float:
     """When the cubic Hermite interpolant of ``phi`` (with ``omega`` as slope) reaches ``level``."""
     h = t1 - t0
     p0, p1, m0, m1 = float(x0[0]), float(x1[0]), float(x0[1]) * h, float(x1[1]) * h
 
     def hermite(s: float) -> float:
         s2, s3 = s * s, s * s * s
-        return ((2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1
-                + (s3 - s2) * m1) - level
+        return (
+            (2 * s3 - 3 * s2 + 1) * p0
+            + (s3 - 2 * s2 + s) * m0
+            + (-2 * s3 + 3 * s2) * p1
+            + (s3 - s2) * m1
+        ) - level
 
     lo, hi = 0.0, 1.0
     for _ in range(60):
@@ -531,4 +578,3 @@ def _crossing_time(t0: float, x0: Sequence[float], t1: float, x1: Sequence[float
         else:
             hi = mid
     return t0 + 0.5 * (lo + hi) * h
-

@@ -49,29 +49,54 @@ from .solver_options import solver_parameters, solver_settings
 __all__ = ["MachineDriveUnit"]
 
 
-
 def _parameters():
     return (
-        parameter("machine", json.dumps(crank_press()), "", "Machine as JSON: inertia "
-                  "(crank_slider or fourier), resistance_angle and resistance_time (Fourier "
-                  "series), resistance_speed (polynomial); a crank press by default", type=str),
-        parameter("motor_slope", 2117.0, "N.m.s/rad", "Slope b of the motor characteristic "
-                  "a - b omega at the main shaft (7.5 kW, 1500 rpm, 3.3 % slip through 1:15; "
-                  "estimate)", min=0.0),
+        parameter(
+            "machine",
+            json.dumps(crank_press()),
+            "",
+            "Machine as JSON: inertia "
+            "(crank_slider or fourier), resistance_angle and resistance_time (Fourier "
+            "series), resistance_speed (polynomial); a crank press by default",
+            type=str,
+        ),
+        parameter(
+            "motor_slope",
+            2117.0,
+            "N.m.s/rad",
+            "Slope b of the motor characteristic "
+            "a - b omega at the main shaft (7.5 kW, 1500 rpm, 3.3 % slip through 1:15; "
+            "estimate)",
+            min=0.0,
+        ),
         parameter("initial_speed", 10.0, "rad/s", "Main shaft speed at the start", min=0.0),
         parameter("initial_angle", 0.0, "rad", "Main shaft angle at the start"),
-        *solver_parameters("energy", 5e-3, rtol=1e-8, atol=1e-10, also=ENERGY_SOLVERS,
-                           note="energy: paper 004 with refinement; energy1: its first-order "
-                                "step"),
+        *solver_parameters(
+            "energy",
+            5e-3,
+            rtol=1e-8,
+            atol=1e-10,
+            also=ENERGY_SOLVERS,
+            note="energy: paper 004 with refinement; energy1: its first-order step",
+        ),
     )
 
 
 def _inputs():
     return (
-        input_("motor.command", 22170.0, "N.m", "a of the motor characteristic a - b omega "
-               "(b omega_sync of the default motor: 2117 x 10.472)"),
-        input_("load.torque", 0.0, "N.m", "Extra load torque on the main shaft, positive "
-               "opposing positive rotation"),
+        input_(
+            "motor.command",
+            22170.0,
+            "N.m",
+            "a of the motor characteristic a - b omega "
+            "(b omega_sync of the default motor: 2117 x 10.472)",
+        ),
+        input_(
+            "load.torque",
+            0.0,
+            "N.m",
+            "Extra load torque on the main shaft, positive opposing positive rotation",
+        ),
     )
 
 
@@ -83,26 +108,38 @@ def _outputs():
         output("motor.torque", "N.m", "Motor torque a - b omega", depends_on=("motor.command",)),
         output("resistance.angle_torque", "N.m", "Resistance of the angle M_c(phi)"),
         output("resistance.speed_torque", "N.m", "Resistance of the speed M_c(omega)"),
-        output("resistance.time_torque", "N.m", "Resistance of time M_c(t) plus the load input",
-               depends_on=("load.torque",)),
+        output(
+            "resistance.time_torque",
+            "N.m",
+            "Resistance of time M_c(t) plus the load input",
+            depends_on=("load.torque",),
+        ),
         output("cycle.count", "", "Revolutions of the main shaft completed", type=int),
         output("cycle.period", "s", "Duration of the last revolution"),
         output("cycle.omega_mean", "rad/s", "Mean speed of the last revolution, 2 pi / period"),
         output("cycle.omega_max", "rad/s", "Highest speed in the last revolution"),
         output("cycle.omega_min", "rad/s", "Lowest speed in the last revolution"),
-        output("cycle.delta", "1", "Coefficient of non-uniformity of the last revolution, "
-               "(omega_max - omega_min) / omega_mean"),
-        output("solver.evaluations", "", "Torque evaluations of the internal solver so far",
-               type=int),
+        output(
+            "cycle.delta",
+            "1",
+            "Coefficient of non-uniformity of the last revolution, "
+            "(omega_max - omega_min) / omega_mean",
+        ),
+        output(
+            "solver.evaluations", "", "Torque evaluations of the internal solver so far", type=int
+        ),
         output("solver.steps", "", "Internal steps so far", type=int),
         output("stored_energy", "J", "Kinetic energy I(phi) omega^2 / 2"),
         output("dissipated_energy", "J", "Work of the speed resistance M_c(omega)"),
-        output("external_work", "J", "Work of the motor minus that of M_c(phi), M_c(t) and the "
-               "load"),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work"),
-        output("mode_changes", "", "Mode events so far (always 0: the machine is smooth)",
-               type=int),
+        output(
+            "external_work", "J", "Work of the motor minus that of M_c(phi), M_c(t) and the load"
+        ),
+        output(
+            "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
+        ),
+        output(
+            "mode_changes", "", "Mode events so far (always 0: the machine is smooth)", type=int
+        ),
     )
 
 
@@ -143,15 +180,19 @@ class MachineDriveUnit(Unit):
         if problems:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
         self.model = MachineDriveModel(spec, slope)
-        self.solver = (make_energy_solver(settings) if settings.method in ENERGY_SOLVERS
-                       else make_solver(settings))
+        self.solver = (
+            make_energy_solver(settings)
+            if settings.method in ENERGY_SOLVERS
+            else make_solver(settings)
+        )
 
     def initialize(self, start_time: float) -> None:
         """Start at ``initial_angle`` and ``initial_speed``."""
         model = self._require_model()
         self._bind(model)
-        model.state = np.array([float(self.values["initial_angle"]),
-                                float(self.values["initial_speed"]), 0.0, 0.0])
+        model.state = np.array(
+            [float(self.values["initial_angle"]), float(self.values["initial_speed"]), 0.0, 0.0]
+        )
         self.time = start_time
         self.initial_energy = model.kinetic_energy()
         self.cycles.start(start_time, model.state[0], model.state[1])
@@ -161,8 +202,9 @@ class MachineDriveUnit(Unit):
         """Advance by ``step`` seconds with the inputs held."""
         model = self._require_model()
         who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = [n for n in ("motor.command", "load.torque")
-               if not math.isfinite(float(self.values[n]))]
+        bad = [
+            n for n in ("motor.command", "load.torque") if not math.isfinite(float(self.values[n]))
+        ]
         if bad:
             return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
         saved = self.get_state()
@@ -173,8 +215,13 @@ class MachineDriveUnit(Unit):
             self.cycles.update(time, x0, time + step, model.state)
             self.time = time + step
             self._update_outputs()
-        except (IntegrationError, FloatingPointError, ValueError, ZeroDivisionError,
-                EnergyFormBreakdownError) as err:
+        except (
+            IntegrationError,
+            FloatingPointError,
+            ValueError,
+            ZeroDivisionError,
+            EnergyFormBreakdownError,
+        ) as err:
             self.set_state(saved)
             return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
         return StepResult(True)

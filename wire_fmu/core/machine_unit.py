@@ -210,8 +210,15 @@ class EnergyStep:
     form: str = "energy"
 
 
-def _trapezoid_work(machine: MachineUnit, t0: float, t1: float, phi0: float, dphi: float,
-                    omega0: float, omega1: float) -> StepWork:
+def _trapezoid_work(
+    machine: MachineUnit,
+    t0: float,
+    t1: float,
+    phi0: float,
+    dphi: float,
+    omega0: float,
+    omega1: float,
+) -> StepWork:
     half = 0.5 * dphi
     return StepWork(
         driving=half * (machine.driving_torque(omega0) + machine.driving_torque(omega1)),
@@ -236,8 +243,9 @@ class EnergyFormIntegrator:
         Refinements allowed before :class:`EnergyFormBreakdownError` (``None`` mode).
     """
 
-    def __init__(self, refinements: int | None = None, tolerance: float = 1e-12,
-                 max_iterations: int = 50) -> None:
+    def __init__(
+        self, refinements: int | None = None, tolerance: float = 1e-12, max_iterations: int = 50
+    ) -> None:
         self.refinements = refinements
         self.tolerance = tolerance
         self.max_iterations = max_iterations
@@ -249,8 +257,9 @@ class EnergyFormIntegrator:
         return 1 if self.refinements == 0 else 2
 
     # ------------------------------------------------------------ angle steps
-    def step_angle(self, machine: MachineUnit, t: float, phi: float, omega: float,
-                   dphi: float) -> EnergyStep:
+    def step_angle(
+        self, machine: MachineUnit, t: float, phi: float, omega: float, dphi: float
+    ) -> EnergyStep:
         """One step of angle ``dphi`` (the paper's own form; ``dphi`` has the sign of omega).
 
         Raises
@@ -271,8 +280,9 @@ class EnergyFormIntegrator:
 
         return self._solve(machine, t, phi, omega, kinematics)
 
-    def step_time(self, machine: MachineUnit, t: float, phi: float, omega: float,
-                  dt: float) -> EnergyStep:
+    def step_time(
+        self, machine: MachineUnit, t: float, phi: float, omega: float, dt: float
+    ) -> EnergyStep:
         """One step of time ``dt``: (13) and (16) read backwards give the angle step.
 
         First order: ``dphi = omega_i dt``; refined: ``dphi = (omega_i +
@@ -280,6 +290,7 @@ class EnergyFormIntegrator:
         time form near ``omega = 0`` (module docstring).
         """
         if omega != 0.0:
+
             def kinematics(omega1: float | None) -> tuple[float, float]:
                 if omega1 is None:
                     return omega * dt, t + dt
@@ -292,17 +303,23 @@ class EnergyFormIntegrator:
         return self._time_form(machine, t, phi, omega, dt)
 
     # ------------------------------------------------------------ internals
-    def _first_order(self, machine: MachineUnit, t: float, t1: float, phi: float,
-                     omega: float, dphi: float) -> float:
+    def _first_order(
+        self, machine: MachineUnit, t: float, t1: float, phi: float, omega: float, dphi: float
+    ) -> float:
         """``omega_{i+1}`` by (9)/(15)."""
         i0, i1 = machine.inertia(phi), machine.inertia(phi + dphi)
         energy = 0.5 * i0 * omega * omega
-        gain = (machine.speed_torque(omega) * dphi - machine.angle_work(phi, phi + dphi)
-                - 0.5 * (machine.resistance_time(t) + machine.resistance_time(t1)) * dphi)
+        gain = (
+            machine.speed_torque(omega) * dphi
+            - machine.angle_work(phi, phi + dphi)
+            - 0.5 * (machine.resistance_time(t) + machine.resistance_time(t1)) * dphi
+        )
         slope = machine.speed_torque_slope(omega)
         self.torque_evaluations += 1
-        d_omega = 2.0 * (gain + energy * (math.log(i0) - math.log(i1))) / (
-            2.0 * i0 * omega - slope * dphi
+        d_omega = (
+            2.0
+            * (gain + energy * (math.log(i0) - math.log(i1)))
+            / (2.0 * i0 * omega - slope * dphi)
         )
         if not abs(d_omega) < 0.5 * abs(omega):
             raise EnergyFormBreakdownError(
@@ -311,8 +328,16 @@ class EnergyFormIntegrator:
             )
         return omega + d_omega
 
-    def _correction(self, machine: MachineUnit, t: float, t1: float, phi: float, omega: float,
-                    omega1: float, dphi: float) -> float:
+    def _correction(
+        self,
+        machine: MachineUnit,
+        t: float,
+        t1: float,
+        phi: float,
+        omega: float,
+        omega1: float,
+        dphi: float,
+    ) -> float:
         """``domega*`` by (12)/(18) as regrouped in the module docstring."""
         i1 = machine.inertia(phi + dphi)
         work = _trapezoid_work(machine, t, t1, phi, dphi, omega, omega1)
@@ -321,16 +346,20 @@ class EnergyFormIntegrator:
         if not energy1 > 0.0:
             raise EnergyFormBreakdownError("the kinetic energy would vanish within the step")
         if omega1 != omega:
-            secant = (machine.speed_torque(omega1) - machine.speed_torque(omega)) / (
-                omega1 - omega
-            )
+            secant = (machine.speed_torque(omega1) - machine.speed_torque(omega)) / (omega1 - omega)
         else:
             secant = machine.speed_torque_slope(omega1)
         log_gap = math.log(2.0 * energy1 / (i1 * omega1 * omega1))
         return 2.0 * log_gap * energy1 * omega1 / (4.0 * energy1 - secant * dphi * omega1)
 
-    def _solve(self, machine: MachineUnit, t: float, phi: float, omega: float,
-               kinematics: Callable[[float | None], tuple[float, float]]) -> EnergyStep:
+    def _solve(
+        self,
+        machine: MachineUnit,
+        t: float,
+        phi: float,
+        omega: float,
+        kinematics: Callable[[float | None], tuple[float, float]],
+    ) -> EnergyStep:
         dphi, t1 = kinematics(None)
         omega1 = self._first_order(machine, t, t1, phi, omega, dphi)
         limit = self.max_iterations if self.refinements is None else self.refinements
@@ -352,8 +381,9 @@ class EnergyFormIntegrator:
         work = _trapezoid_work(machine, t, t1, phi, dphi, omega, omega1)
         return EnergyStep(phi + dphi, omega1, t1, work, done if limit else 0)
 
-    def _time_form(self, machine: MachineUnit, t: float, phi: float, omega: float,
-                   dt: float) -> EnergyStep:
+    def _time_form(
+        self, machine: MachineUnit, t: float, phi: float, omega: float, dt: float
+    ) -> EnergyStep:
         """Euler (first-order variant) or Heun (refined variant) in time."""
         acc0 = machine.acceleration(t, phi, omega)
         omega_p, phi_p = omega + dt * acc0, phi + dt * omega
@@ -369,18 +399,25 @@ class EnergyFormIntegrator:
         return EnergyStep(phi1, omega1, t + dt, work, 0, form="time")
 
 
-def _time_work(machine: MachineUnit, t: float, dt: float, phi0: float, phi1: float,
-               omega0: float, omega1: float) -> StepWork:
+def _time_work(
+    machine: MachineUnit,
+    t: float,
+    dt: float,
+    phi0: float,
+    phi1: float,
+    omega0: float,
+    omega1: float,
+) -> StepWork:
     """Works as trapezoids of power in time (the time-form fallback)."""
     half = 0.5 * dt
     return StepWork(
-        driving=half * (machine.driving_torque(omega0) * omega0
-                        + machine.driving_torque(omega1) * omega1),
+        driving=half
+        * (machine.driving_torque(omega0) * omega0 + machine.driving_torque(omega1) * omega1),
         angle=machine.angle_work(phi0, phi1),
-        speed=half * (machine.resistance_speed(omega0) * omega0
-                      + machine.resistance_speed(omega1) * omega1),
-        time=half * (machine.resistance_time(t) * omega0
-                     + machine.resistance_time(t + dt) * omega1),
+        speed=half
+        * (machine.resistance_speed(omega0) * omega0 + machine.resistance_speed(omega1) * omega1),
+        time=half
+        * (machine.resistance_time(t) * omega0 + machine.resistance_time(t + dt) * omega1),
     )
 
 
@@ -424,8 +461,7 @@ class EnergyFormSolver(_FixedStepSolver):
         self.integrator = EnergyFormIntegrator(refinements)
         self.fallbacks = 0
 
-    def _step(self, system: RigidMachineSystem, t: float, x: np.ndarray,
-              h: float) -> np.ndarray:
+    def _step(self, system: RigidMachineSystem, t: float, x: np.ndarray, h: float) -> np.ndarray:
         machine = system.machine(t, x)
         if machine is None:
             return np.array(x, dtype=float)

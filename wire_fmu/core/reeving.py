@@ -193,9 +193,17 @@ class _Problems:
     def add(self, where: str, text: str) -> None:
         self.items.append(f"{where}: {text}")
 
-    def number(self, data: Mapping, key: str, where: str, default: Any = None, *,
-               positive: bool = False, nonnegative: bool = False,
-               at_most: float | None = None) -> float:
+    def number(
+        self,
+        data: Mapping,
+        key: str,
+        where: str,
+        default: Any = None,
+        *,
+        positive: bool = False,
+        nonnegative: bool = False,
+        at_most: float | None = None,
+    ) -> float:
         value = data.get(key, default)
         if value is None:
             self.add(where, f"'{key}' is required")
@@ -215,8 +223,9 @@ class _Problems:
             self.add(where, f"'{key}' must be <= {at_most:g}, got {value:g}")
         return value
 
-    def vector(self, data: Mapping, key: str, where: str, default: Any = None, *,
-               unit: bool = False) -> Vector:
+    def vector(
+        self, data: Mapping, key: str, where: str, default: Any = None, *, unit: bool = False
+    ) -> Vector:
         value = data.get(key, default)
         try:
             vec = tuple(float(c) for c in value)
@@ -245,8 +254,17 @@ def parse_reeving(data: Mapping[str, Any]) -> Reeving:
     p = _Problems()
     if not isinstance(data, Mapping):
         raise ConfigurationError("reeving", [f"must be a mapping, got {type(data).__name__}"])
-    known = {"rope", "gravity", "bodies", "sheaves", "anchors", "path", "max_fleet_angle_deg",
-             "name", "description"}
+    known = {
+        "rope",
+        "gravity",
+        "bodies",
+        "sheaves",
+        "anchors",
+        "path",
+        "max_fleet_angle_deg",
+        "name",
+        "description",
+    }
     for key in data:
         if key not in known:
             p.add("reeving", f"unknown key {key!r}; known keys: {', '.join(sorted(known))}")
@@ -323,8 +341,11 @@ def _check_carriers(bodies: dict[str, Body], data: Mapping, p: _Problems) -> Non
         if carrier is None:
             p.add(where, f"'on' names {body.on!r}, which is not a body")
         elif carrier.kind != "driven":
-            p.add(where, f"'on' must name a driven body (its motion is an input), "
-                  f"{body.on!r} is a {carrier.kind}")
+            p.add(
+                where,
+                f"'on' must name a driven body (its motion is an input), "
+                f"{body.on!r} is a {carrier.kind}",
+            )
         seen, current = {name}, body.on
         while current in bodies and current != "ground":
             if current in seen:
@@ -334,8 +355,10 @@ def _check_carriers(bodies: dict[str, Body], data: Mapping, p: _Problems) -> Non
             current = bodies[current].on
     for name, spec in data.items():
         if isinstance(spec, Mapping) and spec.get("kind") == "block" and "on" in spec:
-            p.add(f"body {name!r}", "a block moves in the inertial frame; it cannot ride "
-                  "on another body")
+            p.add(
+                f"body {name!r}",
+                "a block moves in the inertial frame; it cannot ride on another body",
+            )
 
 
 def _parse_floor(data: Any, where: str, p: _Problems) -> Floor | None:

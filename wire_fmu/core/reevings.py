@@ -17,8 +17,14 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["drilling_line", "drilling_block_train", "heave_compensated_block_train",
-           "single_fall", "riser_tensioner", "tensioner_line"]
+__all__ = [
+    "drilling_line",
+    "drilling_block_train",
+    "heave_compensated_block_train",
+    "single_fall",
+    "riser_tensioner",
+    "tensioner_line",
+]
 
 GRAVITY = (0.0, -9.81, 0.0)
 
@@ -73,11 +79,13 @@ def drilling_block_train(
     sheaves: dict[str, dict[str, Any]] = {}
     path: list[dict[str, Any]] = [{"line_end": "line_a", "point": [-radius, 0.0, 0.0]}]
     for i in range(n_lines // 2 + 1):
-        sheaves[f"crown_{i}"] = _sheave("ground", 4 * i * radius, crown_height, radius,
-                                        inertia, efficiency)
+        sheaves[f"crown_{i}"] = _sheave(
+            "ground", 4 * i * radius, crown_height, radius, inertia, efficiency
+        )
     for i in range(n_lines // 2):
-        sheaves[f"travel_{i}"] = _sheave("travelling_block", (4 * i + 2) * radius, block_height,
-                                         radius, inertia, efficiency)
+        sheaves[f"travel_{i}"] = _sheave(
+            "travelling_block", (4 * i + 2) * radius, block_height, radius, inertia, efficiency
+        )
     for i in range(n_lines // 2):
         path.append({"sheave": f"crown_{i}", "wrap": "cw"})
         path.append({"sheave": f"travel_{i}", "wrap": "ccw"})
@@ -98,8 +106,9 @@ def drilling_block_train(
         "gravity": list(GRAVITY),
         "bodies": {"travelling_block": block},
         "sheaves": sheaves,
-        "anchors": {"deadline": {"body": "ground",
-                                 "point": [(2 * n_lines) * radius + radius, 0.0, 0.0]}},
+        "anchors": {
+            "deadline": {"body": "ground", "point": [(2 * n_lines) * radius + radius, 0.0, 0.0]}
+        },
         "path": path,
     }
 
@@ -116,10 +125,13 @@ def heave_compensated_block_train(n_lines: int = 10, **kwargs: Any) -> dict[str,
     """
     reeving = drilling_block_train(n_lines, **kwargs)
     reeving["name"] = f"{n_lines}-line block train with crown-mounted heave compensator"
-    reeving["bodies"]["deck"] = {"kind": "driven", "direction": [0.0, 1.0, 0.0],
-                                 "port": "mover_b"}
-    reeving["bodies"]["crown"] = {"kind": "driven", "direction": [0.0, 1.0, 0.0],
-                                  "port": "mover_a", "on": "deck"}
+    reeving["bodies"]["deck"] = {"kind": "driven", "direction": [0.0, 1.0, 0.0], "port": "mover_b"}
+    reeving["bodies"]["crown"] = {
+        "kind": "driven",
+        "direction": [0.0, 1.0, 0.0],
+        "port": "mover_a",
+        "on": "deck",
+    }
     for name, sheave in reeving["sheaves"].items():
         if name.startswith("crown"):
             sheave["body"] = "crown"
@@ -132,8 +144,7 @@ def tensioner_line() -> dict[str, float]:
     """A 2-1/4 in (57 mm) 6x41 IWRC tensioner wire: EA about 1.3e8 N, MBL about 2.8 MN,
     about 13.5 kg/m (manufacturers' tables for 2-1/4 in 6x36/6x41 IWRC); damping for a few
     per cent of critical damping of the line spans."""
-    return {"axial_stiffness": 1.3e8, "damping": 2.0e5, "breaking_load": 2.8e6,
-            "linear_mass": 13.5}
+    return {"axial_stiffness": 1.3e8, "damping": 2.0e5, "breaking_load": 2.8e6, "linear_mass": 13.5}
 
 
 def riser_tensioner(
@@ -174,8 +185,13 @@ def riser_tensioner(
         Tension ratio across one moving sheave, 1.
     """
     r = radius
-    sheave = {"radius": r, "axis": [0.0, 0.0, 1.0], "inertia": inertia,
-              "efficiency": efficiency, "groove_friction": 0.1}
+    sheave = {
+        "radius": r,
+        "axis": [0.0, 0.0, 1.0],
+        "inertia": inertia,
+        "efficiency": efficiency,
+        "groove_friction": 0.1,
+    }
     sheaves = {
         "moving_1": {**sheave, "body": "rod", "centre": [1 * r, cluster_gap, 0.0]},
         "fixed_1": {**sheave, "body": "ground", "centre": [3 * r, 0.0, 0.0]},
@@ -209,8 +225,12 @@ def riser_tensioner(
 
 
 def single_fall(
-    *, mass: float = 1000.0, length: float = 10.0, axial_stiffness: float = 1.0e7,
-    damping: float = 0.0, line_end: bool = True,
+    *,
+    mass: float = 1000.0,
+    length: float = 10.0,
+    axial_stiffness: float = 1.0e7,
+    damping: float = 0.0,
+    line_end: bool = True,
 ) -> dict[str, Any]:
     """One vertical rope from a line end (or anchor) at the top to a hanging block.
 
@@ -222,17 +242,27 @@ def single_fall(
         "name": "single fall",
         "rope": {"axial_stiffness": axial_stiffness, "damping": damping},
         "gravity": list(GRAVITY),
-        "bodies": {"load": {"kind": "block", "mass": mass, "direction": [0.0, 1.0, 0.0],
-                            "position": 0.0, "port": "block_a"}},
+        "bodies": {
+            "load": {
+                "kind": "block",
+                "mass": mass,
+                "direction": [0.0, 1.0, 0.0],
+                "position": 0.0,
+                "port": "block_a",
+            }
+        },
         "sheaves": {},
-        "anchors": {"top": {"body": "ground", "point": [0.0, length, 0.0]},
-                    "hook": {"body": "load", "point": [0.0, 0.0, 0.0]}},
+        "anchors": {
+            "top": {"body": "ground", "point": [0.0, length, 0.0]},
+            "hook": {"body": "load", "point": [0.0, 0.0, 0.0]},
+        },
         "path": [top, {"anchor": "hook"}],
     }
 
 
-def _sheave(body: str, x: float, y: float, radius: float, inertia: float,
-            efficiency: float) -> dict[str, Any]:
+def _sheave(
+    body: str, x: float, y: float, radius: float, inertia: float, efficiency: float
+) -> dict[str, Any]:
     return {
         "body": body,
         "centre": [x, y, 0.0],

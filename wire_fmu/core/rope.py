@@ -175,8 +175,9 @@ def rope_forces(
     strain_rate = t_el * np.asarray(length_rate) - t_el * (1.0 + 0.5 * eps) * np.asarray(
         unstretched_rate
     )
-    loss = np.where(on, t_d * small_l * eps_rate,
-                    np.where(relaxing, np.maximum(-strain_rate, 0.0), 0.0))
+    loss = np.where(
+        on, t_d * small_l * eps_rate, np.where(relaxing, np.maximum(-strain_rate, 0.0), 0.0)
+    )
     return RopeForces(
         tension,
         tension,

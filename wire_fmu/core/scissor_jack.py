@@ -116,8 +116,12 @@ HANDLE_DRIVES = ("speed", "torque")
 """How the handle is driven: kinematically by a speed, or by a torque."""
 
 THREAD_FREE, THREAD_SLIDING, THREAD_STUCK, THREAD_CREEPING = 0, 1, 2, 3
-_STATE_WORDS = {THREAD_FREE: "frictionless", THREAD_SLIDING: "sliding",
-                THREAD_STUCK: "stuck", THREAD_CREEPING: "creeping (regularised)"}
+_STATE_WORDS = {
+    THREAD_FREE: "frictionless",
+    THREAD_SLIDING: "sliding",
+    THREAD_STUCK: "stuck",
+    THREAD_CREEPING: "creeping (regularised)",
+}
 
 
 # ============================================================== geometry
@@ -174,11 +178,15 @@ class JackGeometry:
         for name in ("min_height", "initial_height", "max_height"):
             value = getattr(self, name)
             if not (0.0 < value < two_l):
-                out.append(f"{name} must lie strictly between 0 and twice the rod length "
-                           f"({two_l:.6g} m), got {value}")
+                out.append(
+                    f"{name} must lie strictly between 0 and twice the rod length "
+                    f"({two_l:.6g} m), got {value}"
+                )
         if not out and not self.min_height <= self.initial_height <= self.max_height:
-            out.append(f"initial_height {self.initial_height} m must lie within the travel "
-                       f"[{self.min_height}, {self.max_height}] m")
+            out.append(
+                f"initial_height {self.initial_height} m must lie within the travel "
+                f"[{self.min_height}, {self.max_height}] m"
+            )
         return out
 
 
@@ -256,11 +264,14 @@ class JackConfig:
             if not (value > 0.0 and math.isfinite(value)):
                 out.append(f"{name} must be a positive number, got {value}")
         if self.friction not in FRICTION_MODELS:
-            out.append(f"thread friction model {self.friction!r} is unknown; choose one of "
-                       f"{', '.join(FRICTION_MODELS)}")
+            out.append(
+                f"thread friction model {self.friction!r} is unknown; choose one of "
+                f"{', '.join(FRICTION_MODELS)}"
+            )
         if self.drive not in HANDLE_DRIVES:
-            out.append(f"handle drive {self.drive!r} is unknown; choose one of "
-                       f"{', '.join(HANDLE_DRIVES)}")
+            out.append(
+                f"handle drive {self.drive!r} is unknown; choose one of {', '.join(HANDLE_DRIVES)}"
+            )
         if not math.isfinite(self.initial_speed):
             out.append(f"initial handle speed must be finite, got {self.initial_speed}")
         if out or self.friction == "none":
@@ -272,7 +283,8 @@ class JackConfig:
                 f"handle_inertia {self.handle_inertia} kg m^2 is too light for lowering at "
                 f"min_height {self.geometry.min_height} m: the effective inertia while the "
                 f"thread slides down vanishes (Painleve's paradox of dry friction); use more "
-                f"than {need:.4g} kg m^2 or raise min_height")
+                f"than {need:.4g} kg m^2 or raise min_height"
+            )
         return out
 
 
@@ -293,9 +305,14 @@ class JackInputs:
 
     def problems(self) -> list[str]:
         """Non-finite commands."""
-        return [f"input {name} is not finite ({value})" for name, value in (
-            ("handle.speed_command", self.speed_command),
-            ("handle.torque_command", self.torque_command)) if not math.isfinite(value)]
+        return [
+            f"input {name} is not finite ({value})"
+            for name, value in (
+                ("handle.speed_command", self.speed_command),
+                ("handle.torque_command", self.torque_command),
+            )
+            if not math.isfinite(value)
+        ]
 
 
 @dataclass(frozen=True)
@@ -349,8 +366,9 @@ class ScissorJackModel:
         self.h = config.thread.lead_per_radian
         self.r_mu = config.thread.mean_radius * config.thread.friction
         self.exact = config.friction == "stick_slip"
-        self.friction = StickSlip(np.array([config.handle_inertia]),
-                                  (FrictionLink("screw thread", 0, GROUND),))
+        self.friction = StickSlip(
+            np.array([config.handle_inertia]), (FrictionLink("screw thread", 0, GROUND),)
+        )
         self.inputs = JackInputs()
         self.state = np.zeros(4)
         self.solver = make_solver(settings)
@@ -401,7 +419,8 @@ class ScissorJackModel:
         raise ModelError(
             f"scissor jack: no consistent motion at psi = {psi:.6g} rad, speed {omega:.6g} "
             f"rad/s, handle torque {torque:.6g} N m (dry friction without a solution: "
-            "Painleve's paradox); a heavier handle_inertia avoids it")
+            "Painleve's paradox); a heavier handle_inertia avoids it"
+        )
 
     def _torque_driven(self, x: np.ndarray) -> _Forces:
         """Acceleration and forces under the torque command in the current mode."""
@@ -462,8 +481,9 @@ class ScissorJackModel:
         omega = float(x[1])
         if self._stuck():
             omega = 0.0
-        return np.array([omega, f.acceleration, -f.friction_torque * omega,
-                         f.handle_torque * omega])
+        return np.array(
+            [omega, f.acceleration, -f.friction_torque * omega, f.handle_torque * omega]
+        )
 
     def guard_directions(self) -> np.ndarray:
         """The thread's stick/slip guard fires on a downward crossing."""
@@ -474,8 +494,9 @@ class ScissorJackModel:
         if not self._has_modes():
             return np.zeros(0)
         f = self.forces(x)
-        return self.friction.guards(np.array([x[1]]), np.array([f.friction_torque]),
-                                    self._capacity(float(x[0])))
+        return self.friction.guards(
+            np.array([x[1]]), np.array([f.friction_torque]), self._capacity(float(x[0]))
+        )
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
         """The thread sticks or breaks away."""
@@ -519,8 +540,11 @@ class ScissorJackModel:
         after = self.thread_state(x)
         if after != before or fired:
             self.mode_changes += 1
-            self._event(t, f"thread {_STATE_WORDS[after]} at handle torque "
-                           f"{self.inputs.torque_command:.6g} N m")
+            self._event(
+                t,
+                f"thread {_STATE_WORDS[after]} at handle torque "
+                f"{self.inputs.torque_command:.6g} N m",
+            )
         return self.project(x)
 
     def _event(self, t: float, text: str) -> None:
@@ -531,8 +555,7 @@ class ScissorJackModel:
     def initialize(self, t0: float, inputs: JackInputs) -> None:
         """Start at ``psi = 0``: at rest (or ``initial_speed``), or at the commanded speed."""
         self.inputs = inputs
-        speed = (inputs.speed_command if self.config.drive == "speed"
-                 else self.config.initial_speed)
+        speed = inputs.speed_command if self.config.drive == "speed" else self.config.initial_speed
         x = np.array([0.0, speed, 0.0, 0.0])
         self.mode_changes = 0
         self.last_events = []
@@ -563,8 +586,10 @@ class ScissorJackModel:
         geometry = self.config.geometry
         height = self.height(float(x[0]))
         if not geometry.min_height <= height <= geometry.max_height:
-            raise ModelError(f"the shoe would reach {height:.6g} m, outside the jack's travel "
-                             f"[{geometry.min_height}, {geometry.max_height}] m (end of travel)")
+            raise ModelError(
+                f"the shoe would reach {height:.6g} m, outside the jack's travel "
+                f"[{geometry.min_height}, {geometry.max_height}] m (end of travel)"
+            )
         self.state = x
         return events
 
@@ -610,8 +635,14 @@ class ScissorJackModel:
     @contextmanager
     def trial(self, inputs: JackInputs) -> Iterator[np.ndarray]:
         """The state as it would start a step with ``inputs``; undone on exit."""
-        saved = (self.inputs, self.friction.get_mode(), self.mode_changes,
-                 list(self.last_events), self._held_angle, self.state.copy())
+        saved = (
+            self.inputs,
+            self.friction.get_mode(),
+            self.mode_changes,
+            list(self.last_events),
+            self._held_angle,
+            self.state.copy(),
+        )
         try:
             self.inputs = inputs
             x = np.array(self.state, dtype=float)
@@ -621,8 +652,14 @@ class ScissorJackModel:
                 x = self._settle(0.0, x, [])
             yield x
         finally:
-            (self.inputs, mode, self.mode_changes, self.last_events, self._held_angle,
-             self.state) = saved
+            (
+                self.inputs,
+                mode,
+                self.mode_changes,
+                self.last_events,
+                self._held_angle,
+                self.state,
+            ) = saved
             self.friction.set_mode(mode)
 
     def get_state(self) -> dict[str, Any]:

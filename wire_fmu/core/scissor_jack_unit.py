@@ -51,10 +51,16 @@ from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["ScissorJackUnit", "JACK_EFFECTS"]
 
-JACK_EFFECTS = EffectCatalogue("ScissorJack", (
-    Effect("thread_friction", "frictionless thread",
-           "dry friction r_mean mu |F| in the thread (friction_model)"),
-))
+JACK_EFFECTS = EffectCatalogue(
+    "ScissorJack",
+    (
+        Effect(
+            "thread_friction",
+            "frictionless thread",
+            "dry friction r_mean mu |F| in the thread (friction_model)",
+        ),
+    ),
+)
 
 _INPUTS = ("handle.speed_command", "handle.torque_command")
 _SPEED = ("handle.speed_command",)
@@ -64,46 +70,98 @@ RK4_STABILITY = 2.5
 
 def _parameters():
     return (
-        parameter("effects", "", "", "Effects to include, comma separated: "
-                  + ", ".join(JACK_EFFECTS.names), type=str),
-        parameter("handle_drive", "speed", "", "How the handle is driven: 'speed' "
-                  "(kinematically, input handle.speed_command) or 'torque' (input "
-                  "handle.torque_command)", type=str),
-        parameter("friction_model", "stick_slip", "", "Thread friction with thread_friction: "
-                  "stick_slip (exact), linear (paper 003's regularised form) or tanh", type=str),
+        parameter(
+            "effects",
+            "",
+            "",
+            "Effects to include, comma separated: " + ", ".join(JACK_EFFECTS.names),
+            type=str,
+        ),
+        parameter(
+            "handle_drive",
+            "speed",
+            "",
+            "How the handle is driven: 'speed' "
+            "(kinematically, input handle.speed_command) or 'torque' (input "
+            "handle.torque_command)",
+            type=str,
+        ),
+        parameter(
+            "friction_model",
+            "stick_slip",
+            "",
+            "Thread friction with thread_friction: "
+            "stick_slip (exact), linear (paper 003's regularised form) or tanh",
+            type=str,
+        ),
         parameter("rod_length", 0.130, "m", "Tie rod length (paper 003: 130 mm)", min=0.0),
-        parameter("initial_height", 0.130, "m", "Shoe height at the start (paper 003: 130 mm, "
-                  "rods at 30 deg)", min=0.0),
+        parameter(
+            "initial_height",
+            0.130,
+            "m",
+            "Shoe height at the start (paper 003: 130 mm, rods at 30 deg)",
+            min=0.0,
+        ),
         parameter("min_height", 0.04, "m", "Lowest shoe height (end of travel)", min=0.0),
         parameter("max_height", 0.25, "m", "Highest shoe height (end of travel)", min=0.0),
-        parameter("thread_lead", 0.002, "m", "Screw travel per turn (paper 003: 2 mm)",
-                  min=0.0),
-        parameter("thread_mean_radius", 0.01, "m", "Mean thread radius (paper 003: 0.01 m)",
-                  min=0.0),
-        parameter("thread_friction", 0.1, "1", "Thread friction coefficient (paper 003: 0.1, "
-                  "steel on steel)", min=0.0),
-        parameter("friction_speed_scale", 1.0e-6, "rad/s", "w1 of the regularised friction "
-                  "models (paper 003: 1e-6 rad/s)", min=0.0),
-        parameter("load_mass", 306.0, "kg", "Mass of the shoe with the load (paper 003: 306 kg)",
-                  min=0.0),
-        parameter("load_weight", 3000.0, "N", "Weight on the shoe (paper 003: 3000 N)",
-                  min=0.0),
-        parameter("handle_inertia", 5.0e-3, "kg.m2", "Inertia of screw and handle about the "
-                  "screw axis (estimate: 20 mm x 350 mm steel screw 4e-5 plus a 0.25 kg crank "
-                  "at 0.14 m, 4.9e-3)", min=0.0),
-        parameter("initial_handle_speed", 0.0, "rad/s", "Handle speed at the start with a "
-                  "torque drive"),
-        *solver_parameters("rk4", 2.0e-3, rtol=1e-8, atol=1e-12,
-                           note="the regularised friction models are stiff: radau"),
+        parameter("thread_lead", 0.002, "m", "Screw travel per turn (paper 003: 2 mm)", min=0.0),
+        parameter(
+            "thread_mean_radius", 0.01, "m", "Mean thread radius (paper 003: 0.01 m)", min=0.0
+        ),
+        parameter(
+            "thread_friction",
+            0.1,
+            "1",
+            "Thread friction coefficient (paper 003: 0.1, steel on steel)",
+            min=0.0,
+        ),
+        parameter(
+            "friction_speed_scale",
+            1.0e-6,
+            "rad/s",
+            "w1 of the regularised friction models (paper 003: 1e-6 rad/s)",
+            min=0.0,
+        ),
+        parameter(
+            "load_mass", 306.0, "kg", "Mass of the shoe with the load (paper 003: 306 kg)", min=0.0
+        ),
+        parameter("load_weight", 3000.0, "N", "Weight on the shoe (paper 003: 3000 N)", min=0.0),
+        parameter(
+            "handle_inertia",
+            5.0e-3,
+            "kg.m2",
+            "Inertia of screw and handle about the "
+            "screw axis (estimate: 20 mm x 350 mm steel screw 4e-5 plus a 0.25 kg crank "
+            "at 0.14 m, 4.9e-3)",
+            min=0.0,
+        ),
+        parameter(
+            "initial_handle_speed", 0.0, "rad/s", "Handle speed at the start with a torque drive"
+        ),
+        *solver_parameters(
+            "rk4",
+            2.0e-3,
+            rtol=1e-8,
+            atol=1e-12,
+            note="the regularised friction models are stiff: radau",
+        ),
     )
 
 
 def _inputs():
     return (
-        input_("handle.speed_command", 0.0, "rad/s", "Handle speed with handle_drive 'speed', "
-               "positive lifts"),
-        input_("handle.torque_command", 0.0, "N.m", "Handle torque with handle_drive 'torque', "
-               "positive lifts"),
+        input_(
+            "handle.speed_command",
+            0.0,
+            "rad/s",
+            "Handle speed with handle_drive 'speed', positive lifts",
+        ),
+        input_(
+            "handle.torque_command",
+            0.0,
+            "N.m",
+            "Handle torque with handle_drive 'torque', positive lifts",
+        ),
     )
 
 
@@ -112,28 +170,55 @@ def _outputs():
     return (
         output("handle.angle", "rad", "Handle (screw) angle relative to the nut since the start"),
         output("handle.speed", "rad/s", "Handle speed", depends_on=_SPEED),
-        output("handle.torque", "N.m", "Torque on the handle: the command, or the torque the "
-               "speed drive must supply", depends_on=both),
+        output(
+            "handle.torque",
+            "N.m",
+            "Torque on the handle: the command, or the torque the speed drive must supply",
+            depends_on=both,
+        ),
         output("load.height", "m", "Shoe height above the base joint"),
         output("load.velocity", "m/s", "Shoe velocity, positive up", depends_on=_SPEED),
         output("rod_angle", "rad", "Tie rod angle to the horizontal"),
         output("screw.travel", "m", "Screw travel through the nut since the start"),
-        output("screw.displacement", "m", "Horizontal displacement of the screw's centre of "
-               "mass since the start"),
+        output(
+            "screw.displacement",
+            "m",
+            "Horizontal displacement of the screw's centre of mass since the start",
+        ),
         output("screw.axial_force", "N", "Axial force in the thread", depends_on=both),
-        output("thread.lead_torque", "N.m", "Torque h F of the axial force about the screw axis",
-               depends_on=both),
-        output("thread.friction_torque", "N.m", "Thread friction torque on the screw (opposes "
-               "its rotation relative to the nut)", depends_on=both),
-        output("thread.state", "", "Thread: 0 frictionless, 1 sliding, 2 stuck, 3 creeping "
-               "(regularised)", type=int, depends_on=both),
-        output("stored_energy", "J", "Kinetic energy of handle and load plus W times height",
-               depends_on=_SPEED),
+        output(
+            "thread.lead_torque",
+            "N.m",
+            "Torque h F of the axial force about the screw axis",
+            depends_on=both,
+        ),
+        output(
+            "thread.friction_torque",
+            "N.m",
+            "Thread friction torque on the screw (opposes its rotation relative to the nut)",
+            depends_on=both,
+        ),
+        output(
+            "thread.state",
+            "",
+            "Thread: 0 frictionless, 1 sliding, 2 stuck, 3 creeping (regularised)",
+            type=int,
+            depends_on=both,
+        ),
+        output(
+            "stored_energy",
+            "J",
+            "Kinetic energy of handle and load plus W times height",
+            depends_on=_SPEED,
+        ),
         output("dissipated_energy", "J", "Energy dissipated by the thread friction"),
-        output("external_work", "J", "Work done on the jack through the handle",
-               depends_on=_SPEED),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work", depends_on=_SPEED),
+        output("external_work", "J", "Work done on the jack through the handle", depends_on=_SPEED),
+        output(
+            "energy_balance",
+            "J",
+            "Ledger residual: stored change + dissipated - external work",
+            depends_on=_SPEED,
+        ),
         output("mode_changes", "", "Number of thread stick/slip events so far", type=int),
     )
 
@@ -206,8 +291,11 @@ class ScissorJackUnit(Unit):
     # ---------------------------------------------------------------- state
     def get_state(self) -> dict[str, Any]:
         """Complete state: the model's, time and the ledger's start."""
-        return {**self._require_model().get_state(), "time": float(self.time),
-                "initial_energy": float(self.initial_energy)}
+        return {
+            **self._require_model().get_state(),
+            "time": float(self.time),
+            "initial_energy": float(self.initial_energy),
+        }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`."""
@@ -223,8 +311,9 @@ class ScissorJackUnit(Unit):
         return self.model
 
     def _inputs(self) -> JackInputs:
-        return JackInputs(float(self.values["handle.speed_command"]),
-                          float(self.values["handle.torque_command"]))
+        return JackInputs(
+            float(self.values["handle.speed_command"]), float(self.values["handle.torque_command"])
+        )
 
     def _config(self, effects: frozenset[str], problems: list[str]) -> JackConfig:
         v = self.values
@@ -232,21 +321,37 @@ class ScissorJackUnit(Unit):
         if "thread_friction" in effects:
             friction = str(v["friction_model"])
             if friction not in FRICTION_MODELS or friction == "none":
-                problems.append(f"parameter 'friction_model' must be one of stick_slip, "
-                                f"{', '.join(REGULARISATIONS)}; got {friction!r}")
+                problems.append(
+                    f"parameter 'friction_model' must be one of stick_slip, "
+                    f"{', '.join(REGULARISATIONS)}; got {friction!r}"
+                )
                 friction = "stick_slip"
         drive = str(v["handle_drive"])
         if drive not in HANDLE_DRIVES:
-            problems.append(f"parameter 'handle_drive' must be one of {', '.join(HANDLE_DRIVES)}"
-                            f"; got {drive!r}")
+            problems.append(
+                f"parameter 'handle_drive' must be one of {', '.join(HANDLE_DRIVES)}; got {drive!r}"
+            )
             drive = "speed"
-        geometry = JackGeometry(float(v["rod_length"]), float(v["initial_height"]),
-                                float(v["min_height"]), float(v["max_height"]))
-        thread = ScrewThread(float(v["thread_lead"]), float(v["thread_mean_radius"]),
-                             float(v["thread_friction"]))
-        return JackConfig(geometry, thread, float(v["load_mass"]), float(v["load_weight"]),
-                          float(v["handle_inertia"]), friction, float(v["friction_speed_scale"]),
-                          drive, float(v["initial_handle_speed"]))
+        geometry = JackGeometry(
+            float(v["rod_length"]),
+            float(v["initial_height"]),
+            float(v["min_height"]),
+            float(v["max_height"]),
+        )
+        thread = ScrewThread(
+            float(v["thread_lead"]), float(v["thread_mean_radius"]), float(v["thread_friction"])
+        )
+        return JackConfig(
+            geometry,
+            thread,
+            float(v["load_mass"]),
+            float(v["load_weight"]),
+            float(v["handle_inertia"]),
+            friction,
+            float(v["friction_speed_scale"]),
+            drive,
+            float(v["initial_handle_speed"]),
+        )
 
     def _settings(self, problems: list[str]) -> SolverSettings:
         settings, solver_problems = solver_settings(self.values)
@@ -272,8 +377,9 @@ class ScissorJackUnit(Unit):
         out["stored_energy"] = r.stored_energy
         out["dissipated_energy"] = r.dissipated_energy
         out["external_work"] = r.external_work
-        out["energy_balance"] = (r.stored_energy - self.initial_energy + r.dissipated_energy
-                                 - r.external_work)
+        out["energy_balance"] = (
+            r.stored_energy - self.initial_energy + r.dissipated_energy - r.external_work
+        )
         out["mode_changes"] = int(model.mode_changes)
         reals = (r.height, r.handle_speed, r.handle_torque, r.axial_force, r.stored_energy)
         if not all(math.isfinite(value) for value in reals):
@@ -293,9 +399,11 @@ def _stability_problems(config: JackConfig, max_step: float) -> list[str]:
         rate = max(rate, capacity / (config.speed_scale * inertia))
     if rate * max_step < RK4_STABILITY:
         return []
-    return [f"parameter 'solver': rk4 with steps of {max_step:.3g} s is unstable for the "
-            f"regularised thread friction (stiffness about {rate:.3g} 1/s = M1 / (I w1)); "
-            f"choose 'radau' (or 'ros2'), or solver_max_step below {RK4_STABILITY / rate:.3g} s"]
+    return [
+        f"parameter 'solver': rk4 with steps of {max_step:.3g} s is unstable for the "
+        f"regularised thread friction (stiffness about {rate:.3g} 1/s = M1 / (I w1)); "
+        f"choose 'radau' (or 'ros2'), or solver_max_step below {RK4_STABILITY / rate:.3g} s"
+    ]
 
 
 class _JackOde(ModelOdeView):

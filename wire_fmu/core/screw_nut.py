@@ -83,10 +83,12 @@ def _linear_inverse(x: float) -> float:
 
 
 REGULARISATIONS: Mapping[str, tuple[Callable[[float], float], Callable[[float], float]]] = (
-    MappingProxyType({
-        "linear": (_linear_saturated, _linear_inverse),  # paper 003, Fig. 7
-        "tanh": (math.tanh, math.atanh),
-    })
+    MappingProxyType(
+        {
+            "linear": (_linear_saturated, _linear_inverse),  # paper 003, Fig. 7
+            "tanh": (math.tanh, math.atanh),
+        }
+    )
 )
 """Regularised friction shapes ``s(w / w1)`` and the inverse used for creep speeds."""
 
@@ -130,8 +132,9 @@ class ScrewThread:
         """Whether no axial load can back-drive the thread (``h < r_mean mu``)."""
         return self.lead_per_radian < self.mean_radius * self.friction
 
-    def regularised_torque(self, relative_speed: float, axial_force: float, speed_scale: float,
-                           shape: str = "linear") -> float:
+    def regularised_torque(
+        self, relative_speed: float, axial_force: float, speed_scale: float, shape: str = "linear"
+    ) -> float:
         """The paper's regularised friction torque on the nut, N m (opposes ``relative_speed``).
 
         Parameters
@@ -148,8 +151,9 @@ class ScrewThread:
         s, _ = REGULARISATIONS[shape]
         return -self.friction_capacity(axial_force) * s(relative_speed / speed_scale)
 
-    def creep_speed(self, held_torque: float, axial_force: float, speed_scale: float,
-                    shape: str = "linear") -> float:
+    def creep_speed(
+        self, held_torque: float, axial_force: float, speed_scale: float, shape: str = "linear"
+    ) -> float:
         """Steady creep speed of a regularised thread holding ``held_torque`` (N m), rad/s.
 
         The speed at which the regularised torque balances the torque that
@@ -177,30 +181,35 @@ class ScrewThread:
 # ============================================================== rigid bodies
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of two 3-vectors (``numpy.cross`` costs ~50 us a call)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
 
 
 def rotation_from_quaternion(q: np.ndarray) -> np.ndarray:
     """Rotation matrix of a unit quaternion ``[w, x, y, z]`` (normalised here)."""
     w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _quaternion_rate(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """``dq/dt`` for angular velocity ``omega`` in the world frame."""
     w, x, y, z = q
     ox, oy, oz = omega
-    return 0.5 * np.array([  # [0, omega] * q: omega in the world frame
-        -x * ox - y * oy - z * oz,
-        w * ox + oy * z - oz * y,
-        w * oy + oz * x - ox * z,
-        w * oz + ox * y - oy * x,
-    ])
+    return 0.5 * np.array(
+        [  # [0, omega] * q: omega in the world frame
+            -x * ox - y * oy - z * oz,
+            w * ox + oy * z - oz * y,
+            w * oy + oz * x - ox * z,
+            w * oz + ox * y - oy * x,
+        ]
+    )
 
 
 def _rotate_quaternion(q: np.ndarray, rotation_vector: np.ndarray) -> np.ndarray:
@@ -212,12 +221,14 @@ def _rotate_quaternion(q: np.ndarray, rotation_vector: np.ndarray) -> np.ndarray
     half = 0.5 * angle
     dw, (dx, dy, dz) = math.cos(half), math.sin(half) * axis
     w, x, y, z = q
-    out = np.array([
-        dw * w - dx * x - dy * y - dz * z,
-        dw * x + dx * w + dy * z - dz * y,
-        dw * y - dx * z + dy * w + dz * x,
-        dw * z + dx * y - dy * x + dz * w,
-    ])
+    out = np.array(
+        [
+            dw * w - dx * x - dy * y - dz * z,
+            dw * x + dx * w + dy * z - dz * y,
+            dw * y - dx * z + dy * w + dz * x,
+            dw * z + dx * y - dy * x + dz * w,
+        ]
+    )
     return out / np.linalg.norm(out)
 
 
@@ -269,13 +280,18 @@ class BodyState:
     @classmethod
     def at_rest(cls, position=(0.0, 0.0, 0.0), quaternion=(1.0, 0.0, 0.0, 0.0)) -> BodyState:
         """A body at ``position`` with orientation ``quaternion``, not moving."""
-        return cls(np.array(position, dtype=float), np.array(quaternion, dtype=float),
-                   np.zeros(3), np.zeros(3))
+        return cls(
+            np.array(position, dtype=float),
+            np.array(quaternion, dtype=float),
+            np.zeros(3),
+            np.zeros(3),
+        )
 
     def pack(self) -> np.ndarray:
         """``[position, quaternion, velocity, angular velocity]``, shape (13,)."""
-        return np.concatenate([self.position, self.quaternion, self.velocity,
-                               self.angular_velocity])
+        return np.concatenate(
+            [self.position, self.quaternion, self.velocity, self.angular_velocity]
+        )
 
     @classmethod
     def unpack(cls, y: np.ndarray) -> BodyState:
@@ -323,8 +339,9 @@ class ScrewNutJoint:
 
     N_CONSTRAINTS = 5
 
-    def __init__(self, thread: ScrewThread, point, axis, state_1: BodyState,
-                 state_2: BodyState) -> None:
+    def __init__(
+        self, thread: ScrewThread, point, axis, state_1: BodyState, state_2: BodyState
+    ) -> None:
         self.thread = thread
         self.h = thread.lead_per_radian
         axis = np.asarray(axis, dtype=float)
@@ -377,12 +394,14 @@ class ScrewNutJoint:
             g[row, 3:6] = -_cross(r1, d) + self.h * (d @ c) * c
             g[row, 6:9] = d
             g[row, 9:12] = _cross(r2, d) - self.h * (d @ c) * c
-        u = (s2.velocity + _cross(w2, r2)) - (s1.velocity + _cross(w1, r1)) \
-            - self.h * (c @ dw) * c
+        u = (s2.velocity + _cross(w2, r2)) - (s1.velocity + _cross(w1, r1)) - self.h * (c @ dw) * c
         r2_rate = s1.velocity + _cross(w1, r1) - s2.velocity
         c_rate = _cross(w1, c)
-        quadratic = (_cross(w2, r2_rate) - _cross(w1, _cross(w1, r1))
-                     - self.h * ((c_rate @ dw) * c + (c @ dw) * c_rate))
+        quadratic = (
+            _cross(w2, r2_rate)
+            - _cross(w1, _cross(w1, r1))
+            - self.h * ((c_rate @ dw) * c + (c @ dw) * c_rate)
+        )
         gamma = np.empty(5)
         gamma[0] = -_cross(w1, e1) @ dw
         gamma[1] = -_cross(w1, e2) @ dw
@@ -399,8 +418,9 @@ class ScrewNutJoint:
         frame = self.frame(s1)
         e1, e2, c = frame.T
         c2 = s2.rotation @ self.axis_2
-        gap = (s2.position + s2.rotation @ self.point_2) - (s1.position + s1.rotation
-                                                            @ self.point_1)
+        gap = (s2.position + s2.rotation @ self.point_2) - (
+            s1.position + s1.rotation @ self.point_1
+        )
         angle = self.relative_angle(s1, s2)
         return np.array([-(e2 @ c2), e1 @ c2, e1 @ gap, e2 @ gap, c @ gap - self.h * angle])
 
@@ -484,10 +504,18 @@ class ScrewNutSystem:
         Stick/slip transitions are located to within this time, s.
     """
 
-    def __init__(self, body_1: RigidBody, body_2: RigidBody, joint: ScrewNutJoint,
-                 state_1: BodyState, state_2: BodyState, gravity=(0.0, 0.0, 0.0),
-                 stabilise: bool = True, thread_friction: bool = False,
-                 event_tolerance: float = 1e-10) -> None:
+    def __init__(
+        self,
+        body_1: RigidBody,
+        body_2: RigidBody,
+        joint: ScrewNutJoint,
+        state_1: BodyState,
+        state_2: BodyState,
+        gravity=(0.0, 0.0, 0.0),
+        stabilise: bool = True,
+        thread_friction: bool = False,
+        event_tolerance: float = 1e-10,
+    ) -> None:
         if body_2.fixed:
             raise ValueError("the nut (body 2) must be free; fix the screw (body 1) instead")
         self.bodies = (body_1, body_2)
@@ -504,8 +532,9 @@ class ScrewNutSystem:
         self.events: list[tuple[float, str]] = []
         self.last_multipliers = np.zeros(ScrewNutJoint.N_CONSTRAINTS)
         self.friction_torque = 0.0
-        self._free = np.r_[np.zeros(6, bool) if body_1.fixed else np.ones(6, bool),
-                           np.ones(6, bool)]
+        self._free = np.r_[
+            np.zeros(6, bool) if body_1.fixed else np.ones(6, bool), np.ones(6, bool)
+        ]
         self.project()
 
     # -- dynamics -----------------------------------------------------------------
@@ -513,8 +542,8 @@ class ScrewNutSystem:
         m = np.zeros((12, 12))
         for i, (body, s) in enumerate(zip(self.bodies, states, strict=True)):
             r = s.rotation
-            m[6 * i:6 * i + 3, 6 * i:6 * i + 3] = body.mass * np.eye(3)
-            m[6 * i + 3:6 * i + 6, 6 * i + 3:6 * i + 6] = r @ body.inertia @ r.T
+            m[6 * i : 6 * i + 3, 6 * i : 6 * i + 3] = body.mass * np.eye(3)
+            m[6 * i + 3 : 6 * i + 6, 6 * i + 3 : 6 * i + 6] = r @ body.inertia @ r.T
         return m[np.ix_(self._free, self._free)]
 
     def _forces(self, states: list[BodyState]) -> np.ndarray:
@@ -523,8 +552,8 @@ class ScrewNutSystem:
             r = s.rotation
             inertia = r @ body.inertia @ r.T
             w = s.angular_velocity
-            f[6 * i:6 * i + 3] = body.mass * self.gravity
-            f[6 * i + 3:6 * i + 6] = -_cross(w, inertia @ w)
+            f[6 * i : 6 * i + 3] = body.mass * self.gravity
+            f[6 * i + 3 : 6 * i + 6] = -_cross(w, inertia @ w)
         return f[self._free]
 
     def _axis_row(self, states: list[BodyState]) -> tuple[np.ndarray, float]:
@@ -590,7 +619,7 @@ class ScrewNutSystem:
         force); a stuck thread's holding torque is :attr:`friction_torque`.
         """
         acc, lam, _ = self._solve(states, self.mode)
-        return acc, lam[:ScrewNutJoint.N_CONSTRAINTS]
+        return acc, lam[: ScrewNutJoint.N_CONSTRAINTS]
 
     def _rate(self, y: np.ndarray) -> np.ndarray:
         states = [BodyState.unpack(y[:13]), BodyState.unpack(y[13:])]
@@ -600,10 +629,10 @@ class ScrewNutSystem:
             if self.bodies[i].fixed:
                 continue
             o = 13 * i
-            out[o:o + 3] = s.velocity
-            out[o + 3:o + 7] = _quaternion_rate(s.quaternion, s.angular_velocity)
-            out[o + 7:o + 10] = acc[6 * i:6 * i + 3]
-            out[o + 10:o + 13] = acc[6 * i + 3:6 * i + 6]
+            out[o : o + 3] = s.velocity
+            out[o + 3 : o + 7] = _quaternion_rate(s.quaternion, s.angular_velocity)
+            out[o + 7 : o + 10] = acc[6 * i : 6 * i + 3]
+            out[o + 10 : o + 13] = acc[6 * i + 3 : 6 * i + 6]
         return out
 
     # -- stepping ---------------------------------------------------------------------
@@ -654,7 +683,7 @@ class ScrewNutSystem:
                 remaining = 0.0
             guard = self.guard()
         acc, lam, self.friction_torque = self._solve(self.states, self.mode)
-        self.last_multipliers = lam[:ScrewNutJoint.N_CONSTRAINTS]
+        self.last_multipliers = lam[: ScrewNutJoint.N_CONSTRAINTS]
 
     def _locate(self, y: np.ndarray, h: float) -> tuple[float, list[BodyState]]:
         """Bisection for the first time the guard turns negative: (time taken, states just past)."""
@@ -669,8 +698,9 @@ class ScrewNutSystem:
                 lo = mid
         return hi, past
 
-    def _settle(self, states: list[BodyState], fired: bool = False,
-                before: int | None = None) -> None:
+    def _settle(
+        self, states: list[BodyState], fired: bool = False, before: int | None = None
+    ) -> None:
         """Make the thread's mode fit the state (StickSlip's rules); log a change."""
         before = self.mode if before is None else before
         if self.mode != 0 and (fired or self.relative_speed(states) == 0.0):
@@ -722,8 +752,9 @@ class ScrewNutSystem:
             residual = np.r_[residual, self.joint.relative_angle(*self.states) - self.held_angle]
         return residual
 
-    def _project_positions(self, stuck: bool, iterations: int = 4,
-                           tolerance: float = 1e-15) -> None:
+    def _project_positions(
+        self, stuck: bool, iterations: int = 4, tolerance: float = 1e-15
+    ) -> None:
         for _ in range(iterations):
             residual = self._position_residual(stuck)
             if np.max(np.abs(residual)) <= tolerance:
@@ -732,8 +763,8 @@ class ScrewNutSystem:
             delta = self._correction(g, residual)
             for i, s in enumerate(self.states):
                 if not self.bodies[i].fixed:
-                    s.position = s.position + delta[6 * i:6 * i + 3]
-                    s.quaternion = _rotate_quaternion(s.quaternion, delta[6 * i + 3:6 * i + 6])
+                    s.position = s.position + delta[6 * i : 6 * i + 3]
+                    s.quaternion = _rotate_quaternion(s.quaternion, delta[6 * i + 3 : 6 * i + 6])
             self.joint.angle = self.joint.relative_angle(*self.states)
 
     def _project_velocities(self, stuck: bool) -> None:
@@ -741,8 +772,8 @@ class ScrewNutSystem:
         delta = self._correction(g, g @ _velocities(*self.states))
         for i, s in enumerate(self.states):
             if not self.bodies[i].fixed:
-                s.velocity = s.velocity + delta[6 * i:6 * i + 3]
-                s.angular_velocity = s.angular_velocity + delta[6 * i + 3:6 * i + 6]
+                s.velocity = s.velocity + delta[6 * i : 6 * i + 3]
+                s.angular_velocity = s.angular_velocity + delta[6 * i + 3 : 6 * i + 6]
 
     # -- invariants ----------------------------------------------------------------
     def kinetic_energy(self) -> float:
@@ -759,8 +790,11 @@ class ScrewNutSystem:
 
     def potential_energy(self) -> float:
         """Gravitational energy ``-m g . x``, J."""
-        return -sum(b.mass * float(self.gravity @ s.position)
-                    for b, s in zip(self.bodies, self.states, strict=True) if not b.fixed)
+        return -sum(
+            b.mass * float(self.gravity @ s.position)
+            for b, s in zip(self.bodies, self.states, strict=True)
+            if not b.fixed
+        )
 
     def momentum(self) -> tuple[np.ndarray, np.ndarray]:
         """Linear momentum (kg m/s) and angular momentum about the origin (kg m^2/s)."""

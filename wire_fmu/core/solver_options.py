@@ -17,8 +17,15 @@ from .interface import Variable, parameter
 __all__ = ["solver_parameters", "solver_settings"]
 
 
-def solver_parameters(method: str, max_step: float, *, rtol: float = 1e-6, atol: float = 1e-9,
-                      also: Collection[str] = (), note: str = "") -> tuple[Variable, ...]:
+def solver_parameters(
+    method: str,
+    max_step: float,
+    *,
+    rtol: float = 1e-6,
+    atol: float = 1e-9,
+    also: Collection[str] = (),
+    note: str = "",
+) -> tuple[Variable, ...]:
     """Declarations of the solver parameters with a unit's defaults.
 
     Parameters
@@ -44,11 +51,18 @@ def solver_parameters(method: str, max_step: float, *, rtol: float = 1e-6, atol:
     )
 
 
-def solver_settings(values: Mapping[str, Any], also: Collection[str] = ()
-                    ) -> tuple[SolverSettings, list[str]]:
+def solver_settings(
+    values: Mapping[str, Any], also: Collection[str] = ()
+) -> tuple[SolverSettings, list[str]]:
     """The settings the solver parameters in ``values`` ask for, and their problems."""
-    settings = SolverSettings(str(values["solver"]), float(values["solver_max_step"]),
-                              float(values["solver_rtol"]), float(values["solver_atol"]))
-    problems = [f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
-                for p in settings.problems(also)]
+    settings = SolverSettings(
+        str(values["solver"]),
+        float(values["solver_max_step"]),
+        float(values["solver_rtol"]),
+        float(values["solver_atol"]),
+    )
+    problems = [
+        f"parameter {p}" if p.startswith("solver_") else f"parameter 'solver': {p}"
+        for p in settings.problems(also)
+    ]
     return settings, problems

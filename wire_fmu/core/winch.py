@@ -101,15 +101,25 @@ _BRAKE_WORDS = ("released", "slipping", "holding")  # indexed by brake state
 WINCH_EFFECTS = EffectCatalogue(
     "winch",
     (
-        Effect("drum_inertia", "kinetostatic drum (eq. 32), speed commanded",
-               "drum and drive-train inertia J"),
+        Effect(
+            "drum_inertia",
+            "kinetostatic drum (eq. 32), speed commanded",
+            "drum and drive-train inertia J",
+        ),
         Effect("band_brake", "no brake", "band brake (eq. 34), dry friction, direction dependent"),
-        Effect("motor_characteristic", "motor torque input", "motor characteristic a - b omega",
-               requires=("drum_inertia",)),
-        Effect("elastic_drive_train", "rigid drive train", "n-mass elastic chain (paper 002)",
-               requires=("drum_inertia",)),
-        Effect("rope_layers", "constant winding radius",
-               "radius grows per layer, inertia I(phi)"),
+        Effect(
+            "motor_characteristic",
+            "motor torque input",
+            "motor characteristic a - b omega",
+            requires=("drum_inertia",),
+        ),
+        Effect(
+            "elastic_drive_train",
+            "rigid drive train",
+            "n-mass elastic chain (paper 002)",
+            requires=("drum_inertia",),
+        ),
+        Effect("rope_layers", "constant winding radius", "radius grows per layer, inertia I(phi)"),
     ),
 )
 
@@ -157,8 +167,11 @@ class BandBrake:
             ("brake_friction", self.friction, self.friction > 0, "> 0"),
             ("brake_wrap_angle", self.wrap_angle, self.wrap_angle > 0, "> 0 rad"),
         )
-        return [f"parameter {name!r} must be {bound}, got {value}"
-                for name, value, ok, bound in checks if not (ok and math.isfinite(value))]
+        return [
+            f"parameter {name!r} must be {bound}, got {value}"
+            for name, value, ok, bound in checks
+            if not (ok and math.isfinite(value))
+        ]
 
 
 @dataclass(frozen=True)
@@ -187,8 +200,11 @@ class WinchInputs:
         """Names of non-finite inputs."""
         names = ("rope.tension", "brake.lever_force", "motor.command", "drum.speed_command")
         values = (self.tension, self.lever_force, self.motor_command, self.speed_command)
-        return [f"input {n!r} is not finite ({v})" for n, v in zip(names, values, strict=True)
-                if not math.isfinite(v)]
+        return [
+            f"input {n!r} is not finite ({v})"
+            for n, v in zip(names, values, strict=True)
+            if not math.isfinite(v)
+        ]
 
 
 @dataclass(frozen=True)
@@ -297,8 +313,12 @@ class _WinchBase:
     def held_inputs(self) -> dict[str, float]:
         """The held inputs as plain data."""
         i = self.inputs
-        return {"tension": i.tension, "lever_force": i.lever_force,
-                "motor_command": i.motor_command, "speed_command": i.speed_command}
+        return {
+            "tension": i.tension,
+            "lever_force": i.lever_force,
+            "motor_command": i.motor_command,
+            "speed_command": i.speed_command,
+        }
 
     def restore_held_inputs(self, data: dict[str, float]) -> None:
         """Restore inputs saved by :meth:`held_inputs`."""
@@ -382,8 +402,9 @@ class WinchModel(_WinchBase):
         forces[0] += self._motor_reduced(omega[0])
         phi, w = theta[n - 1], omega[n - 1]
         drum, k = self.drum, self.layer
-        forces[n - 1] += (self.inputs.tension * drum.layer_radius(k)
-                          - 0.5 * drum.rope_inertia_slope(k) * w * w)
+        forces[n - 1] += (
+            self.inputs.tension * drum.layer_radius(k) - 0.5 * drum.rope_inertia_slope(k) * w * w
+        )
         self.masses[n - 1] = self.base_inertia[n - 1] + drum.rope_inertia(phi, k)
         return forces
 
@@ -414,8 +435,9 @@ class WinchModel(_WinchBase):
                 out[n - 1] = 0.0
         r = self.drum.layer_radius(self.layer)
         out[2 * n] = loss
-        out[2 * n + 1] = (self._motor_reduced(omega[0]) * omega[0]
-                          + self.inputs.tension * r * omega[n - 1])
+        out[2 * n + 1] = (
+            self._motor_reduced(omega[0]) * omega[0] + self.inputs.tension * r * omega[n - 1]
+        )
         return out
 
     def guard_directions(self) -> np.ndarray:
@@ -551,7 +573,8 @@ class WinchModel(_WinchBase):
         forces = self._forces(x)
         acc = self._rigid_acceleration(float(forces.sum()), float(self.masses.sum()), x[2 * n - 1])
         twists = np.cumsum(forces[:-1] - self.masses[:-1] * acc) / np.asarray(
-            self.chain.stiffnesses, dtype=float)
+            self.chain.stiffnesses, dtype=float
+        )
         x[: n - 1] = np.cumsum(twists[::-1])[::-1]  # angles relative to the drum's 0
         self.engaged = False
         self.mode_changes = 0
@@ -619,16 +642,30 @@ class WinchModel(_WinchBase):
     @contextmanager
     def trial(self, inputs: WinchInputs) -> Iterator[None]:
         """Modes settled for other inputs, undone on exit (for feedthrough outputs)."""
-        saved = (self.inputs, self.engaged, self.friction.get_mode(), self.mode_changes,
-                 list(self.last_events), self._held_angle, self.state.copy())
+        saved = (
+            self.inputs,
+            self.engaged,
+            self.friction.get_mode(),
+            self.mode_changes,
+            list(self.last_events),
+            self._held_angle,
+            self.state.copy(),
+        )
         try:
             self.set_inputs(inputs)
             self._settle_modes(0.0, self.state)
             self.mode_changes = saved[3]  # a trial is not an event
             yield
         finally:
-            (inputs_, self.engaged, mode, self.mode_changes, self.last_events,
-             self._held_angle, self.state) = saved
+            (
+                inputs_,
+                self.engaged,
+                mode,
+                self.mode_changes,
+                self.last_events,
+                self._held_angle,
+                self.state,
+            ) = saved
             self.friction.set_mode(mode)
             self.set_inputs(inputs_)
             self._forces(self.state)
@@ -719,8 +756,9 @@ class KinetostaticWinch(_WinchBase):
         dissipated = -brake * (phi1 - phi0) + self.beta * omega * omega * h
         rope_work = inputs.tension * paid
         motor_work = dissipated - rope_work  # what (32) makes the motor do
-        self.state = np.array([phi1, omega, self.state[2] + dissipated,
-                               self.state[3] + rope_work + motor_work])
+        self.state = np.array(
+            [phi1, omega, self.state[2] + dissipated, self.state[3] + rope_work + motor_work]
+        )
         return len(self.last_events)
 
     def _cross_layers(self, t: float, h: float, phi0: float, phi1: float) -> None:
@@ -823,8 +861,6 @@ class KinetostaticWinch(_WinchBase):
         self.restore_held_inputs(data["inputs"])
 
 
-
-
 def fastest_rate(chain: DriveChain, motor_slope: float = 0.0) -> float:
     """Largest ``|lambda|`` (1/s) of the chain with the motor characteristic, brake released.
 
@@ -842,10 +878,12 @@ def fastest_rate(chain: DriveChain, motor_slope: float = 0.0) -> float:
     damping = chain.damping_matrix()
     damping[0, 0] += motor_slope * chain.motor_ratio**2
     inv_mass = 1.0 / np.asarray(chain.inertias, dtype=float)
-    system = np.block([
-        [np.zeros((n, n)), np.eye(n)],
-        [-inv_mass[:, None] * chain.stiffness_matrix(), -inv_mass[:, None] * damping],
-    ])
+    system = np.block(
+        [
+            [np.zeros((n, n)), np.eye(n)],
+            [-inv_mass[:, None] * chain.stiffness_matrix(), -inv_mass[:, None] * damping],
+        ]
+    )
     return float(np.abs(np.linalg.eigvals(system)).max())
 
 

@@ -71,44 +71,106 @@ __all__ = ["WinchUnit"]
 _FEEDTHROUGH = ("rope.tension", "brake.lever_force", "motor.command")
 
 
-
 def _parameters():
     return (
-        parameter("effects", "", "", "Effects to include, comma separated: "
-                  + ", ".join(WINCH_EFFECTS.names), type=str),
-        *solver_parameters("rk4", 1e-3, also=ENERGY_SOLVERS,
-                           note="energy, energy1: paper 004's energy form, rigid drive train "
-                                "only"),
-        parameter("drive_train", json.dumps(default_drive_train()), "",
-                  "Drive train as JSON: masses (motor rotor .. drum) and shafts, each with its "
-                  "speed ratio to the drum (estimated 1500-2000 hp drawworks by default)",
-                  type=str),
-        parameter("drive_train_masses", 0, "", "Masses kept with elastic_drive_train: 0 the "
-                  "full chain, 1 rigid, 2.. reduced by delta-star elimination", type=int),
-        parameter("drum_radius", 0.42, "m", "Rope centreline radius on the first layer (32 in "
-                  "barrel with 1-3/8 in line, typical 1500-2000 hp drawworks; estimate)", min=0.0),
-        parameter("rope_diameter", 0.0349, "m", "Rope diameter: 1-3/8 in drilling line "
-                  "(API 9A size); the radius grows by one diameter per layer", min=0.0),
-        parameter("rope_linear_mass", 5.06, "kg/m", "Rope mass per metre (1-3/8 in 6x19 IWRC, "
-                  "about 3.4 lb/ft)", min=0.0),
-        parameter("drum_wraps_per_layer", 40, "", "Turns per layer (about 1.4 m barrel / "
-                  "rope diameter)", type=int),
+        parameter(
+            "effects",
+            "",
+            "",
+            "Effects to include, comma separated: " + ", ".join(WINCH_EFFECTS.names),
+            type=str,
+        ),
+        *solver_parameters(
+            "rk4",
+            1e-3,
+            also=ENERGY_SOLVERS,
+            note="energy, energy1: paper 004's energy form, rigid drive train only",
+        ),
+        parameter(
+            "drive_train",
+            json.dumps(default_drive_train()),
+            "",
+            "Drive train as JSON: masses (motor rotor .. drum) and shafts, each with its "
+            "speed ratio to the drum (estimated 1500-2000 hp drawworks by default)",
+            type=str,
+        ),
+        parameter(
+            "drive_train_masses",
+            0,
+            "",
+            "Masses kept with elastic_drive_train: 0 the "
+            "full chain, 1 rigid, 2.. reduced by delta-star elimination",
+            type=int,
+        ),
+        parameter(
+            "drum_radius",
+            0.42,
+            "m",
+            "Rope centreline radius on the first layer (32 in "
+            "barrel with 1-3/8 in line, typical 1500-2000 hp drawworks; estimate)",
+            min=0.0,
+        ),
+        parameter(
+            "rope_diameter",
+            0.0349,
+            "m",
+            "Rope diameter: 1-3/8 in drilling line "
+            "(API 9A size); the radius grows by one diameter per layer",
+            min=0.0,
+        ),
+        parameter(
+            "rope_linear_mass",
+            5.06,
+            "kg/m",
+            "Rope mass per metre (1-3/8 in 6x19 IWRC, about 3.4 lb/ft)",
+            min=0.0,
+        ),
+        parameter(
+            "drum_wraps_per_layer",
+            40,
+            "",
+            "Turns per layer (about 1.4 m barrel / rope diameter)",
+            type=int,
+        ),
         parameter("drum_layers", 4, "", "Layers the drum flanges allow", type=int),
-        parameter("rope_on_drum", 150.0, "m", "Rope on the drum at the start (rope_layers)",
-                  min=0.0),
-        parameter("brake_rim_radius", 0.62, "m", "Brake-rim radius r_f (about 49 in rims; "
-                  "estimate)", min=0.0),
-        parameter("brake_lever_ratio", 15.0, "1", "Lever ratio L/l of the brake handle linkage "
-                  "(estimate)", min=0.0),
-        parameter("brake_efficiency", 0.9, "1", "Efficiency eta of the brake linkage",
-                  min=0.0, max=1.0),
-        parameter("brake_friction", 0.4, "1", "Band friction coefficient mu (moulded lining on "
-                  "steel, 0.35-0.45)", min=0.0),
-        parameter("brake_wrap_angle", 5.24, "rad", "Band wrap angle alpha (about 300 deg)",
-                  min=0.0),
-        parameter("motor_slope", 3.6e3, "N.m.s/rad", "Slope b of the motor characteristic at "
-                  "the motor shaft (1150 hp AC motor, 1.5 % slip at 1200 rpm; estimate)",
-                  min=0.0),
+        parameter(
+            "rope_on_drum", 150.0, "m", "Rope on the drum at the start (rope_layers)", min=0.0
+        ),
+        parameter(
+            "brake_rim_radius",
+            0.62,
+            "m",
+            "Brake-rim radius r_f (about 49 in rims; estimate)",
+            min=0.0,
+        ),
+        parameter(
+            "brake_lever_ratio",
+            15.0,
+            "1",
+            "Lever ratio L/l of the brake handle linkage (estimate)",
+            min=0.0,
+        ),
+        parameter(
+            "brake_efficiency", 0.9, "1", "Efficiency eta of the brake linkage", min=0.0, max=1.0
+        ),
+        parameter(
+            "brake_friction",
+            0.4,
+            "1",
+            "Band friction coefficient mu (moulded lining on steel, 0.35-0.45)",
+            min=0.0,
+        ),
+        parameter(
+            "brake_wrap_angle", 5.24, "rad", "Band wrap angle alpha (about 300 deg)", min=0.0
+        ),
+        parameter(
+            "motor_slope",
+            3.6e3,
+            "N.m.s/rad",
+            "Slope b of the motor characteristic at "
+            "the motor shaft (1150 hp AC motor, 1.5 % slip at 1200 rpm; estimate)",
+            min=0.0,
+        ),
         parameter("initial_drum_speed", 0.0, "rad/s", "Drum speed at the start (drum_inertia)"),
     )
 
@@ -117,10 +179,20 @@ def _inputs():
     return (
         input_("rope.tension", 0.0, "N", "Rope tension at the drum"),
         input_("brake.lever_force", 0.0, "N", "Force on the brake lever (<= 0: released)"),
-        input_("motor.command", 0.0, "N.m", "Motor torque at the motor shaft, positive paying "
-               "out; with motor_characteristic the zero-speed torque a of a - b omega"),
-        input_("drum.speed_command", 0.0, "rad/s", "Drum speed the drive imposes without "
-               "drum_inertia (kinetostatic mode), positive paying out"),
+        input_(
+            "motor.command",
+            0.0,
+            "N.m",
+            "Motor torque at the motor shaft, positive paying "
+            "out; with motor_characteristic the zero-speed torque a of a - b omega",
+        ),
+        input_(
+            "drum.speed_command",
+            0.0,
+            "rad/s",
+            "Drum speed the drive imposes without "
+            "drum_inertia (kinetostatic mode), positive paying out",
+        ),
     )
 
 
@@ -131,24 +203,43 @@ def _outputs():
         output("rope.payout_rate", "m/s", "Rate of rope paid out"),
         output("drum.speed", "rad/s", "Drum speed, positive paying out"),
         output("drum.angle", "rad", "Drum angle since the start, positive paying out"),
-        output("drum.layer", "", "Rope layer the rope leaves from (1 = on the barrel)",
-               type=int, start=1),
+        output(
+            "drum.layer",
+            "",
+            "Rope layer the rope leaves from (1 = on the barrel)",
+            type=int,
+            start=1,
+        ),
         output("drum.radius", "m", "Winding radius where the rope leaves the drum"),
         output("motor.speed", "rad/s", "Motor shaft speed"),
         output("motor.torque", "N.m", "Motor torque at the motor shaft", depends_on=deps),
         output("brake.torque", "N.m", "Torque of the band brake on the drum", depends_on=deps),
-        output("brake.capacity", "N.m", "Brake capacity against paying out (eq. 34)",
-               depends_on=("brake.lever_force",)),
-        output("brake.state", "", "Band brake: 0 released, 1 slipping, 2 holding", type=int,
-               depends_on=deps),
-        output("stored_energy", "J", "Kinetic energy of the drive train and drum plus shaft "
-               "strain energy"),
+        output(
+            "brake.capacity",
+            "N.m",
+            "Brake capacity against paying out (eq. 34)",
+            depends_on=("brake.lever_force",),
+        ),
+        output(
+            "brake.state",
+            "",
+            "Band brake: 0 released, 1 slipping, 2 holding",
+            type=int,
+            depends_on=deps,
+        ),
+        output(
+            "stored_energy",
+            "J",
+            "Kinetic energy of the drive train and drum plus shaft strain energy",
+        ),
         output("dissipated_energy", "J", "Energy dissipated by the brake and dampers"),
         output("external_work", "J", "Work done on the winch by the rope and the motor"),
-        output("energy_balance", "J",
-               "Ledger residual: stored change + dissipated - external work"),
-        output("mode_changes", "", "Number of mode events so far (stick/slip, layer changes)",
-               type=int),
+        output(
+            "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
+        ),
+        output(
+            "mode_changes", "", "Number of mode events so far (stick/slip, layer changes)", type=int
+        ),
     )
 
 
@@ -185,8 +276,14 @@ class WinchUnit(Unit):
             problems += self._stability_problems(chain, effects, settings.max_step)
         if problems:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
-        config = WinchConfig(effects, drum, chain, brake, float(self.values["motor_slope"]),
-                             float(self.values["initial_drum_speed"]))
+        config = WinchConfig(
+            effects,
+            drum,
+            chain,
+            brake,
+            float(self.values["motor_slope"]),
+            float(self.values["initial_drum_speed"]),
+        )
         self.model = build_winch(config, settings)
 
     def initialize(self, start_time: float) -> None:
@@ -210,8 +307,13 @@ class WinchUnit(Unit):
             model.advance(time, step, inputs)
             self.time = time + step
             self._update_outputs()
-        except (IntegrationError, FloatingPointError, ValueError, ModelError,
-                EnergyFormBreakdownError) as err:
+        except (
+            IntegrationError,
+            FloatingPointError,
+            ValueError,
+            ModelError,
+            EnergyFormBreakdownError,
+        ) as err:
             self.set_state(saved)
             return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
         events = tuple(f"t = {t:.9g} s: {text}" for t, text in model.last_events)
@@ -253,8 +355,12 @@ class WinchUnit(Unit):
 
     def _inputs(self) -> WinchInputs:
         v = self.values
-        return WinchInputs(float(v["rope.tension"]), float(v["brake.lever_force"]),
-                           float(v["motor.command"]), float(v["drum.speed_command"]))
+        return WinchInputs(
+            float(v["rope.tension"]),
+            float(v["brake.lever_force"]),
+            float(v["motor.command"]),
+            float(v["drum.speed_command"]),
+        )
 
     def _settings(self, problems: list[str]) -> SolverSettings:
         settings, solver_problems = solver_settings(self.values, also=ENERGY_SOLVERS)
@@ -273,22 +379,34 @@ class WinchUnit(Unit):
             return None
         keep = int(self.values["drive_train_masses"])
         if not 0 <= keep <= chain.n:
-            problems.append(f"parameter 'drive_train_masses' must be 0 (full chain) or 1..{chain.n}"
-                            f" (the drive train has {chain.n} masses), got {keep}")
+            problems.append(
+                f"parameter 'drive_train_masses' must be 0 (full chain) or 1..{chain.n}"
+                f" (the drive train has {chain.n} masses), got {keep}"
+            )
             return None
         return chain.reduced(keep) if "elastic_drive_train" in effects else chain.rigid()
 
     def _drum(self, effects: frozenset[str]) -> Drum:
         v = self.values
-        return Drum(float(v["drum_radius"]), float(v["rope_diameter"]),
-                    float(v["rope_linear_mass"]), int(v["drum_wraps_per_layer"]),
-                    int(v["drum_layers"]), float(v["rope_on_drum"]), "rope_layers" in effects)
+        return Drum(
+            float(v["drum_radius"]),
+            float(v["rope_diameter"]),
+            float(v["rope_linear_mass"]),
+            int(v["drum_wraps_per_layer"]),
+            int(v["drum_layers"]),
+            float(v["rope_on_drum"]),
+            "rope_layers" in effects,
+        )
 
     def _brake(self) -> BandBrake:
         v = self.values
-        return BandBrake(float(v["brake_rim_radius"]), float(v["brake_lever_ratio"]),
-                         float(v["brake_efficiency"]), float(v["brake_friction"]),
-                         float(v["brake_wrap_angle"]))
+        return BandBrake(
+            float(v["brake_rim_radius"]),
+            float(v["brake_lever_ratio"]),
+            float(v["brake_efficiency"]),
+            float(v["brake_friction"]),
+            float(v["brake_wrap_angle"]),
+        )
 
     def _scalar_problems(self, effects: frozenset[str]) -> list[str]:
         v, out = self.values, []
@@ -296,21 +414,25 @@ class WinchUnit(Unit):
         if "motor_characteristic" in effects and not (slope >= 0 and math.isfinite(slope)):
             out.append(f"parameter 'motor_slope' must be >= 0 N.m.s/rad, got {slope}")
         if not math.isfinite(float(v["initial_drum_speed"])):
-            out.append(f"parameter 'initial_drum_speed' must be finite, "
-                       f"got {v['initial_drum_speed']}")
+            out.append(
+                f"parameter 'initial_drum_speed' must be finite, got {v['initial_drum_speed']}"
+            )
         return out
 
-    def _stability_problems(self, chain: DriveChain, effects: frozenset[str],
-                            max_step: float) -> list[str]:
+    def _stability_problems(
+        self, chain: DriveChain, effects: frozenset[str], max_step: float
+    ) -> list[str]:
         """RK4 is stable for ``|lambda| h < 2.8``: refuse settings that cannot be."""
         slope = float(self.values["motor_slope"]) if "motor_characteristic" in effects else 0.0
         rate = fastest_rate(chain, slope)
         if rate * max_step < RK4_STABILITY:
             return []
-        return [f"parameter 'solver_max_step': rk4 with steps of {max_step:.3g} s is unstable for "
-                f"this drive train (fastest eigenvalue {rate:.4g} 1/s; rk4 needs |lambda| h < "
-                f"{RK4_STABILITY}): set solver_max_step below {RK4_STABILITY / rate:.3g} s, "
-                "reduce the chain (drive_train_masses) or choose the L-stable 'ros2'"]
+        return [
+            f"parameter 'solver_max_step': rk4 with steps of {max_step:.3g} s is unstable for "
+            f"this drive train (fastest eigenvalue {rate:.4g} 1/s; rk4 needs |lambda| h < "
+            f"{RK4_STABILITY}): set solver_max_step below {RK4_STABILITY / rate:.3g} s, "
+            "reduce the chain (drive_train_masses) or choose the L-stable 'ros2'"
+        ]
 
     def _update_outputs(self) -> None:
         report: WinchReport = self._require_model().report()
@@ -329,11 +451,21 @@ class WinchUnit(Unit):
         out["stored_energy"] = report.stored_energy
         out["dissipated_energy"] = report.dissipated_energy
         out["external_work"] = report.external_work
-        out["energy_balance"] = (report.stored_energy - self.initial_energy
-                                 + report.dissipated_energy - report.external_work)
+        out["energy_balance"] = (
+            report.stored_energy
+            - self.initial_energy
+            + report.dissipated_energy
+            - report.external_work
+        )
         out["mode_changes"] = int(self._require_model().mode_changes)
-        reals = (report.payout, report.payout_rate, report.drum_speed, report.motor_torque,
-                 report.brake_torque, report.stored_energy)
+        reals = (
+            report.payout,
+            report.payout_rate,
+            report.drum_speed,
+            report.motor_torque,
+            report.brake_torque,
+            report.stored_energy,
+        )
         if not all(math.isfinite(x) for x in reals):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
@@ -342,12 +474,16 @@ def _energy_solver_problems(method: str, effects: frozenset[str], chain: DriveCh
     """Paper 004's integrator needs a rigid one-degree-of-freedom machine."""
     out = []
     if "drum_inertia" not in effects:
-        out.append(f"parameter 'solver': {method!r} integrates a drum with inertia; add the "
-                   "effect 'drum_inertia' (the kinetostatic winch needs no solver)")
+        out.append(
+            f"parameter 'solver': {method!r} integrates a drum with inertia; add the "
+            "effect 'drum_inertia' (the kinetostatic winch needs no solver)"
+        )
     elif chain.n != 1:
-        out.append(f"parameter 'solver': {method!r} integrates a rigid one-degree-of-freedom "
-                   f"machine, but the drive train keeps {chain.n} masses; set "
-                   "drive_train_masses to 1, drop 'elastic_drive_train', or choose ros2")
+        out.append(
+            f"parameter 'solver': {method!r} integrates a rigid one-degree-of-freedom "
+            f"machine, but the drive train keeps {chain.n} masses; set "
+            "drive_train_masses to 1, drop 'elastic_drive_train', or choose ros2"
+        )
     return out
 
 

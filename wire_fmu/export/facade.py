@@ -259,8 +259,9 @@ class CoreFacade(Fmi2Slave):
             raise FacadeError(
                 f"fixed parameter {var.name!r} can only be set before fmi2ExitInitializationMode"
             )
-        if var.type is float and (value != value or (var.causality is Causality.input
-                                                     and not math.isfinite(value))):
+        if var.type is float and (
+            value != value or (var.causality is Causality.input and not math.isfinite(value))
+        ):
             # a parameter may be infinite (no limit); NaN never, an input never infinite
             raise FacadeError(f"{var.causality.value} {var.name!r} = {value!r}: must be finite")
         self.unit.values[var.name] = var.type(value)

@@ -17,5 +17,13 @@ from .plan import ExportError, ExportPlan, plan_export
 from .ssp import export_ssp, write_ssp
 from .ssp_read import read_ssp
 
-__all__ = ["export_ssp", "write_ssp", "export_osp", "write_osp", "read_ssp", "plan_export",
-           "ExportPlan", "ExportError"]
+__all__ = [
+    "export_ssp",
+    "write_ssp",
+    "export_osp",
+    "write_osp",
+    "read_ssp",
+    "plan_export",
+    "ExportPlan",
+    "ExportError",
+]

@@ -55,8 +55,17 @@ from wire_fmu.master.scene import Bond, Scene, VarRef
 
 from .plan import ExportPlan, archive_names, plan_export
 
-__all__ = ["OSP_NS", "OSP_MD_NS", "PORTS", "Port", "model_ports", "system_structure_tree",
-           "model_description_tree", "write_osp", "export_osp"]
+__all__ = [
+    "OSP_NS",
+    "OSP_MD_NS",
+    "PORTS",
+    "Port",
+    "model_ports",
+    "system_structure_tree",
+    "model_description_tree",
+    "write_osp",
+    "export_osp",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -71,11 +80,27 @@ PORTS = {
     "rotational": ("AngularMechanicalPort", "Torque", "AngularVelocity", "AngularDisplacement"),
     "hydraulic": ("HydraulicPort", "Pressure", "VolumeFlowRate", "Volume"),
 }
-_GROUP_ORDER = ("Generic", "Force", "Torque", "Voltage", "Pressure", "LinearVelocity",
-                "AngularVelocity", "Current", "VolumeFlowRate", "LinearDisplacement",
-                "AngularDisplacement", "Charge", "Volume", "LinearAcceleration",
-                "AngularAcceleration", "LinearMechanicalPort", "AngularMechanicalPort",
-                "ElectromagneticPort", "HydraulicPort")
+_GROUP_ORDER = (
+    "Generic",
+    "Force",
+    "Torque",
+    "Voltage",
+    "Pressure",
+    "LinearVelocity",
+    "AngularVelocity",
+    "Current",
+    "VolumeFlowRate",
+    "LinearDisplacement",
+    "AngularDisplacement",
+    "Charge",
+    "Volume",
+    "LinearAcceleration",
+    "AngularAcceleration",
+    "LinearMechanicalPort",
+    "AngularMechanicalPort",
+    "ElectromagneticPort",
+    "HydraulicPort",
+)
 """The order OspModelDescription 1.0.1 requires for top-level groups."""
 _BASE = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
@@ -140,11 +165,13 @@ def model_ports(plan: ExportPlan) -> tuple[dict[str, list[Port]], dict[tuple[str
         for unit, (effort, flow, position) in _bond_ends(bond).items():
             model = plan.unit(unit).model.modelName
             members = ((effort_el, effort), (flow_el, flow))
-            by_end[(unit, bond.name)] = _add(by_model[model], group, members,
-                                             _port_name([effort, flow]))
+            by_end[(unit, bond.name)] = _add(
+                by_model[model], group, members, _port_name([effort, flow])
+            )
             if position is not None:
                 by_end[(unit, f"{bond.name}.position")] = _add(
-                    by_model[model], position_el, (("", position),), position)
+                    by_model[model], position_el, (("", position),), position
+                )
     return {m: list(ports.values()) for m, ports in by_model.items()}, by_end
 
 
@@ -175,8 +202,9 @@ def _text(parent: etree._Element, tag: str, value: str) -> None:
 def _simulators(root: etree._Element, plan: ExportPlan, names: dict[Path, str]) -> None:
     simulators = _el(root, OSP_NS, "Simulators")
     for unit in plan.units:
-        simulator = _el(simulators, OSP_NS, "Simulator", name=unit.name,
-                        source=names[unit.fmu.resolve()])
+        simulator = _el(
+            simulators, OSP_NS, "Simulator", name=unit.name, source=names[unit.fmu.resolve()]
+        )
         if not unit.start_values:
             continue
         values = _el(simulator, OSP_NS, "InitialValues")
@@ -198,9 +226,12 @@ def _connections(root: etree._Element, plan: ExportPlan) -> None:
     _, by_end = model_ports(plan)
     for bond in plan.bonds:
         a, b = bond.effort.source.unit, bond.effort.target.unit
-        connections.append(etree.Comment(
-            f" power bond {bond.name!r} ({bond.kind}): effort {bond.effort.source} -> "
-            f"{bond.effort.target}, flow {bond.flow.source} -> {bond.flow.target} "))
+        connections.append(
+            etree.Comment(
+                f" power bond {bond.name!r} ({bond.kind}): effort {bond.effort.source} -> "
+                f"{bond.effort.target}, flow {bond.flow.source} -> {bond.flow.target} "
+            )
+        )
         for key in (bond.name, f"{bond.name}.position"):
             if (a, key) in by_end:
                 element = _el(connections, OSP_NS, "VariableGroupConnection")
@@ -208,8 +239,9 @@ def _connections(root: etree._Element, plan: ExportPlan) -> None:
                     _endpoint(element, "VariableGroup", VarRef(unit, by_end[(unit, key)].name))
 
 
-def system_structure_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None
-                          ) -> etree._Element:
+def system_structure_tree(
+    plan: ExportPlan, fmu_names: dict[Path, str] | None = None
+) -> etree._Element:
     """The ``OspSystemStructure.xml`` document of ``plan``."""
     names = fmu_names or archive_names(plan.units)
     root = _el(None, OSP_NS, "OspSystemStructure", version="0.1")
@@ -248,8 +280,11 @@ def model_description_tree(model, ports: list[Port]) -> etree._Element:
     for port in sorted(ports, key=lambda p: (_GROUP_ORDER.index(p.group), p.name)):
         element = _el(groups, OSP_MD_NS, port.group, name=port.name)
         for nested, variable in port.members:
-            parent = element if not nested else _el(element, OSP_MD_NS, nested,
-                                                    name=port.nested_name(nested))
+            parent = (
+                element
+                if not nested
+                else _el(element, OSP_MD_NS, nested, name=port.nested_name(nested))
+            )
             _el(parent, OSP_MD_NS, "Variable", ref=variable, unit=units.get(variable))
     return root
 

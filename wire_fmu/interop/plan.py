@@ -30,8 +30,16 @@ from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 from wire_fmu.master.scene import Bond, Connection, Scene, VarRef
 from wire_fmu.master.validate import Structure, unit_start_values, validate_scene
 
-__all__ = ["ExportError", "TypedValue", "PlannedUnit", "ExportPlan", "plan_export",
-           "portable_driver_spec", "archive_names", "safe_name"]
+__all__ = [
+    "ExportError",
+    "TypedValue",
+    "PlannedUnit",
+    "ExportPlan",
+    "plan_export",
+    "portable_driver_spec",
+    "archive_names",
+    "safe_name",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -223,8 +231,12 @@ def _metadata(scene: Scene) -> dict[str, Any]:
         "description": scene.description,
         "run": run,
         "drivers": [
-            {"target": str(d.target), "rate_target": str(d.rate_target) if d.rate_target else None,
-             "label": d.label, "spec": portable_driver_spec(d.spec, scene.base_dir)}
+            {
+                "target": str(d.target),
+                "rate_target": str(d.rate_target) if d.rate_target else None,
+                "label": d.label,
+                "spec": portable_driver_spec(d.spec, scene.base_dir),
+            }
             for d in scene.drivers
         ],
         "events": [
@@ -232,9 +244,10 @@ def _metadata(scene: Scene) -> dict[str, Any]:
             for e in scene.events
         ],
         "outputs": None if scene.outputs is None else [str(r) for r in scene.outputs],
-        "plots": [{"title": p.title, "ylabel": p.ylabel, "variables": [str(r) for r in
-                                                                       p.variables]}
-                  for p in scene.plots],
+        "plots": [
+            {"title": p.title, "ylabel": p.ylabel, "variables": [str(r) for r in p.variables]}
+            for p in scene.plots
+        ],
         "effects": {name: list(u.effects) for name, u in scene.units.items() if u.effects},
         "fmus": {name: u.fmu for name, u in scene.units.items()},
     }
@@ -245,26 +258,38 @@ def _warn_about_run_settings(scene: Scene) -> None:
     differs = []
     if s.algorithm != "jacobi":
         differs.append(f"algorithm {s.algorithm!r}")
-    if s.extrapolation != "constant" or any(c.extrapolation not in (None, "constant")
-                                            for c in scene.all_connections):
+    if s.extrapolation != "constant" or any(
+        c.extrapolation not in (None, "constant") for c in scene.all_connections
+    ):
         differs.append(f"extrapolation {s.extrapolation!r}")
     if s.iterations > 1:
         differs.append(f"{s.iterations} iterations per step")
     if s.adaptive:
         differs.append("adaptive steps")
     if differs:
-        logger.warning("scene %r asks for %s; the exported fixed-step system is run by other "
-                       "tools as Jacobi with inputs held constant (zero-order hold) at step "
-                       "%g s — see docs/interop.md", scene.name, ", ".join(differs), s.step)
+        logger.warning(
+            "scene %r asks for %s; the exported fixed-step system is run by other "
+            "tools as Jacobi with inputs held constant (zero-order hold) at step "
+            "%g s — see docs/interop.md",
+            scene.name,
+            ", ".join(differs),
+            s.step,
+        )
     for event in scene.events:
         ratio = event.time / s.step
         if abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            logger.warning("event %r at %g s is not on the %g s step grid; a fixed-step host "
-                           "applies it at the next step", event.label, event.time, s.step)
+            logger.warning(
+                "event %r at %g s is not on the %g s step grid; a fixed-step host "
+                "applies it at the next step",
+                event.label,
+                event.time,
+                s.step,
+            )
 
 
-def plan_export(scene: Scene, *, fmu_dir: Path = DEFAULT_FMU_DIR,
-                build_dir: Path | None = None) -> ExportPlan:
+def plan_export(
+    scene: Scene, *, fmu_dir: Path = DEFAULT_FMU_DIR, build_dir: Path | None = None
+) -> ExportPlan:
     """Validate ``scene`` and resolve everything an export writes.
 
     Parameters
@@ -290,9 +315,16 @@ def plan_export(scene: Scene, *, fmu_dir: Path = DEFAULT_FMU_DIR,
     """
     structure = validate_scene(scene, fmu_dir, through_fmi=False)
     _warn_about_run_settings(scene)
-    units = [PlannedUnit(name, structure.paths[name], structure.descriptions[name],
-                         _typed_start_values(scene, structure, name), spec.effects)
-             for name, spec in scene.units.items()]
+    units = [
+        PlannedUnit(
+            name,
+            structure.paths[name],
+            structure.descriptions[name],
+            _typed_start_values(scene, structure, name),
+            spec.effects,
+        )
+        for name, spec in scene.units.items()
+    ]
     connections = list(scene.connections)
     signals_name = None
     if scene.drivers or scene.events:
@@ -300,11 +332,19 @@ def plan_export(scene: Scene, *, fmu_dir: Path = DEFAULT_FMU_DIR,
 
         signals_name = _free_name(SIGNALS_UNIT, scene.units)
         built = build_signals_fmu(scene, structure, Path(build_dir or fmu_dir), signals_name)
-        units.append(PlannedUnit(signals_name, built.path, built.model,
-                                 {"step": TypedValue("Real", scene.run.step)}, generated=True))
+        units.append(
+            PlannedUnit(
+                signals_name,
+                built.path,
+                built.model,
+                {"step": TypedValue("Real", scene.run.step)},
+                generated=True,
+            )
+        )
         connections += built.connections
-    plan = ExportPlan(scene, tuple(units), scene.bonds, tuple(connections), signals_name,
-                      _metadata(scene))
+    plan = ExportPlan(
+        scene, tuple(units), scene.bonds, tuple(connections), signals_name, _metadata(scene)
+    )
     json.dumps(plan.metadata)  # fail here, not half-way through writing, if not JSON-ready
     return plan
 
@@ -315,4 +355,3 @@ def _free_name(base: str, taken) -> str:
         i += 1
         name = f"{base}_{i}"
     return name
-

@@ -79,8 +79,12 @@ def _target_variable(structure: Structure, ref: VarRef) -> Any:
 def _unit_of(var: Any) -> str:
     unit = var.unit or "1"
     if unit not in UNITS:
-        logger.warning("%s has unit %r, which the FMU builder does not know; its signal is "
-                       "declared without a unit ('1')", var.name, unit)
+        logger.warning(
+            "%s has unit %r, which the FMU builder does not know; its signal is "
+            "declared without a unit ('1')",
+            var.name,
+            unit,
+        )
         return "1"
     return unit
 
@@ -95,9 +99,17 @@ def _driver_entries(scene: Scene, structure: Structure) -> list[dict[str, Any]]:
             pairs.append((d.rate_target, "mean_rate"))
         for ref, mode in pairs:
             var = _target_variable(structure, ref)
-            out.append({"name": str(ref), "target": str(ref), "type": "Real",
-                        "unit": _unit_of(var), "mode": mode, "driver": spec,
-                        "description": f"{label} ({mode.replace('_', ' ')}) for {ref}"})
+            out.append(
+                {
+                    "name": str(ref),
+                    "target": str(ref),
+                    "type": "Real",
+                    "unit": _unit_of(var),
+                    "mode": mode,
+                    "driver": spec,
+                    "description": f"{label} ({mode.replace('_', ' ')}) for {ref}",
+                }
+            )
     return out
 
 
@@ -110,18 +122,28 @@ def _event_entries(scene: Scene, structure: Structure) -> list[dict[str, Any]]:
     for ref, events in schedules.items():
         var = _target_variable(structure, ref)
         kind = "Integer" if var.type == "Enumeration" else var.type
-        start = var.start if var.start is not None else {"Real": 0.0, "Integer": 0,
-                                                         "Boolean": False}.get(kind, "")
+        start = (
+            var.start
+            if var.start is not None
+            else {"Real": 0.0, "Integer": 0, "Boolean": False}.get(kind, "")
+        )
         given = scene.units[ref.unit].parameters  # the scene may set the input's start
         if ref.variable in given:
             start = given[ref.variable]
         if kind == "Boolean" and isinstance(start, str):
             start = start.strip().lower() in ("true", "1")
-        out.append({"name": str(ref), "target": str(ref), "type": kind,
-                    "unit": _unit_of(var) if kind == "Real" else "", "mode": "events",
-                    "start": _python_value(kind, start), "events": [
-                        [t, _python_value(kind, v)] for t, v in events],
-                    "description": f"scheduled events on {ref}"})
+        out.append(
+            {
+                "name": str(ref),
+                "target": str(ref),
+                "type": kind,
+                "unit": _unit_of(var) if kind == "Real" else "",
+                "mode": "events",
+                "start": _python_value(kind, start),
+                "events": [[t, _python_value(kind, v)] for t, v in events],
+                "description": f"scheduled events on {ref}",
+            }
+        )
     return out
 
 
@@ -141,8 +163,10 @@ def _check_targets(scene: Scene, entries: list[dict[str, Any]]) -> None:
     for entry in entries:
         name = entry["target"]
         if name in seen:
-            problems.append(f"{name} is both driven and set by events; an export can feed an "
-                            "input from one source only")
+            problems.append(
+                f"{name} is both driven and set by events; an export can feed an "
+                "input from one source only"
+            )
         if name in connected:
             problems.append(f"{name} is connected and also set by events or a driver")
         seen.add(name)
@@ -171,8 +195,9 @@ def _copy_as_module(source: Path, prefix: str, folder: Path) -> Path:
     return target
 
 
-def build_signals_fmu(scene: Scene, structure: Structure, out_dir: Path,
-                      unit_name: str) -> SignalsFmu:
+def build_signals_fmu(
+    scene: Scene, structure: Structure, out_dir: Path, unit_name: str
+) -> SignalsFmu:
     """Build the signals FMU of ``scene`` into ``out_dir``.
 
     Parameters
@@ -196,13 +221,19 @@ def build_signals_fmu(scene: Scene, structure: Structure, out_dir: Path,
         drivers = _copy_as_module(_DRIVERS, "wire_fmu_drivers", folder)
         runtime = _copy_as_module(_RUNTIME, "wire_fmu_signals_unit", folder)
         script = folder / f"signals_{safe_name(scene.name).lower()}.py"
-        script.write_text(_SCRIPT.format(scene=scene.name, drivers=drivers.stem,
-                                         runtime=runtime.stem,
-                                         program=json.dumps(program, sort_keys=True)),
-                          encoding="utf-8")
+        script.write_text(
+            _SCRIPT.format(
+                scene=scene.name,
+                drivers=drivers.stem,
+                runtime=runtime.stem,
+                program=json.dumps(program, sort_keys=True),
+            ),
+            encoding="utf-8",
+        )
         path = build_fmu(script, out_dir, extra_modules=[drivers, runtime])
     logger.info("built %s (%d signals)", path.name, len(program["signals"]))
     connections = tuple(
         Connection(VarRef(unit_name, entry["name"]), VarRef.parse(entry["target"]))
-        for entry in program["signals"])
+        for entry in program["signals"]
+    )
     return SignalsFmu(path, read_model_description(str(path)), connections)

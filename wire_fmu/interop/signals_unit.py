@@ -83,8 +83,7 @@ def _signal(entry: Mapping[str, Any], make_driver: Callable) -> _Signal:
         kind = _TYPES[entry["type"]]
         events = tuple((float(t), kind(v)) for t, v in entry["events"])
         return _Signal(entry["name"], mode, start=kind(entry["start"]), events=events)
-    driver, problems = make_driver(entry["driver"], where=f"signal {entry['name']}",
-                                   base_dir=".")
+    driver, problems = make_driver(entry["driver"], where=f"signal {entry['name']}", base_dir=".")
     if problems:
         raise ValueError("; ".join(problems))
     return _Signal(entry["name"], mode, driver=driver)
@@ -131,13 +130,25 @@ class SignalsUnit(Unit):
 
 
 def _variables(program: Mapping[str, Any]) -> tuple:
-    out = [parameter("step", float(program["step"]), "s",
-                     "Macro step the host takes; outputs hold for one step of this length",
-                     min=0.0)]
+    out = [
+        parameter(
+            "step",
+            float(program["step"]),
+            "s",
+            "Macro step the host takes; outputs hold for one step of this length",
+            min=0.0,
+        )
+    ]
     for entry in program["signals"]:
         kind = _TYPES[entry["type"]]
-        out.append(output(entry["name"], entry["unit"] if kind is float else "",
-                          entry["description"], type=kind))
+        out.append(
+            output(
+                entry["name"],
+                entry["unit"] if kind is float else "",
+                entry["description"],
+                type=kind,
+            )
+        )
     return tuple(out)
 
 

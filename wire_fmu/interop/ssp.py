@@ -50,8 +50,17 @@ from wire_fmu.master.scene import Scene
 
 from .plan import ExportPlan, PlannedUnit, archive_names, plan_export
 
-__all__ = ["NS", "BOND_ANNOTATION", "SCENE_ANNOTATION", "OSP_ANNOTATION", "SSD_NAME",
-           "ssd_tree", "ssv_tree", "write_ssp", "export_ssp"]
+__all__ = [
+    "NS",
+    "BOND_ANNOTATION",
+    "SCENE_ANNOTATION",
+    "OSP_ANNOTATION",
+    "SSD_NAME",
+    "ssd_tree",
+    "ssv_tree",
+    "write_ssp",
+    "export_ssp",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -68,8 +77,12 @@ BOND_ANNOTATION = "org.wire-fmu.bond"
 SCENE_ANNOTATION = "org.wire-fmu.scene"
 OSP_ANNOTATION = "com.opensimulationplatform"
 SSD_NAME = "SystemStructure.ssd"
-_KINDS = {"input": "input", "output": "output", "parameter": "parameter",
-          "calculatedParameter": "calculatedParameter"}
+_KINDS = {
+    "input": "input",
+    "output": "output",
+    "parameter": "parameter",
+    "calculatedParameter": "calculatedParameter",
+}
 _BASE = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
@@ -78,8 +91,9 @@ def _q(prefix: str, tag: str) -> str:
 
 
 def _sub(parent: etree._Element, prefix: str, tag: str, **attrs: str) -> etree._Element:
-    return etree.SubElement(parent, _q(prefix, tag), {k: v for k, v in attrs.items()
-                                                       if v is not None})
+    return etree.SubElement(
+        parent, _q(prefix, tag), {k: v for k, v in attrs.items() if v is not None}
+    )
 
 
 def _type_element(parent: etree._Element, var) -> None:
@@ -93,20 +107,37 @@ def _connectors(component: etree._Element, unit: PlannedUnit) -> None:
         kind = _KINDS.get(var.causality)
         if kind is None:
             continue
-        connector = _sub(connectors, "ssd", "Connector", name=var.name, kind=kind,
-                         description=var.description or None)
+        connector = _sub(
+            connectors,
+            "ssd",
+            "Connector",
+            name=var.name,
+            kind=kind,
+            description=var.description or None,
+        )
         _type_element(connector, var)
 
 
 def _component(elements: etree._Element, unit: PlannedUnit, fmu_name: str) -> None:
-    component = _sub(elements, "ssd", "Component", name=unit.name,
-                     type="application/x-fmu-sharedlibrary", source=f"resources/{fmu_name}",
-                     description=unit.model.description or None)
+    component = _sub(
+        elements,
+        "ssd",
+        "Component",
+        name=unit.name,
+        type="application/x-fmu-sharedlibrary",
+        source=f"resources/{fmu_name}",
+        description=unit.model.description or None,
+    )
     _connectors(component, unit)
     if unit.start_values:
         bindings = _sub(component, "ssd", "ParameterBindings")
-        _sub(bindings, "ssd", "ParameterBinding", type="application/x-ssp-parameter-set",
-             source=f"resources/{unit.name}.ssv")
+        _sub(
+            bindings,
+            "ssd",
+            "ParameterBinding",
+            type="application/x-ssp-parameter-set",
+            source=f"resources/{unit.name}.ssv",
+        )
 
 
 def _annotation(parent: etree._Element, kind: str) -> etree._Element:
@@ -118,9 +149,15 @@ def _connections(system: etree._Element, plan: ExportPlan) -> None:
     connections = _sub(system, "ssd", "Connections")
     roles = {id(c): b for b in plan.bonds for c in b.connections}
     for c in plan.all_connections:
-        element = _sub(connections, "ssd", "Connection", startElement=c.source.unit,
-                       startConnector=c.source.variable, endElement=c.target.unit,
-                       endConnector=c.target.variable)
+        element = _sub(
+            connections,
+            "ssd",
+            "Connection",
+            startElement=c.source.unit,
+            startConnector=c.source.variable,
+            endElement=c.target.unit,
+            endConnector=c.target.variable,
+        )
         bond = roles.get(id(c))
         if bond is not None:
             note = _annotation(element, BOND_ANNOTATION)
@@ -151,8 +188,13 @@ def _units(parent: etree._Element, prefix: str, used: set[str], models) -> None:
 
 
 def _default_experiment(root: etree._Element, plan: ExportPlan) -> None:
-    experiment = _sub(root, "ssd", "DefaultExperiment", startTime="0.0",
-                      stopTime=repr(float(plan.scene.run.stop_time)))
+    experiment = _sub(
+        root,
+        "ssd",
+        "DefaultExperiment",
+        startTime="0.0",
+        stopTime=repr(float(plan.scene.run.stop_time)),
+    )
     note = _annotation(experiment, OSP_ANNOTATION)
     algorithm = _sub(note, "osp", "Algorithm")
     _sub(algorithm, "osp", "FixedStepAlgorithm", baseStepSize=repr(float(plan.scene.run.step)))
@@ -170,13 +212,19 @@ def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etre
     """
     names = fmu_names or archive_names(plan.units)
     scene = plan.scene
-    root = etree.Element(_q("ssd", "SystemStructureDescription"),
-                         {"version": "1.0", "name": scene.name,
-                          "generationTool": f"wire_fmu {wire_fmu.__version__}",
-                          "generationDateAndTime": _now()},
-                         nsmap={k: NS[k] for k in ("ssd", "ssc", "osp", "wf")})
-    system = _sub(root, "ssd", "System", name=scene.name,
-                  description=scene.description.strip() or None)
+    root = etree.Element(
+        _q("ssd", "SystemStructureDescription"),
+        {
+            "version": "1.0",
+            "name": scene.name,
+            "generationTool": f"wire_fmu {wire_fmu.__version__}",
+            "generationDateAndTime": _now(),
+        },
+        nsmap={k: NS[k] for k in ("ssd", "ssc", "osp", "wf")},
+    )
+    system = _sub(
+        root, "ssd", "System", name=scene.name, description=scene.description.strip() or None
+    )
     elements = _sub(system, "ssd", "Elements")
     for unit in plan.units:
         _component(elements, unit, names[unit.fmu.resolve()])
@@ -192,10 +240,11 @@ def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etre
 
 def ssv_tree(unit: PlannedUnit) -> etree._Element:
     """The SSV 1.0 parameter set of ``unit`` (Reals with their units)."""
-    root = etree.Element(_q("ssv", "ParameterSet"),
-                         {"version": "1.0", "name": unit.name,
-                          "generationTool": f"wire_fmu {wire_fmu.__version__}"},
-                         nsmap={k: NS[k] for k in ("ssv", "ssc")})
+    root = etree.Element(
+        _q("ssv", "ParameterSet"),
+        {"version": "1.0", "name": unit.name, "generationTool": f"wire_fmu {wire_fmu.__version__}"},
+        nsmap={k: NS[k] for k in ("ssv", "ssc")},
+    )
     parameters = _sub(root, "ssv", "Parameters")
     used = set()
     for name, typed in unit.start_values.items():
@@ -233,8 +282,9 @@ def write_ssp(plan: ExportPlan, path: Path) -> Path:
         for unit in plan.units:
             if unit.start_values:
                 archive.writestr(f"resources/{unit.name}.ssv", _xml(ssv_tree(unit)))
-    logger.info("wrote %s (%d components, %d connections)", path, len(plan.units),
-                len(plan.all_connections))
+    logger.info(
+        "wrote %s (%d components, %d connections)", path, len(plan.units), len(plan.all_connections)
+    )
     return path
 
 

@@ -72,8 +72,12 @@ class GaussSeidel(CouplingAlgorithm):
             new.update(sim.read_sources(unit))
 
 
-def step_order(units: Sequence[str], flows_to: dict[str, set[str]],
-               feeds: dict[str, set[str]], preferred: Sequence[str] = ()) -> list[str]:
+def step_order(
+    units: Sequence[str],
+    flows_to: dict[str, set[str]],
+    feeds: dict[str, set[str]],
+    preferred: Sequence[str] = (),
+) -> list[str]:
     """Order for Gauss-Seidel: flow sources before the units they feed.
 
     Parameters
@@ -99,8 +103,9 @@ def step_order(units: Sequence[str], flows_to: dict[str, set[str]],
     while len(order) < len(units):
         ready = [u for u in units if u not in placed and indegree[u] == 0]
         if not ready:  # a cycle of flows: take the unit that feeds most, in scene order
-            ready = sorted((u for u in units if u not in placed),
-                           key=lambda u: -len(feeds.get(u, ())))[:1]
+            ready = sorted(
+                (u for u in units if u not in placed), key=lambda u: -len(feeds.get(u, ()))
+            )[:1]
         unit = ready[0]
         order.append(unit)
         placed.add(unit)
@@ -117,5 +122,6 @@ def make_algorithm(name: str, order: Sequence[str]) -> CouplingAlgorithm:
     try:
         return ALGORITHMS[name](order)
     except KeyError:
-        raise ValueError(f"algorithm {name!r} is unknown; choose one of {sorted(ALGORITHMS)}")\
-            from None
+        raise ValueError(
+            f"algorithm {name!r} is unknown; choose one of {sorted(ALGORITHMS)}"
+        ) from None

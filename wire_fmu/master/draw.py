@@ -365,13 +365,17 @@ def _plane_normal(r: Reeving, nodes: list[PathNode], geo: PathGeometry) -> tuple
     return _best_fit_normal(np.array(pts, dtype=float)), False
 
 
-def _circle_points(centre: Sequence[float], axis: Sequence[float], radius_vector: np.ndarray,
-                   angles: np.ndarray) -> np.ndarray:
+def _circle_points(
+    centre: Sequence[float], axis: Sequence[float], radius_vector: np.ndarray, angles: np.ndarray
+) -> np.ndarray:
     """Points ``C + R(axis, angle) radius_vector`` for ``radius_vector`` normal to ``axis``, m."""
     a = np.asarray(axis, dtype=float)
     side = np.cross(a, radius_vector)
-    return (np.asarray(centre, dtype=float) + np.outer(np.cos(angles), radius_vector)
-            + np.outer(np.sin(angles), side))
+    return (
+        np.asarray(centre, dtype=float)
+        + np.outer(np.cos(angles), radius_vector)
+        + np.outer(np.sin(angles), side)
+    )
 
 
 def _sheave_outline(centre: Sequence[float], axis: Sequence[float], radius: float) -> np.ndarray:
@@ -403,16 +407,23 @@ def _unit(vector: np.ndarray, fallback: Sequence[float] = (0.0, -1.0)) -> np.nda
 def _sheave_shapes(r: Reeving, view: _View) -> tuple[SheaveShape, ...]:
     reeved = {e.name for e in r.path if e.kind == "sheave"}
     return tuple(
-        SheaveShape(s.name, s.body, view.project(s.centre), s.radius,
-                    view.project(_sheave_outline(s.centre, s.axis, s.radius)), s.name in reeved)
+        SheaveShape(
+            s.name,
+            s.body,
+            view.project(s.centre),
+            s.radius,
+            view.project(_sheave_outline(s.centre, s.axis, s.radius)),
+            s.name in reeved,
+        )
         for s in r.sheaves.values()
     )
 
 
 def _rope(r: Reeving, nodes: list[PathNode], geo: PathGeometry, view: _View):
     """Spans and arcs of the rope."""
-    spans = tuple(RopeSpan(k, view.project(a), view.project(b))
-                  for k, (a, b) in enumerate(geo.points))
+    spans = tuple(
+        RopeSpan(k, view.project(a), view.project(b)) for k, (a, b) in enumerate(geo.points)
+    )
     arcs = []
     for j in range(1, len(nodes) - 1):
         wrap_angle = float(geo.wrap_angles[j - 1])
@@ -424,8 +435,10 @@ def _rope(r: Reeving, nodes: list[PathNode], geo: PathGeometry, view: _View):
 
 def _anchors(r: Reeving, view: _View) -> tuple[AnchorMark, ...]:
     used = {e.name for e in r.path if e.kind == "anchor"}
-    return tuple(AnchorMark(a.name, a.body, view.project(a.point), a.name in used)
-                 for a in r.anchors.values())
+    return tuple(
+        AnchorMark(a.name, a.body, view.project(a.point), a.name in used)
+        for a in r.anchors.values()
+    )
 
 
 def _line_ends(r: Reeving, geo: PathGeometry, view: _View) -> tuple[LineEndArrow, ...]:
@@ -476,8 +489,11 @@ def _bodies(r: Reeving, parts: dict[str, list[np.ndarray]], view: _View, pad: fl
         label = _body_label(body)
         if np.linalg.norm(direction) < 1e-6:
             label += ", moves across the page"
-        boxes.append(BodyBox(body.name, body.kind, label, pts.min(axis=0) - pad,
-                             pts.max(axis=0) + pad, direction))
+        boxes.append(
+            BodyBox(
+                body.name, body.kind, label, pts.min(axis=0) - pad, pts.max(axis=0) + pad, direction
+            )
+        )
     return tuple(boxes)
 
 
@@ -580,8 +596,12 @@ def _figure_size(lower: np.ndarray, upper: np.ndarray) -> tuple[float, float]:
     return 10.0, float(np.clip(10.0 * aspect + 2.0, 5.0, 9.0))
 
 
-_LABEL_BOX = {"boxstyle": "square,pad=0.1", "facecolor": "white", "alpha": 0.75,
-              "edgecolor": "none"}
+_LABEL_BOX = {
+    "boxstyle": "square,pad=0.1",
+    "facecolor": "white",
+    "alpha": 0.75,
+    "edgecolor": "none",
+}
 
 
 def _radial_text(direction: np.ndarray) -> tuple[float, str]:
@@ -596,15 +616,31 @@ def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) 
     """Sheave outlines, centres, and names running outwards opposite the wrapped rope."""
     for s in drawing.sheaves:
         style = "-" if s.reeved else "--"
-        ax.fill(s.outline[:, 0], s.outline[:, 1], facecolor=_SHEAVE_FILL, edgecolor=_SHEAVE_EDGE,
-                linewidth=1.0, linestyle=style, zorder=2)
+        ax.fill(
+            s.outline[:, 0],
+            s.outline[:, 1],
+            facecolor=_SHEAVE_FILL,
+            edgecolor=_SHEAVE_EDGE,
+            linewidth=1.0,
+            linestyle=style,
+            zorder=2,
+        )
         ax.plot(*s.centre, marker="+", color=_SHEAVE_EDGE, markersize=4, zorder=3)
         away = _unit(s.centre - arcs_mid[s.name]) if s.name in arcs_mid else np.array([0.0, -1.0])
         rotation, ha = _radial_text(away)
         text = s.name if s.reeved else f"{s.name} (not reeved)"
-        ax.annotate(text, s.centre + away * s.radius * 1.15, rotation=rotation,
-                    rotation_mode="anchor", ha=ha, va="center", fontsize=7, color=_SHEAVE_EDGE,
-                    bbox=_LABEL_BOX, zorder=6)
+        ax.annotate(
+            text,
+            s.centre + away * s.radius * 1.15,
+            rotation=rotation,
+            rotation_mode="anchor",
+            ha=ha,
+            va="center",
+            fontsize=7,
+            color=_SHEAVE_EDGE,
+            bbox=_LABEL_BOX,
+            zorder=6,
+        )
 
 
 def _h_align(x: float) -> str:
@@ -621,31 +657,67 @@ def _draw_rope(ax, drawing: ReevingDrawing, arrow: float) -> None:
         xs, ys = np.array([span.start, span.end]).T
         ax.plot(xs, ys, color=_ROPE_COLOUR, linewidth=1.8, solid_capstyle="round", zorder=4)
         mid, d = 0.5 * (span.start + span.end), _unit(span.end - span.start)
-        ax.annotate("", xy=mid + 0.25 * arrow * d, xytext=mid - 0.25 * arrow * d, zorder=5,
-                    arrowprops={"arrowstyle": "-|>", "color": _ROPE_COLOUR, "lw": 0,
-                                "mutation_scale": 12})
+        ax.annotate(
+            "",
+            xy=mid + 0.25 * arrow * d,
+            xytext=mid - 0.25 * arrow * d,
+            zorder=5,
+            arrowprops={"arrowstyle": "-|>", "color": _ROPE_COLOUR, "lw": 0, "mutation_scale": 12},
+        )
     for arc in drawing.arcs:
-        ax.plot(arc.points[:, 0], arc.points[:, 1], color=_ROPE_COLOUR, linewidth=2.6,
-                solid_capstyle="round", zorder=4)
+        ax.plot(
+            arc.points[:, 0],
+            arc.points[:, 1],
+            color=_ROPE_COLOUR,
+            linewidth=2.6,
+            solid_capstyle="round",
+            zorder=4,
+        )
 
 
 def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
     """Anchors as triangles, line ends as labelled arrows."""
     for a in drawing.anchors:
         face = "black" if a.used else "white"
-        ax.plot(*a.point, marker="^", markersize=11, markerfacecolor=face,
-                markeredgecolor="black", zorder=7)
+        ax.plot(
+            *a.point,
+            marker="^",
+            markersize=11,
+            markerfacecolor=face,
+            markeredgecolor="black",
+            zorder=7,
+        )
         label = a.name if a.used else f"{a.name} (unused)"
-        ax.annotate(label, a.point, xytext=(7, -10), textcoords="offset points", fontsize=8,
-                    bbox=_LABEL_BOX, zorder=7)
+        ax.annotate(
+            label,
+            a.point,
+            xytext=(7, -10),
+            textcoords="offset points",
+            fontsize=8,
+            bbox=_LABEL_BOX,
+            zorder=7,
+        )
     for e in drawing.line_ends:
         tip = e.point + arrow * e.direction
-        ax.annotate("", xy=tip, xytext=e.point, zorder=7,
-                    arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.4})
+        ax.annotate(
+            "",
+            xy=tip,
+            xytext=e.point,
+            zorder=7,
+            arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.4},
+        )
         ax.plot(*e.point, marker="o", markersize=5, color="black", zorder=7)
-        ax.annotate(e.port, tip, xytext=(4 * e.direction[0], 4 * e.direction[1]),
-                    textcoords="offset points", ha=_h_align(e.direction[0]),
-                    va=_v_align(e.direction[1]), fontsize=9, fontweight="bold", zorder=7)
+        ax.annotate(
+            e.port,
+            tip,
+            xytext=(4 * e.direction[0], 4 * e.direction[1]),
+            textcoords="offset points",
+            ha=_h_align(e.direction[0]),
+            va=_v_align(e.direction[1]),
+            fontsize=9,
+            fontweight="bold",
+            zorder=7,
+        )
 
 
 def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
@@ -655,18 +727,42 @@ def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
 
     for b in drawing.bodies:
         size = b.upper - b.lower
-        ax.add_patch(Rectangle(tuple(b.lower), size[0], size[1], fill=False, linestyle="--",
-                               edgecolor=_BODY_COLOUR, linewidth=1.2, zorder=1))
-        label = ax.annotate(b.label, (b.lower[0], b.lower[1]), xytext=(0, -3),
-                            textcoords="offset points", fontsize=8, color=_BODY_COLOUR, va="top",
-                            bbox=_LABEL_BOX, zorder=6)
+        ax.add_patch(
+            Rectangle(
+                tuple(b.lower),
+                size[0],
+                size[1],
+                fill=False,
+                linestyle="--",
+                edgecolor=_BODY_COLOUR,
+                linewidth=1.2,
+                zorder=1,
+            )
+        )
+        label = ax.annotate(
+            b.label,
+            (b.lower[0], b.lower[1]),
+            xytext=(0, -3),
+            textcoords="offset points",
+            fontsize=8,
+            color=_BODY_COLOUR,
+            va="top",
+            bbox=_LABEL_BOX,
+            zorder=6,
+        )
         if np.linalg.norm(b.direction) > 1e-6:
             d = _unit(b.direction)  # equal aspect: the same direction on screen
             centre = np.array([16.0, 0.0])  # points right of the label's right edge
             anchor = OffsetFrom(label, (1.0, 0.5), unit="points")
-            ax.annotate("", xy=tuple(centre + 9.0 * d), xycoords=anchor,
-                        xytext=tuple(centre - 9.0 * d), textcoords=anchor, zorder=6,
-                        arrowprops={"arrowstyle": "-|>", "color": _BODY_COLOUR, "lw": 1.6})
+            ax.annotate(
+                "",
+                xy=tuple(centre + 9.0 * d),
+                xycoords=anchor,
+                xytext=tuple(centre - 9.0 * d),
+                textcoords=anchor,
+                zorder=6,
+                arrowprops={"arrowstyle": "-|>", "color": _BODY_COLOUR, "lw": 1.6},
+            )
 
 
 def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
@@ -678,25 +774,54 @@ def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
         tick = 0.18 * arrow * _unit(f.below - 0.8 * _unit(along))
         for s in np.linspace(0.0, 1.0, 16):
             p = f.start + s * along
-            ax.plot([p[0], p[0] + tick[0]], [p[1], p[1] + tick[1]], color=_FLOOR_COLOUR,
-                    linewidth=0.8, zorder=3)
-        ax.annotate(f"floor of {f.body}\ncontact after {f.travel:+.2f} m travel",
-                    0.5 * (f.start + f.end), xytext=(-4.0 * f.below[0], -4.0 * f.below[1]),
-                    textcoords="offset points", ha="center", va=_v_align(-f.below[1]),
-                    fontsize=7, color=_FLOOR_COLOUR, bbox=_LABEL_BOX, zorder=6)
+            ax.plot(
+                [p[0], p[0] + tick[0]],
+                [p[1], p[1] + tick[1]],
+                color=_FLOOR_COLOUR,
+                linewidth=0.8,
+                zorder=3,
+            )
+        ax.annotate(
+            f"floor of {f.body}\ncontact after {f.travel:+.2f} m travel",
+            0.5 * (f.start + f.end),
+            xytext=(-4.0 * f.below[0], -4.0 * f.below[1]),
+            textcoords="offset points",
+            ha="center",
+            va=_v_align(-f.below[1]),
+            fontsize=7,
+            color=_FLOOR_COLOUR,
+            bbox=_LABEL_BOX,
+            zorder=6,
+        )
 
 
 def _legend(fig) -> None:
     from matplotlib.lines import Line2D
 
     handles = [
-        Line2D([], [], color=_ROPE_COLOUR, linewidth=2, marker=">",
-               label="rope (arrow: path order)"),
-        Line2D([], [], color=_SHEAVE_EDGE, marker="o", markerfacecolor=_SHEAVE_FILL, linestyle="",
-               markersize=9, label="sheave"),
+        Line2D(
+            [], [], color=_ROPE_COLOUR, linewidth=2, marker=">", label="rope (arrow: path order)"
+        ),
+        Line2D(
+            [],
+            [],
+            color=_SHEAVE_EDGE,
+            marker="o",
+            markerfacecolor=_SHEAVE_FILL,
+            linestyle="",
+            markersize=9,
+            label="sheave",
+        ),
         Line2D([], [], color="black", marker="^", linestyle="", markersize=9, label="anchor"),
-        Line2D([], [], color="black", marker=r"$\rightarrow$", linestyle="", markersize=12,
-               label="line end"),
+        Line2D(
+            [],
+            [],
+            color="black",
+            marker=r"$\rightarrow$",
+            linestyle="",
+            markersize=12,
+            label="line end",
+        ),
         Line2D([], [], color=_BODY_COLOUR, linestyle="--", label="moving body"),
     ]
     fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=8, frameon=False)
@@ -776,4 +901,3 @@ def draw_reeving(reeving: Mapping[str, Any], path: Path, *, title: str = "") -> 
     _render(drawing, path, title)
     logger.info("drew reeving %r to %s", title or drawing.title, path)
     return path
-

@@ -90,15 +90,25 @@ class EnergyGuard:
         What the user could change, for the stop message.
     """
 
-    def __init__(self, bonds: Iterable[str], share: float, floor: float,
-                 remedies: Sequence[str] = ("a smaller step",)) -> None:
+    def __init__(
+        self,
+        bonds: Iterable[str],
+        share: float,
+        floor: float,
+        remedies: Sequence[str] = ("a smaller step",),
+    ) -> None:
         self.share = share
         self.floor = floor
         self.remedies = tuple(remedies)
         self.bonds = {name: BondEnergy() for name in bonds}
 
-    def book(self, residuals: Mapping[str, float], powers: Mapping[str, float],
-             h: float, across_events: Collection[str] = ()) -> None:
+    def book(
+        self,
+        residuals: Mapping[str, float],
+        powers: Mapping[str, float],
+        h: float,
+        across_events: Collection[str] = (),
+    ) -> None:
         """Add one accepted step's residuals (J) and transmitted powers (W) over ``h`` (s).
 
         Bonds in ``across_events`` took the step across a mode event of one of
@@ -129,20 +139,22 @@ class EnergyGuard:
         """
         if math.isinf(self.share):
             return None
-        unstable = [(name, bond) for name, bond in self.bonds.items()
-                    if not bond.error <= self.limit(name)]  # a NaN residual is unstable too
+        unstable = [
+            (name, bond) for name, bond in self.bonds.items() if not bond.error <= self.limit(name)
+        ]  # a NaN residual is unstable too
         if not unstable:
             return None
         details = "; ".join(_describe(name, bond) for name, bond in unstable)
-        return (f"t = {t:.6g} s: the coupling blows up at the macro step {h:.3g} s: {details} "
-                f"(limit: energy_guard = {self.share:g} of the carried energy, at least "
-                f"energy_tolerance {self.floor:g} J). The dynamics coupled across the bond "
-                f"are too fast for this step: use {' or '.join(self.remedies)}")
+        return (
+            f"t = {t:.6g} s: the coupling blows up at the macro step {h:.3g} s: {details} "
+            f"(limit: energy_guard = {self.share:g} of the carried energy, at least "
+            f"energy_tolerance {self.floor:g} J). The dynamics coupled across the bond "
+            f"are too fast for this step: use {' or '.join(self.remedies)}"
+        )
 
 
 def _describe(name: str, bond: BondEnergy) -> str:
-    text = (f"bond '{name}' created and destroyed {bond.error:.3g} J "
-            f"(net {bond.created:+.3g} J)")
+    text = f"bond '{name}' created and destroyed {bond.error:.3g} J (net {bond.created:+.3g} J)"
     if bond.carried > 0.0 and math.isfinite(bond.error):
         share = 100 * bond.error / bond.carried
         return text + f", {share:.3g} % of the {bond.carried:.3g} J it carried"

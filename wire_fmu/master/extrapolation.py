@@ -65,8 +65,9 @@ def _lagrange(points: list[tuple[float, float]], t: float) -> float:
     return total
 
 
-def held_value(history: History, t: float, step: float, scheme: str,
-               fresh: float | None = None) -> float:
+def held_value(
+    history: History, t: float, step: float, scheme: str, fresh: float | None = None
+) -> float:
     """The value to hold over ``[t, t + step]``.
 
     Parameters
@@ -85,12 +86,13 @@ def held_value(history: History, t: float, step: float, scheme: str,
     if fresh is not None:
         if scheme == "constant":
             return fresh
-        pts = list(history.points)[-(need - 1):] + [(t + step, fresh)]
+        pts = list(history.points)[-(need - 1) :] + [(t + step, fresh)]
     else:
         pts = list(history.points)[-need:]
     if len(pts) == 1:
         return pts[0][1]
     if len(pts) == 2:
         return _lagrange(pts, t + 0.5 * step)
-    return (_lagrange(pts, t) + 4.0 * _lagrange(pts, t + 0.5 * step)
-            + _lagrange(pts, t + step)) / 6.0
+    return (
+        _lagrange(pts, t) + 4.0 * _lagrange(pts, t + 0.5 * step) + _lagrange(pts, t + step)
+    ) / 6.0

@@ -41,8 +41,9 @@ class DriverSet:
     def __init__(self, specs: tuple[DriverSpec, ...], base_dir: Path) -> None:
         self._by_unit: dict[str, list[_Driven]] = defaultdict(list)
         for i, d in enumerate(specs):
-            driver, problems = make_driver(d.spec, where=f"driver {i} ({d.target})",
-                                           base_dir=base_dir)
+            driver, problems = make_driver(
+                d.spec, where=f"driver {i} ({d.target})", base_dir=base_dir
+            )
             if problems:
                 raise ValueError("; ".join(problems))
             self._by_unit[d.target.unit].append(_Driven(driver, d.target, d.rate_target))
@@ -55,8 +56,9 @@ class DriverSet:
                 out[d.target.variable] = d.driver.value(t if h is None else t + 0.5 * h)
             else:
                 out[d.target.variable] = d.driver.value(t)
-                out[d.rate.variable] = (d.driver.rate(t) if not h else
-                                        (d.driver.value(t + h) - d.driver.value(t)) / h)
+                out[d.rate.variable] = (
+                    d.driver.rate(t) if not h else (d.driver.value(t + h) - d.driver.value(t)) / h
+                )
         return out
 
 

@@ -67,8 +67,9 @@ class CsvRecorder:
         self.directory.mkdir(parents=True, exist_ok=True)
         self._plan = self._recorded(sim)
         self.columns = ["time"] + [f"{u}.{n}" for u, names in self._plan.items() for n in names]
-        self.columns += [f"bond.{b}.{channel}" for channel in BOND_CHANNELS
-                         for b in sim.energy.bonds]
+        self.columns += [
+            f"bond.{b}.{channel}" for channel in BOND_CHANNELS for b in sim.energy.bonds
+        ]
         self._ledger_units = [u for u, s in sim.slaves.items() if "energy_balance" in s.variables]
         if self._ledger_units:
             self.columns.append(LEDGER_CHANNEL)
@@ -98,8 +99,11 @@ class CsvRecorder:
         wanted = sim.scene.outputs
         if wanted is None:
             for name, slave in sim.slaves.items():
-                plan[name] = [v.name for v in slave.model_description.modelVariables
-                              if v.causality == "output"]
+                plan[name] = [
+                    v.name
+                    for v in slave.model_description.modelVariables
+                    if v.causality == "output"
+                ]
         else:
             for ref in wanted:
                 plan[ref.unit].append(ref.variable)
@@ -138,8 +142,11 @@ class CsvRecorder:
         variables = {}
         for unit, slave in sim.slaves.items():
             for v in slave.model_description.modelVariables:
-                variables[f"{unit}.{v.name}"] = {"unit": v.unit or "", "description":
-                                                 v.description or "", "causality": v.causality}
+                variables[f"{unit}.{v.name}"] = {
+                    "unit": v.unit or "",
+                    "description": v.description or "",
+                    "causality": v.causality,
+                }
         meta = {
             "scene": sim.scene.name,
             "description": sim.scene.description,
@@ -150,16 +157,23 @@ class CsvRecorder:
         }
         if result is not None:
             meta["result"] = {
-                "status": result.status, "message": result.message,
-                "end_time": result.end_time, "wall_time": result.wall_time,
-                "real_time_factor": result.end_time / result.wall_time if result.wall_time else
-                None,
-                "steps": result.steps, "rejected_steps": result.rejected,
-                "sweeps": result.iterations, "bond_energy_residual": result.bond_residual,
+                "status": result.status,
+                "message": result.message,
+                "end_time": result.end_time,
+                "wall_time": result.wall_time,
+                "real_time_factor": result.end_time / result.wall_time
+                if result.wall_time
+                else None,
+                "steps": result.steps,
+                "rejected_steps": result.rejected,
+                "sweeps": result.iterations,
+                "bond_energy_residual": result.bond_residual,
                 "bond_energy_carried": result.bond_carried,
                 "bond_energy_error": result.bond_error,
-                "units": {u: {"calls": dict(s.calls), "seconds": dict(s.seconds)}
-                          for u, s in sim.slaves.items()},
+                "units": {
+                    u: {"calls": dict(s.calls), "seconds": dict(s.seconds)}
+                    for u, s in sim.slaves.items()
+                },
             }
         meta["run"]["order"] = list(meta["run"]["order"])
         self.meta_path.write_text(json.dumps(meta, indent=2, default=str) + "\n")
@@ -206,8 +220,10 @@ class Progress:
         bar = "#" * int(done * self.width)
         elapsed = now - self._start
         rtf = sim.time / elapsed if elapsed > 0 else 0.0
-        self.stream.write(f"\r{sim.scene.name}: [{bar:<{self.width}}] {100 * done:5.1f} % "
-                          f"t = {sim.time:8.3f} s  {rtf:6.2f}x real time")
+        self.stream.write(
+            f"\r{sim.scene.name}: [{bar:<{self.width}}] {100 * done:5.1f} % "
+            f"t = {sim.time:8.3f} s  {rtf:6.2f}x real time"
+        )
         self.stream.flush()
 
 
@@ -217,19 +233,28 @@ def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
         ("status", result.status),
         ("simulated", f"{result.end_time:.6g} s"),
         ("wall time", f"{result.wall_time:.3g} s"),
-        ("real-time factor", f"{result.end_time / result.wall_time:.3g}" if result.wall_time
-         else "-"),
-        ("macro steps", f"{result.steps} accepted, {result.rejected} rejected, "
-                        f"{result.iterations} sweeps"),
+        (
+            "real-time factor",
+            f"{result.end_time / result.wall_time:.3g}" if result.wall_time else "-",
+        ),
+        (
+            "macro steps",
+            f"{result.steps} accepted, {result.rejected} rejected, {result.iterations} sweeps",
+        ),
     ]
     for name, value in result.bond_residual.items():
         error, carried = result.bond_error.get(name, 0.0), result.bond_carried.get(name, 0.0)
-        rows.append((f"bond {name} energy residual",
-                     f"{value:+.4g} J net, {error:.4g} J created or destroyed, "
-                     f"of {carried:.4g} J carried"))
+        rows.append(
+            (
+                f"bond {name} energy residual",
+                f"{value:+.4g} J net, {error:.4g} J created or destroyed, "
+                f"of {carried:.4g} J carried",
+            )
+        )
     for unit, slave in sim.slaves.items():
         steps = slave.calls.get("doStep", 0)
         secs = sum(slave.seconds.values())
-        rows.append((f"unit {unit}", f"{steps} doStep, {sum(slave.calls.values())} FMI calls, "
-                                     f"{secs:.3g} s"))
+        rows.append(
+            (f"unit {unit}", f"{steps} doStep, {sum(slave.calls.values())} FMI calls, {secs:.3g} s")
+        )
     return rows

@@ -21,8 +21,9 @@ def read_results(csv_path: Path) -> dict[str, np.ndarray]:
     with Path(csv_path).open(newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], rows[1:]
-    data = np.array([[float(c) for c in row] for row in body]) if body else np.zeros((0, len(
-        header)))
+    data = (
+        np.array([[float(c) for c in row] for row in body]) if body else np.zeros((0, len(header)))
+    )
     return {name: data[:, i] for i, name in enumerate(header)}
 
 

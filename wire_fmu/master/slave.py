@@ -327,8 +327,9 @@ class Slave:
             said = "; ".join(dict.fromkeys(self.messages.kept[-5:]))
             status = FMI_STATUS.get(exc.status, exc.status)
             raise UnitFailedError(  # the unit's own words name the call, else we do
-                f"unit {self.name!r}: {said}" if said else f"unit {self.name!r}: {fn} failed "
-                f"with {status} and no message",
+                f"unit {self.name!r}: {said}"
+                if said
+                else f"unit {self.name!r}: {fn} failed with {status} and no message",
                 self.name,
             ) from None
         finally:

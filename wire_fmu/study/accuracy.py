@@ -179,8 +179,12 @@ class StudyError(WireFmuError):
 
 
 # ----------------------------------------------------------------------- settings
-UNIT_SOLVER_DEFAULTS = {"solver": "ros2", "solver_max_step": 1e-3, "solver_rtol": 1e-6,
-                        "solver_atol": 1e-9}
+UNIT_SOLVER_DEFAULTS = {
+    "solver": "ros2",
+    "solver_max_step": 1e-3,
+    "solver_rtol": 1e-6,
+    "solver_atol": 1e-9,
+}
 """Solver parameters of a unit of ours that declares none (the winch's default is rk4)."""
 
 
@@ -234,12 +238,18 @@ DEFAULT_SOLVERS = (
     SolverChoice("ros2 h=1e-3", _ROS2),
     SolverChoice("ros2 h=2.5e-4", {"solver": "ros2", "solver_max_step": 2.5e-4}),
     SolverChoice("rk4 h=1e-3", {"solver": "rk4", "solver_max_step": 1e-3}),
-    SolverChoice("radau rtol=1e-5", {"solver": "radau", "solver_rtol": 1e-5, "solver_atol": 1e-8,
-                                     "solver_max_step": 1.0}),
-    SolverChoice("radau rtol=1e-8", {"solver": "radau", "solver_rtol": 1e-8,
-                                     "solver_atol": 1e-11, "solver_max_step": 1.0}),
-    SolverChoice("bdf rtol=1e-6", {"solver": "bdf", "solver_rtol": 1e-6, "solver_atol": 1e-9,
-                                   "solver_max_step": 1.0}),
+    SolverChoice(
+        "radau rtol=1e-5",
+        {"solver": "radau", "solver_rtol": 1e-5, "solver_atol": 1e-8, "solver_max_step": 1.0},
+    ),
+    SolverChoice(
+        "radau rtol=1e-8",
+        {"solver": "radau", "solver_rtol": 1e-8, "solver_atol": 1e-11, "solver_max_step": 1.0},
+    ),
+    SolverChoice(
+        "bdf rtol=1e-6",
+        {"solver": "bdf", "solver_rtol": 1e-6, "solver_atol": 1e-9, "solver_max_step": 1.0},
+    ),
     SolverChoice("energy (winch)", {"solver": "energy"}, only="Winch"),
 )
 """Internal solvers of the full grid (the winch's energy form only where there is a winch);
@@ -315,8 +325,10 @@ def _study_table(scene: Scene) -> Mapping[str, Any]:
     table = getattr(scene, "study", None) or {}
     unknown = sorted(set(table) - set(STUDY_KEYS))
     if unknown:
-        raise SceneError(f"scene {scene.name!r} [study]", [
-            f"unknown keys {unknown}; known: {', '.join(STUDY_KEYS)}"])
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            [f"unknown keys {unknown}; known: {', '.join(STUDY_KEYS)}"],
+        )
     return table
 
 
@@ -326,18 +338,26 @@ def _key_outputs(scene: Scene, table: Mapping[str, Any]) -> tuple[VarRef, ...]:
         refs = [r for plot in scene.plots for r in plot.variables]
         refs = refs or list(scene.outputs or ())
         if not refs:
-            raise SceneError(f"scene {scene.name!r}", [
-                "no key outputs: give [study] key_outputs = [\"unit.variable\", ...] or "
-                "[[plots]] variables"])
+            raise SceneError(
+                f"scene {scene.name!r}",
+                [
+                    'no key outputs: give [study] key_outputs = ["unit.variable", ...] or '
+                    "[[plots]] variables"
+                ],
+            )
         return tuple(dict.fromkeys(refs))
     if not isinstance(raw, list) or not raw:
-        raise SceneError(f"scene {scene.name!r} [study]", [
-            "key_outputs must be a non-empty list of 'unit.variable'"])
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            ["key_outputs must be a non-empty list of 'unit.variable'"],
+        )
     refs = [VarRef.parse(text) for text in raw]
     bad = [text for text, ref in zip(raw, refs, strict=True) if ref is None]
     if bad:
-        raise SceneError(f"scene {scene.name!r} [study]", [
-            f"key_outputs: {text!r} is not 'unit.variable'" for text in bad])
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            [f"key_outputs: {text!r} is not 'unit.variable'" for text in bad],
+        )
     return tuple(dict.fromkeys(refs))
 
 
@@ -346,24 +366,35 @@ def _steps(scene: Scene, table: Mapping[str, Any], quick: bool) -> tuple[float, 
     if raw is None:
         exponents = (1, 0, -1) if quick else (2, 1, 0, -1, -2)
         return tuple(scene.run.step * 2.0**k for k in exponents)
-    if not isinstance(raw, list) or not raw or not all(
-            isinstance(h, int | float) and not isinstance(h, bool) and h > 0 for h in raw):
-        raise SceneError(f"scene {scene.name!r} [study]", [
-            "steps must be a non-empty list of positive macro steps (s)"])
+    if (
+        not isinstance(raw, list)
+        or not raw
+        or not all(isinstance(h, int | float) and not isinstance(h, bool) and h > 0 for h in raw)
+    ):
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            ["steps must be a non-empty list of positive macro steps (s)"],
+        )
     steps = tuple(sorted((float(h) for h in raw), reverse=True))
     if quick and len(steps) > 3:
         middle = len(steps) // 2
-        steps = steps[middle - 1:middle + 2]
+        steps = steps[middle - 1 : middle + 2]
     return steps
 
 
 def _output_interval(scene: Scene, table: Mapping[str, Any], steps: Sequence[float]) -> float:
     interval = float(table.get("output_interval", steps[0]))
-    problems = [f"output_interval {interval:g} s is not a multiple of the macro step {h:g} s"
-                for h in steps if not _multiple(interval, h)]
+    problems = [
+        f"output_interval {interval:g} s is not a multiple of the macro step {h:g} s"
+        for h in steps
+        if not _multiple(interval, h)
+    ]
     if problems:
-        raise SceneError(f"scene {scene.name!r} [study]", problems + [
-            "every run is compared on one grid of step ends: choose steps that divide it"])
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            problems
+            + ["every run is compared on one grid of step ends: choose steps that divide it"],
+        )
     return interval
 
 
@@ -395,9 +426,14 @@ def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
     stop = max(1, math.floor(stop / interval + 1e-9)) * interval
     settings = StudySettings(keys, stop, steps, interval)
     if quick:
-        settings = replace(settings, extrapolations=("constant", "linear"),
-                           solvers=(), monolithic_rtols=(), run_budget=20.0,
-                           quick=True)
+        settings = replace(
+            settings,
+            extrapolations=("constant", "linear"),
+            solvers=(),
+            monolithic_rtols=(),
+            run_budget=20.0,
+            quick=True,
+        )
     return settings
 
 
@@ -455,14 +491,18 @@ def _unit_solver_defaults(fmu: str) -> dict[str, Any]:
 
 def scene_solver(scene: Scene) -> SolverChoice:
     """The internal solvers as the scene sets them (nothing overridden)."""
-    complete = [{**_unit_solver_defaults(spec.fmu),
-                 **{k: spec.parameters[k] for k in SOLVER_KEYS if k in spec.parameters}}
-                for spec in scene.units.values() if spec.fmu in CORE_UNITS]
+    complete = [
+        {
+            **_unit_solver_defaults(spec.fmu),
+            **{k: spec.parameters[k] for k in SOLVER_KEYS if k in spec.parameters},
+        }
+        for spec in scene.units.values()
+        if spec.fmu in CORE_UNITS
+    ]
     distinct = {json.dumps(c, sort_keys=True) for c in complete}
     if len(distinct) > 1:
         names = [n for n, spec in scene.units.items() if spec.fmu in CORE_UNITS]
-        label = ", ".join(f"{n} {describe_solver(c)}" for n, c in zip(names, complete,
-                                                                      strict=True))
+        label = ", ".join(f"{n} {describe_solver(c)}" for n, c in zip(names, complete, strict=True))
         return SolverChoice(f"scene: {label}", {}, settings={"solver": "(mixed)"})
     settings = complete[0] if complete else dict(UNIT_SOLVER_DEFAULTS)
     return SolverChoice(f"{describe_solver(settings)} (scene)", {}, settings=settings)
@@ -473,8 +513,9 @@ def solver_choices(scene: Scene, settings: StudySettings) -> list[SolverChoice]:
     own = scene_solver(scene)
     out = [own]
     for choice in settings.solvers:
-        if choice.applies_to(scene) and (choice.only is not None
-                                         or choice.complete != own.complete):
+        if choice.applies_to(scene) and (
+            choice.only is not None or choice.complete != own.complete
+        ):
             out.append(choice)
     return out
 
@@ -489,16 +530,21 @@ def build_grid(scene: Scene, settings: StudySettings) -> list[Configuration]:
     solvers = solver_choices(scene, settings)
     couplings = [(a, e) for a in settings.algorithms for e in settings.extrapolations]
     if settings.grid == "product":
-        return [Configuration(a, e, h, s) for s in solvers for a, e in couplings
-                for h in settings.steps]
+        return [
+            Configuration(a, e, h, s) for s in solvers for a, e in couplings for h in settings.steps
+        ]
     own = [Configuration(a, e, h, solvers[0]) for a, e in couplings for h in settings.steps]
     run = scene.run
-    return own + [Configuration(run.algorithm, run.extrapolation, h, s) for s in solvers[1:]
-                  for h in settings.steps]
+    return own + [
+        Configuration(run.algorithm, run.extrapolation, h, s)
+        for s in solvers[1:]
+        for h in settings.steps
+    ]
 
 
-def _solver_parameters(scene: Scene, structure: Structure | None,
-                       solver: SolverChoice) -> dict[str, Any]:
+def _solver_parameters(
+    scene: Scene, structure: Structure | None, solver: SolverChoice
+) -> dict[str, Any]:
     units = {}
     for name, spec in scene.units.items():
         params = copy.deepcopy(spec.parameters)
@@ -511,16 +557,22 @@ def _solver_parameters(scene: Scene, structure: Structure | None,
 
 def study_scene(scene: Scene, settings: StudySettings) -> Scene:
     """The scene as every run of the study sees it: stop time, grid, key outputs recorded."""
-    scene = with_run_settings(scene, stop_time=settings.stop_time,
-                              output_interval=settings.output_interval, adaptive=False)
+    scene = with_run_settings(
+        scene,
+        stop_time=settings.stop_time,
+        output_interval=settings.output_interval,
+        adaptive=False,
+    )
     return replace(scene, outputs=settings.key_outputs)
 
 
-def configured_scene(scene: Scene, config: Configuration,
-                     structure: Structure | None = None) -> Scene:
+def configured_scene(
+    scene: Scene, config: Configuration, structure: Structure | None = None
+) -> Scene:
     """A copy of a study scene set up for ``config`` (parameters deep-copied)."""
-    scene = with_run_settings(scene, step=config.step, algorithm=config.algorithm,
-                              extrapolation=config.extrapolation)
+    scene = with_run_settings(
+        scene, step=config.step, algorithm=config.algorithm, extrapolation=config.extrapolation
+    )
     return replace(scene, units=_solver_parameters(scene, structure, config.solver))
 
 
@@ -546,8 +598,11 @@ class Timing:
         if self.wall <= 0:
             return math.nan, math.nan, math.nan
         physics = min(self.physics, self.fmi)
-        return physics / self.wall, (self.fmi - physics) / self.wall, (
-            self.wall - self.fmi) / self.wall
+        return (
+            physics / self.wall,
+            (self.fmi - physics) / self.wall,
+            (self.wall - self.fmi) / self.wall,
+        )
 
 
 class PhysicsTimer:
@@ -635,8 +690,14 @@ class _TimingObserver:
         if wall0 == 0.0:
             return
         fmi, calls, steps = self._fmi(sim)
-        self.timing = Timing(time.perf_counter() - wall0, sim.time, self.timer.elapsed - physics0,
-                             fmi - fmi0, calls - calls0, steps - steps0)
+        self.timing = Timing(
+            time.perf_counter() - wall0,
+            sim.time,
+            self.timer.elapsed - physics0,
+            fmi - fmi0,
+            calls - calls0,
+            steps - steps0,
+        )
 
 
 @dataclass
@@ -669,12 +730,14 @@ def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsT
         logger.debug("run failed: %s", exc, exc_info=True)
         return TimedRun("failed", f"{type(exc).__name__}: {exc}", {}, Timing())
     columns = read_results(recorder.csv_path) if recorder.csv_path.exists() else {}
-    return TimedRun(result.status, result.message, columns, timing.timing, result.steps,
-                    result.rejected)
+    return TimedRun(
+        result.status, result.message, columns, timing.timing, result.steps, result.rejected
+    )
 
 
-def fastest_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsTimer,
-                repeats: int = 1) -> tuple[TimedRun, float]:
+def fastest_run(
+    scene: Scene, structure: Structure, workdir: Path, timer: PhysicsTimer, repeats: int = 1
+) -> tuple[TimedRun, float]:
     """The fastest of ``repeats`` runs, and the spread of their costs (s per simulated s;
     NaN with fewer than two finished runs).
 
@@ -711,8 +774,11 @@ def _scale(reference: np.ndarray) -> float:
     return max(span, _RANGE_FLOOR * float(np.max(np.abs(reference), initial=0.0)), 1e-300)
 
 
-def output_error(values: Mapping[str, np.ndarray], reference: Mapping[str, np.ndarray],
-                 keys: Sequence[VarRef | str]) -> tuple[float, str]:
+def output_error(
+    values: Mapping[str, np.ndarray],
+    reference: Mapping[str, np.ndarray],
+    keys: Sequence[VarRef | str],
+) -> tuple[float, str]:
     """The study's error metric (module docstring) and the key output that sets it.
 
     Returns ``(nan, reason)`` if the run does not cover the reference grid.
@@ -768,30 +834,84 @@ def _row(config: Configuration, run: TimedRun, error: float, worst: str) -> RunR
     status = run.status
     if status == "finished" and not (math.isfinite(error) and error <= _DIVERGED):
         status = "diverged"
-    return RunRow(config.family, config.algorithm, config.extrapolation, config.solver.label,
-                  config.step, status, error, worst, t.wall, t.simulated,
-                  t.per_simulated_second, run.steps, run.rejected, t.calls, t.do_steps, physics,
-                  overhead, master, one_line(run.message))
+    return RunRow(
+        config.family,
+        config.algorithm,
+        config.extrapolation,
+        config.solver.label,
+        config.step,
+        status,
+        error,
+        worst,
+        t.wall,
+        t.simulated,
+        t.per_simulated_second,
+        run.steps,
+        run.rejected,
+        t.calls,
+        t.do_steps,
+        physics,
+        overhead,
+        master,
+        one_line(run.message),
+    )
 
 
 def one_line(message: str, limit: int = 300) -> str:
     """A message on one line (a unit's list of problems joined), at most ``limit`` characters."""
     text = " ".join(message.split())
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _skipped(config: Configuration, reason: str) -> RunRow:
-    return RunRow(config.family, config.algorithm, config.extrapolation, config.solver.label,
-                  config.step, "skipped", math.nan, "", math.nan, 0.0, math.nan, 0, 0, 0, 0,
-                  math.nan, math.nan, math.nan, reason)
+    return RunRow(
+        config.family,
+        config.algorithm,
+        config.extrapolation,
+        config.solver.label,
+        config.step,
+        "skipped",
+        math.nan,
+        "",
+        math.nan,
+        0.0,
+        math.nan,
+        0,
+        0,
+        0,
+        0,
+        math.nan,
+        math.nan,
+        math.nan,
+        reason,
+    )
 
 
-def _monolithic_row(family: str, label: str, result: MonolithicResult, error: float,
-                    worst: str, stop: float) -> RunRow:
+def _monolithic_row(
+    family: str, label: str, result: MonolithicResult, error: float, worst: str, stop: float
+) -> RunRow:
     status = "finished" if math.isfinite(error) and error <= _DIVERGED else "diverged"
-    return RunRow(family, "monolithic", "-", label, math.nan, status, error,
-                  worst, result.wall_time, stop, result.wall_time / stop, result.steps, 0, 0, 0,
-                  1.0, 0.0, 0.0, f"{result.rhs_calls} right-hand side calls")
+    return RunRow(
+        family,
+        "monolithic",
+        "-",
+        label,
+        math.nan,
+        status,
+        error,
+        worst,
+        result.wall_time,
+        stop,
+        result.wall_time / stop,
+        result.steps,
+        0,
+        0,
+        0,
+        1.0,
+        0.0,
+        0.0,
+        f"{result.rhs_calls} right-hand side calls",
+    )
 
 
 # --------------------------------------------------------------------- orders
@@ -837,15 +957,15 @@ def _slope(steps: Sequence[float], errors: Sequence[float]) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def observed_orders(rows: Sequence[RunRow], scene: Scene,
-                    min_error: float = 0.0) -> list[OrderRow]:
+def observed_orders(rows: Sequence[RunRow], scene: Scene, min_error: float = 0.0) -> list[OrderRow]:
     """The order of every family over its runs where coupling error dominates.
 
     ``min_error``: errors at or below it are the reference's own (the
     study passes 100 times the reference's tolerance).
     """
-    floors = {r.solver: r.error for r in rows
-              if r.family == f"monolithic / {r.solver}" and r.usable}
+    floors = {
+        r.solver: r.error for r in rows if r.family == f"monolithic / {r.solver}" and r.usable
+    }
     out = []
     for family, runs in _families(rows).items():
         first = runs[0]
@@ -855,14 +975,36 @@ def observed_orders(rows: Sequence[RunRow], scene: Scene,
         kept = [r for r in runs if r.usable and floor < r.error <= ASYMPTOTIC_LIMIT]
         theory = theoretical_order(scene, first.extrapolation)
         if len(kept) < 2:
-            note = (f"{len(kept)} run(s) with an error between {DOMINANCE:g} x the solver's own "
-                    f"error and {ASYMPTOTIC_LIMIT:g}: not measurable")
-            out.append(OrderRow(family, first.algorithm, first.extrapolation, first.solver,
-                                theory, math.nan, len(kept), note=note))
+            note = (
+                f"{len(kept)} run(s) with an error between {DOMINANCE:g} x the solver's own "
+                f"error and {ASYMPTOTIC_LIMIT:g}: not measurable"
+            )
+            out.append(
+                OrderRow(
+                    family,
+                    first.algorithm,
+                    first.extrapolation,
+                    first.solver,
+                    theory,
+                    math.nan,
+                    len(kept),
+                    note=note,
+                )
+            )
             continue
         observed = _slope([r.step for r in kept], [r.error for r in kept])
-        out.append(OrderRow(family, first.algorithm, first.extrapolation, first.solver, theory,
-                            observed, len(kept), tuple(r.step for r in kept)))
+        out.append(
+            OrderRow(
+                family,
+                first.algorithm,
+                first.extrapolation,
+                first.solver,
+                theory,
+                observed,
+                len(kept),
+                tuple(r.step for r in kept),
+            )
+        )
     return out
 
 
@@ -871,8 +1013,12 @@ def _families(rows: Sequence[RunRow]) -> dict[str, list[RunRow]]:
     for r in rows:
         out[r.family].append(r)
     for runs in out.values():
-        runs.sort(key=lambda r: (-r.step if math.isfinite(r.step) else 0.0, -r.error
-                                 if math.isfinite(r.error) else 0.0))
+        runs.sort(
+            key=lambda r: (
+                -r.step if math.isfinite(r.step) else 0.0,
+                -r.error if math.isfinite(r.error) else 0.0,
+            )
+        )
     return dict(out)
 
 
@@ -930,8 +1076,9 @@ def equal_error(rows: Sequence[RunRow], targets: Sequence[float]) -> list[EqualE
 
 
 # ------------------------------------------------------------------ reference
-def reference_run(scene: Scene, settings: StudySettings, rtol: float | None = None
-                  ) -> MonolithicResult:
+def reference_run(
+    scene: Scene, settings: StudySettings, rtol: float | None = None
+) -> MonolithicResult:
     """The monolithic model of a study scene on the study's output grid.
 
     Raises
@@ -944,13 +1091,17 @@ def reference_run(scene: Scene, settings: StudySettings, rtol: float | None = No
     try:
         return run_monolithic(scene, rtol=tol, atol=tol, output_interval=settings.output_interval)
     except NotImplementedError as exc:
-        raise StudyError(f"scene {scene.name!r}: no monolithic reference: {exc} (its core "
-                         "unit offers no ode() view yet)") from None
+        raise StudyError(
+            f"scene {scene.name!r}: no monolithic reference: {exc} (its core "
+            "unit offers no ode() view yet)"
+        ) from None
     except SceneError as exc:
         raise StudyError(f"scene {scene.name!r}: no monolithic reference: {exc}") from None
     except (IntegrationError, ModelError, FloatingPointError, ValueError) as exc:
-        raise StudyError(f"scene {scene.name!r}: the monolithic reference (Radau, rtol "
-                         f"{tol:g}) failed: {type(exc).__name__}: {exc}") from None
+        raise StudyError(
+            f"scene {scene.name!r}: the monolithic reference (Radau, rtol "
+            f"{tol:g}) failed: {type(exc).__name__}: {exc}"
+        ) from None
 
 
 # ------------------------------------------------------------------- progress
@@ -988,8 +1139,9 @@ class StudyProgress:
         width = 20
         filled = int(width * self.done / max(self.total, 1))
         bar = "#" * filled + "." * (width - filled)
-        self.note(f"[{bar}] {self.done:>3}/{self.total} {elapsed:6.0f} s (~{left:.0f} s left) "
-                  f"{text}")
+        self.note(
+            f"[{bar}] {self.done:>3}/{self.total} {elapsed:6.0f} s (~{left:.0f} s left) {text}"
+        )
 
 
 # ------------------------------------------------------------------ the study
@@ -1010,28 +1162,43 @@ class AccuracyStudy:
 def _describe(row: RunRow) -> str:
     where = f"{row.family} H={row.step:g}" if math.isfinite(row.step) else row.family
     if row.status == "finished":
-        return (f"{where}: error {row.error:.2e}, "
-                f"{row.wall_per_sim_s:.3g} s/s")
+        return f"{where}: error {row.error:.2e}, {row.wall_per_sim_s:.3g} s/s"
     return f"{where}: {row.status} {row.message[:80]}"
 
 
-def _run_grid(scene: Scene, structure: Structure, grid: Sequence[Configuration],
-              reference: MonolithicResult, settings: StudySettings, workdir: Path,
-              progress: StudyProgress) -> list[RunRow]:
+def _run_grid(
+    scene: Scene,
+    structure: Structure,
+    grid: Sequence[Configuration],
+    reference: MonolithicResult,
+    settings: StudySettings,
+    workdir: Path,
+    progress: StudyProgress,
+) -> list[RunRow]:
     rows: list[RunRow] = []
     over_budget: dict[str, float] = {}
     with PhysicsTimer(core_classes(scene)) as timer:
         for config in grid:
             if config.family in over_budget:
-                row = _skipped(config, f"skipped: the run at a larger step took "
-                               f"{over_budget[config.family]:.1f} s (budget "
-                               f"{settings.run_budget:g} s)")
+                row = _skipped(
+                    config,
+                    f"skipped: the run at a larger step took "
+                    f"{over_budget[config.family]:.1f} s (budget "
+                    f"{settings.run_budget:g} s)",
+                )
             else:
-                run, _ = fastest_run(configured_scene(scene, config, structure), structure,
-                                     workdir, timer, settings.repeats)
-                error, worst = (output_error(run.columns, reference.values,
-                                             settings.key_outputs)
-                                if run.status == "finished" else (math.nan, ""))
+                run, _ = fastest_run(
+                    configured_scene(scene, config, structure),
+                    structure,
+                    workdir,
+                    timer,
+                    settings.repeats,
+                )
+                error, worst = (
+                    output_error(run.columns, reference.values, settings.key_outputs)
+                    if run.status == "finished"
+                    else (math.nan, "")
+                )
                 row = _row(config, run, error, worst)
                 if 2.0 * row.wall_time_s > settings.run_budget:
                     over_budget[config.family] = row.wall_time_s
@@ -1040,14 +1207,38 @@ def _run_grid(scene: Scene, structure: Structure, grid: Sequence[Configuration],
     return rows
 
 
-def _monolithic_attempt(scene: Scene, settings: StudySettings, reference: MonolithicResult,
-                        family: str, label: str, **solver) -> RunRow:
+def _monolithic_attempt(
+    scene: Scene,
+    settings: StudySettings,
+    reference: MonolithicResult,
+    family: str,
+    label: str,
+    **solver,
+) -> RunRow:
     try:
         result = run_monolithic(scene, output_interval=settings.output_interval, **solver)
     except Exception as exc:  # noqa: BLE001 - a loose tolerance may fail; record it
-        return RunRow(family, "monolithic", "-", label, math.nan, "failed", math.nan, "",
-                      math.nan, 0.0, math.nan, 0, 0, 0, 0, math.nan, math.nan, math.nan,
-                      one_line(f"{type(exc).__name__}: {exc}"))
+        return RunRow(
+            family,
+            "monolithic",
+            "-",
+            label,
+            math.nan,
+            "failed",
+            math.nan,
+            "",
+            math.nan,
+            0.0,
+            math.nan,
+            0,
+            0,
+            0,
+            0,
+            math.nan,
+            math.nan,
+            math.nan,
+            one_line(f"{type(exc).__name__}: {exc}"),
+        )
     error, worst = output_error(result.values, reference.values, settings.key_outputs)
     return _monolithic_row(family, label, result, error, worst, settings.stop_time)
 
@@ -1057,40 +1248,72 @@ def _monolithic_solver(choice: SolverChoice) -> dict[str, Any] | None:
     params = choice.complete
     if choice.only is not None or params["solver"] not in HYBRID_SOLVERS:
         return None
-    return {"method": params["solver"], "rtol": float(params["solver_rtol"]),
-            "atol": float(params["solver_atol"]), "max_step": float(params["solver_max_step"])}
+    return {
+        "method": params["solver"],
+        "rtol": float(params["solver_rtol"]),
+        "atol": float(params["solver_atol"]),
+        "max_step": float(params["solver_max_step"]),
+    }
 
 
-def _monolithic_rows(scene: Scene, settings: StudySettings, reference: MonolithicResult,
-                     progress: StudyProgress) -> list[RunRow]:
+def _monolithic_rows(
+    scene: Scene, settings: StudySettings, reference: MonolithicResult, progress: StudyProgress
+) -> list[RunRow]:
     """The monolithic model at looser Radau tolerances, and with each unit solver."""
     rows = []
     for rtol in settings.monolithic_rtols:
-        rows.append(_monolithic_attempt(scene, settings, reference, MONOLITHIC_RADAU,
-                                        f"radau rtol={rtol:g}", method="radau", rtol=rtol,
-                                        atol=rtol))
+        rows.append(
+            _monolithic_attempt(
+                scene,
+                settings,
+                reference,
+                MONOLITHIC_RADAU,
+                f"radau rtol={rtol:g}",
+                method="radau",
+                rtol=rtol,
+                atol=rtol,
+            )
+        )
         progress.advance(_describe(rows[-1]))
     for choice in solver_choices(scene, settings) if settings.solver_floors else ():
         solver = _monolithic_solver(choice)
         if solver is not None:
-            rows.append(_monolithic_attempt(scene, settings, reference,
-                                            f"monolithic / {choice.label}", choice.label,
-                                            **solver))
+            rows.append(
+                _monolithic_attempt(
+                    scene,
+                    settings,
+                    reference,
+                    f"monolithic / {choice.label}",
+                    choice.label,
+                    **solver,
+                )
+            )
             progress.advance(_describe(rows[-1]))
     return rows
 
 
 def _monolithic_runs(scene: Scene, settings: StudySettings) -> int:
-    floors = sum(1 for c in solver_choices(scene, settings)
-                 if _monolithic_solver(c) is not None) if settings.solver_floors else 0
+    floors = (
+        sum(1 for c in solver_choices(scene, settings) if _monolithic_solver(c) is not None)
+        if settings.solver_floors
+        else 0
+    )
     return len(settings.monolithic_rtols) + floors
 
 
-def run_accuracy_study(scene: Scene | str | Path, output_dir: Path, *, quick: bool = False,
-                       settings: StudySettings | None = None, repeats: int | None = None,
-                       grid: str | None = None, stop_time: float | None = None,
-                       fmu_dir: Path = DEFAULT_FMU_DIR, progress: bool = True,
-                       stream: TextIO | None = None) -> AccuracyStudy:
+def run_accuracy_study(
+    scene: Scene | str | Path,
+    output_dir: Path,
+    *,
+    quick: bool = False,
+    settings: StudySettings | None = None,
+    repeats: int | None = None,
+    grid: str | None = None,
+    stop_time: float | None = None,
+    fmu_dir: Path = DEFAULT_FMU_DIR,
+    progress: bool = True,
+    stream: TextIO | None = None,
+) -> AccuracyStudy:
     """Run the accuracy study of ``scene`` and write its files into ``output_dir``.
 
     Parameters
@@ -1133,28 +1356,39 @@ def run_accuracy_study(scene: Scene | str | Path, output_dir: Path, *, quick: bo
     base = study_scene(scene, settings)
     with tempfile.TemporaryDirectory(prefix="wire_fmu_study_") as tmp:
         structure = pinned(validate_scene(base, fmu_dir), Path(tmp))
-        study = _study(scene.name, base, structure, settings, Path(tmp) / "run", progress,
-                       stream)
+        study = _study(scene.name, base, structure, settings, Path(tmp) / "run", progress, stream)
     study.elapsed = time.perf_counter() - started
     study.files = write_accuracy_files(study, Path(output_dir))
     return study
 
 
-def _study(name: str, base: Scene, structure: Structure, settings: StudySettings,
-           workdir: Path, progress: bool, stream: TextIO | None) -> AccuracyStudy:
+def _study(
+    name: str,
+    base: Scene,
+    structure: Structure,
+    settings: StudySettings,
+    workdir: Path,
+    progress: bool,
+    stream: TextIO | None,
+) -> AccuracyStudy:
     grid = build_grid(base, settings)
     report = StudyProgress(len(grid) + _monolithic_runs(base, settings), stream, progress)
-    report.note(f"study of {name!r}: {len(grid)} runs of {settings.stop_time:g} s, "
-                f"reference: monolithic Radau rtol {settings.reference_rtol:g}")
+    report.note(
+        f"study of {name!r}: {len(grid)} runs of {settings.stop_time:g} s, "
+        f"reference: monolithic Radau rtol {settings.reference_rtol:g}"
+    )
     reference = reference_run(base, settings)
-    report.note(f"reference: {reference.wall_time:.2f} s wall, {reference.rhs_calls} "
-                f"right-hand side calls, {reference.events} events")
+    report.note(
+        f"reference: {reference.wall_time:.2f} s wall, {reference.rhs_calls} "
+        f"right-hand side calls, {reference.events} events"
+    )
     rows = _run_grid(base, structure, grid, reference, settings, workdir, report)
     rows += _monolithic_rows(base, settings, reference, report)
     orders = observed_orders(rows, base, REFERENCE_MARGIN * settings.reference_rtol)
     comparison = equal_error(rows, default_targets(rows))
-    return AccuracyStudy(name, settings, reference.wall_time / settings.stop_time, rows, orders,
-                         comparison)
+    return AccuracyStudy(
+        name, settings, reference.wall_time / settings.stop_time, rows, orders, comparison
+    )
 
 
 def load_study_scene(scene: Scene | str | Path) -> Scene:
@@ -1236,17 +1470,20 @@ def _plan_lines(study: AccuracyStudy) -> list[str]:
 
 
 def _order_lines(study: AccuracyStudy) -> list[str]:
-    lines = ["## Observed convergence orders", "",
-             f"Slope of log error against log macro step over the runs with an error below "
-             f"{ASYMPTOTIC_LIMIT:g} and above {DOMINANCE:g} times the solver's smallest error "
-             "(where coupling error dominates).", "",
-             "| family | theory | observed | runs used | steps used (s) |",
-             "|---|---:|---:|---:|---|"]
+    lines = [
+        "## Observed convergence orders",
+        "",
+        f"Slope of log error against log macro step over the runs with an error below "
+        f"{ASYMPTOTIC_LIMIT:g} and above {DOMINANCE:g} times the solver's smallest error "
+        "(where coupling error dominates).",
+        "",
+        "| family | theory | observed | runs used | steps used (s) |",
+        "|---|---:|---:|---:|---|",
+    ]
     for o in study.orders:
         theory = "—" if o.theory is None else str(o.theory)
         used = ", ".join(f"{h:g}" for h in o.steps_used) or o.note
-        lines.append(f"| {o.family} | {theory} | {_fmt(o.observed, '.2f')} | {o.points} | "
-                     f"{used} |")
+        lines.append(f"| {o.family} | {theory} | {_fmt(o.observed, '.2f')} | {o.points} | {used} |")
     return lines + [""]
 
 
@@ -1254,50 +1491,78 @@ def _comparison_lines(study: AccuracyStudy) -> list[str]:
     if not study.comparison:
         return ["## Equal-error comparison", "", "No run finished with a usable error.", ""]
     targets = [c.target for c in study.comparison]
-    lines = ["## Equal-error comparison", "",
-             "Wall seconds per simulated second each family needs to reach a target error "
-             "(interpolated log-log between its runs; — : not reached on this grid).", "",
-             "| family | " + " | ".join(f"error {t:.0e}" for t in targets) + " |",
-             "|---|" + "---:|" * len(targets)]
+    lines = [
+        "## Equal-error comparison",
+        "",
+        "Wall seconds per simulated second each family needs to reach a target error "
+        "(interpolated log-log between its runs; — : not reached on this grid).",
+        "",
+        "| family | " + " | ".join(f"error {t:.0e}" for t in targets) + " |",
+        "|---|" + "---:|" * len(targets),
+    ]
     for family in study.comparison[0].costs:
         cells = [_fmt(c.costs[family]) for c in study.comparison]
         lines.append(f"| {family} | " + " | ".join(cells) + " |")
-    lines += ["| **cheapest** | " + " | ".join(
-        f"{c.cheapest} ({_fmt(c.cheapest_cost)})" if c.cheapest else "—"
-        for c in study.comparison) + " |", ""]
+    lines += [
+        "| **cheapest** | "
+        + " | ".join(
+            f"{c.cheapest} ({_fmt(c.cheapest_cost)})" if c.cheapest else "—"
+            for c in study.comparison
+        )
+        + " |",
+        "",
+    ]
     for c in study.comparison:
         if c.cheapest:
             ratio = c.cheapest_cost / study.reference_wall_per_sim_s
-            lines.append(f"- error {c.target:.0e}: cheapest **{c.cheapest}**, "
-                         f"{c.cheapest_cost:.3g} s/s ({ratio:.2g} x the monolithic reference's "
-                         f"cost); {c.reached()} of {len(c.costs)} families reach it.")
+            lines.append(
+                f"- error {c.target:.0e}: cheapest **{c.cheapest}**, "
+                f"{c.cheapest_cost:.3g} s/s ({ratio:.2g} x the monolithic reference's "
+                f"cost); {c.reached()} of {len(c.costs)} families reach it."
+            )
     return lines + [""]
 
 
 def _run_lines(study: AccuracyStudy) -> list[str]:
-    lines = ["## Runs", "",
-             "| family | H (s) | status | error | worst output | s/s | doStep | FMU calls | "
-             "physics | FMI overhead | master |",
-             "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        "## Runs",
+        "",
+        "| family | H (s) | status | error | worst output | s/s | doStep | FMU calls | "
+        "physics | FMI overhead | master |",
+        "|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in study.rows:
-        lines.append(f"| {r.family} | {_fmt(r.step, 'g')} | {r.status} | {_fmt(r.error, '.2e')} "
-                     f"| {r.worst_output} | {_fmt(r.wall_per_sim_s)} | {r.do_step_calls} | "
-                     f"{r.fmu_calls} | {_pct(r.physics_share)} | {_pct(r.fmi_overhead_share)} | "
-                     f"{_pct(r.master_share)} |")
+        lines.append(
+            f"| {r.family} | {_fmt(r.step, 'g')} | {r.status} | {_fmt(r.error, '.2e')} "
+            f"| {r.worst_output} | {_fmt(r.wall_per_sim_s)} | {r.do_step_calls} | "
+            f"{r.fmu_calls} | {_pct(r.physics_share)} | {_pct(r.fmi_overhead_share)} | "
+            f"{_pct(r.master_share)} |"
+        )
     failed = [r for r in study.rows if r.status not in ("finished", "skipped")]
     if failed:
         lines += ["", "### Runs that did not finish or blew up", ""]
-        lines += [f"- {r.family}, H = {r.step:g} s: {r.status}: {r.message or '(no message)'}"
-                  for r in failed]
+        lines += [
+            f"- {r.family}, H = {r.step:g} s: {r.status}: {r.message or '(no message)'}"
+            for r in failed
+        ]
     return lines + [""]
 
 
 def accuracy_markdown(study: AccuracyStudy) -> str:
     """The summary ``accuracy.md``."""
-    files = ["", "Files: `accuracy.csv` (the table), `accuracy.json`, `work_precision.png`, "
-             "`convergence.png`.", ""]
-    return "\n".join(_plan_lines(study) + _order_lines(study) + _comparison_lines(study)
-                     + _run_lines(study) + files)
+    files = [
+        "",
+        "Files: `accuracy.csv` (the table), `accuracy.json`, `work_precision.png`, "
+        "`convergence.png`.",
+        "",
+    ]
+    return "\n".join(
+        _plan_lines(study)
+        + _order_lines(study)
+        + _comparison_lines(study)
+        + _run_lines(study)
+        + files
+    )
 
 
 def _style(study_rows: Sequence[RunRow]):
@@ -1315,15 +1580,37 @@ def _legend(ax, colours, dashes, markers, work_precision: bool) -> None:
     handles += [Line2D([], [], color="0.3", ls=d, label=e) for e, d in dashes.items()]
     handles += [Line2D([], [], color="0.3", ls="", marker=m, label=a) for a, m in markers.items()]
     if work_precision:
-        handles += [Line2D([], [], color="k", marker="D", ms=4, label="monolithic, Radau rtol"),
-                    Line2D([], [], color="w", ls="", marker="*", ms=11, mec="k",
-                           label="monolithic, unit solver"),
-                    Line2D([], [], color="k", ls="-.", lw=1, label="monolithic reference")]
+        handles += [
+            Line2D([], [], color="k", marker="D", ms=4, label="monolithic, Radau rtol"),
+            Line2D(
+                [],
+                [],
+                color="w",
+                ls="",
+                marker="*",
+                ms=11,
+                mec="k",
+                label="monolithic, unit solver",
+            ),
+            Line2D([], [], color="k", ls="-.", lw=1, label="monolithic reference"),
+        ]
     else:
-        handles += [Line2D([], [], color="0.3", ls=(0, (1, 3)),
-                           label="solver's own error\n(monolithic, same solver)")]
-    ax.legend(handles=handles, loc="center left", bbox_to_anchor=(1.01, 0.5),
-              fontsize="small", frameon=False)
+        handles += [
+            Line2D(
+                [],
+                [],
+                color="0.3",
+                ls=(0, (1, 3)),
+                label="solver's own error\n(monolithic, same solver)",
+            )
+        ]
+    ax.legend(
+        handles=handles,
+        loc="center left",
+        bbox_to_anchor=(1.01, 0.5),
+        fontsize="small",
+        frameon=False,
+    )
 
 
 def _figure(title: str, xlabel: str, ylabel: str):
@@ -1352,41 +1639,67 @@ def _plot_families(ax, study: AccuracyStudy, x_of, y_of, work_precision: bool) -
             ax.plot([x_of(r) for r in ok], [y_of(r) for r in ok], color="k", marker="D", ms=4)
             continue
         if first.algorithm == "monolithic":
-            ax.plot([x_of(first)], [y_of(first)], ls="", marker="*", ms=11, mec="k",
-                    color=colours.get(first.solver, "k"))
+            ax.plot(
+                [x_of(first)],
+                [y_of(first)],
+                ls="",
+                marker="*",
+                ms=11,
+                mec="k",
+                color=colours.get(first.solver, "k"),
+            )
             continue
-        ax.plot([x_of(r) for r in ok], [y_of(r) for r in ok], color=colours[first.solver],
-                ls=dashes[first.extrapolation], marker=markers[first.algorithm], ms=4, lw=1.2)
+        ax.plot(
+            [x_of(r) for r in ok],
+            [y_of(r) for r in ok],
+            color=colours[first.solver],
+            ls=dashes[first.extrapolation],
+            marker=markers[first.algorithm],
+            ms=4,
+            lw=1.2,
+        )
         if work_precision and not labelled:
             for r in ok:
-                ax.annotate(f"H={r.step:g}", (x_of(r), y_of(r)), fontsize="x-small",
-                            textcoords="offset points", xytext=(4, 4))
+                ax.annotate(
+                    f"H={r.step:g}",
+                    (x_of(r), y_of(r)),
+                    fontsize="x-small",
+                    textcoords="offset points",
+                    xytext=(4, 4),
+                )
             labelled = True
     _legend(ax, colours, dashes, markers, work_precision)
 
 
 def plot_work_precision(study: AccuracyStudy, path: Path) -> Path:
     """The work-precision diagram: error (x) against wall s per simulated s (y), log-log."""
-    fig, ax = _figure(f"{study.scene}: what accuracy costs", "error (max over key outputs of "
-                      "max |y - y_ref| / range of y_ref)", "wall time per simulated second (s/s)")
-    _plot_families(ax, study, lambda r: r.error, lambda r: r.wall_per_sim_s,
-                   work_precision=True)
+    fig, ax = _figure(
+        f"{study.scene}: what accuracy costs",
+        "error (max over key outputs of max |y - y_ref| / range of y_ref)",
+        "wall time per simulated second (s/s)",
+    )
+    _plot_families(ax, study, lambda r: r.error, lambda r: r.wall_per_sim_s, work_precision=True)
     floor = study.reference_wall_per_sim_s
     ax.axhline(floor, color="k", ls="-.", lw=1)
-    ax.annotate(f"monolithic reference, Radau rtol {study.settings.reference_rtol:g}: "
-                f"{floor:.3g} s/s", (0.01, floor), xycoords=("axes fraction", "data"),
-                fontsize="small", textcoords="offset points", xytext=(0, 4))
+    ax.annotate(
+        f"monolithic reference, Radau rtol {study.settings.reference_rtol:g}: {floor:.3g} s/s",
+        (0.01, floor),
+        xycoords=("axes fraction", "data"),
+        fontsize="small",
+        textcoords="offset points",
+        xytext=(0, 4),
+    )
     fig.savefig(path)
     return path
 
 
 def plot_convergence(study: AccuracyStudy, path: Path) -> Path:
     """Error against macro step for every family, with slope-1 and slope-2 guides."""
-    fig, ax = _figure(f"{study.scene}: convergence in the macro step", "macro step H (s)",
-                      "error")
+    fig, ax = _figure(f"{study.scene}: convergence in the macro step", "macro step H (s)", "error")
     rows = [r for r in study.rows if r.algorithm != "monolithic"]
-    _plot_families(ax, replace(study, rows=rows), lambda r: r.step, lambda r: r.error,
-                   work_precision=False)
+    _plot_families(
+        ax, replace(study, rows=rows), lambda r: r.step, lambda r: r.error, work_precision=False
+    )
     colours = _style(study.rows)[0]
     for r in study.rows:
         if r.algorithm == "monolithic" and r.family != MONOLITHIC_RADAU and r.usable:
@@ -1397,8 +1710,12 @@ def plot_convergence(study: AccuracyStudy, path: Path) -> Path:
         anchor = max(r.error for r in usable if r.step == h[-1])
         for order, ls in ((1, (0, (6, 3))), (2, (0, (2, 2)))):
             ax.plot(h, anchor * (h / h[-1]) ** order, color="0.5", ls=ls, lw=1)
-            ax.annotate(f"order {order}", (h[0], anchor * (h[0] / h[-1]) ** order),
-                        fontsize="small", color="0.4")
+            ax.annotate(
+                f"order {order}",
+                (h[0], anchor * (h[0] / h[-1]) ** order),
+                fontsize="small",
+                color="0.4",
+            )
     fig.savefig(path)
     return path
 
@@ -1410,10 +1727,19 @@ def write_accuracy_files(study: AccuracyStudy, directory: Path) -> dict[str, Pat
     files["md"] = directory / "accuracy.md"
     files["md"].write_text(accuracy_markdown(study))
     files["json"] = directory / "accuracy.json"
-    files["json"].write_text(dumps({
-        "scene": study.scene, "settings": study.settings, "elapsed_s": study.elapsed,
-        "reference_wall_per_sim_s": study.reference_wall_per_sim_s, "orders": study.orders,
-        "equal_error": study.comparison, "runs": study.rows}))
+    files["json"].write_text(
+        dumps(
+            {
+                "scene": study.scene,
+                "settings": study.settings,
+                "elapsed_s": study.elapsed,
+                "reference_wall_per_sim_s": study.reference_wall_per_sim_s,
+                "orders": study.orders,
+                "equal_error": study.comparison,
+                "runs": study.rows,
+            }
+        )
+    )
     files["work_precision"] = plot_work_precision(study, directory / "work_precision.png")
     files["convergence"] = plot_convergence(study, directory / "convergence.png")
     return files
@@ -1425,11 +1751,15 @@ def summary_text(study: AccuracyStudy) -> str:
     width = max((len(o.family) for o in study.orders), default=10)
     for o in study.orders:
         theory = "-" if o.theory is None else str(o.theory)
-        lines.append(f"  {o.family:<{width}}  theory {theory}  observed "
-                     f"{_fmt(o.observed, '.2f'):>5}  ({o.points} runs)")
+        lines.append(
+            f"  {o.family:<{width}}  theory {theory}  observed "
+            f"{_fmt(o.observed, '.2f'):>5}  ({o.points} runs)"
+        )
     lines.append(f"monolithic reference: {study.reference_wall_per_sim_s:.3g} s per simulated s")
     for c in study.comparison:
         if c.cheapest:
-            lines.append(f"  at error {c.target:.0e}: cheapest {c.cheapest} "
-                         f"({c.cheapest_cost:.3g} s/s, {c.reached()}/{len(c.costs)} reach it)")
+            lines.append(
+                f"  at error {c.target:.0e}: cheapest {c.cheapest} "
+                f"({c.cheapest_cost:.3g} s/s, {c.reached()}/{len(c.costs)} reach it)"
+            )
     return "\n".join(lines)

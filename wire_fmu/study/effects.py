@@ -57,9 +57,19 @@ from .accuracy import (
     write_csv,
 )
 
-__all__ = ["EFFECT_CATALOGUES", "EffectCase", "EffectRow", "EffectsStudy", "effect_cases",
-           "catalogue", "run_effects_study", "effects_markdown", "summary_text", "verdict",
-           "without"]
+__all__ = [
+    "EFFECT_CATALOGUES",
+    "EffectCase",
+    "EffectRow",
+    "EffectsStudy",
+    "effect_cases",
+    "catalogue",
+    "run_effects_study",
+    "effects_markdown",
+    "summary_text",
+    "verdict",
+    "without",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -152,8 +162,9 @@ class EffectRow:
     @property
     def label(self) -> str:
         """Short label for tables and charts."""
-        return EffectCase(self.unit, self.effect, tuple(self.also_removed.split()) if
-                          self.also_removed else ()).label
+        return EffectCase(
+            self.unit, self.effect, tuple(self.also_removed.split()) if self.also_removed else ()
+        ).label
 
 
 @dataclass
@@ -198,26 +209,65 @@ def verdict(saved: float, noise: float) -> str:
     return "within noise" if abs(saved) <= noise else word
 
 
-def _effect_row(case: EffectCase, run: TimedRun, spread: float, baseline: TimedRun,
-                baseline_spread: float, keys: Sequence[str]) -> EffectRow:
+def _effect_row(
+    case: EffectCase,
+    run: TimedRun,
+    spread: float,
+    baseline: TimedRun,
+    baseline_spread: float,
+    keys: Sequence[str],
+) -> EffectRow:
     base_cost = baseline.timing.per_simulated_second
     also = " ".join(case.also_removed)
     if run.status != "finished":
-        return EffectRow(case.unit, case.effect, also, run.status, math.nan, base_cost,
-                         math.nan, math.nan, "—", math.nan, "", math.nan, math.nan,
-                         one_line(run.message))
+        return EffectRow(
+            case.unit,
+            case.effect,
+            also,
+            run.status,
+            math.nan,
+            base_cost,
+            math.nan,
+            math.nan,
+            "—",
+            math.nan,
+            "",
+            math.nan,
+            math.nan,
+            one_line(run.message),
+        )
     cost = run.timing.per_simulated_second
     change, worst = output_error(run.columns, baseline.columns, keys)
     noise = max(spread, baseline_spread) if math.isfinite(spread + baseline_spread) else math.nan
-    return EffectRow(case.unit, case.effect, also, "finished", cost, base_cost, base_cost - cost,
-                     (base_cost - cost) / base_cost, verdict(base_cost - cost, noise), change,
-                     worst, spread, run.timing.shares()[0])
+    return EffectRow(
+        case.unit,
+        case.effect,
+        also,
+        "finished",
+        cost,
+        base_cost,
+        base_cost - cost,
+        (base_cost - cost) / base_cost,
+        verdict(base_cost - cost, noise),
+        change,
+        worst,
+        spread,
+        run.timing.shares()[0],
+    )
 
 
-def run_effects_study(scene: Scene | str | Path, output_dir: Path, *, quick: bool = False,
-                      settings: StudySettings | None = None, repeats: int | None = None,
-                      stop_time: float | None = None, fmu_dir: Path = DEFAULT_FMU_DIR,
-                      progress: bool = True, stream: TextIO | None = None) -> EffectsStudy:
+def run_effects_study(
+    scene: Scene | str | Path,
+    output_dir: Path,
+    *,
+    quick: bool = False,
+    settings: StudySettings | None = None,
+    repeats: int | None = None,
+    stop_time: float | None = None,
+    fmu_dir: Path = DEFAULT_FMU_DIR,
+    progress: bool = True,
+    stream: TextIO | None = None,
+) -> EffectsStudy:
     """Run the effects study of ``scene`` and write its files into ``output_dir``.
 
     Parameters
@@ -248,26 +298,41 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, *, quick: boo
     base = effects_scene(scene, settings)
     cases = effect_cases(base)
     report = StudyProgress(len(cases) + 1, stream, progress)
-    report.note(f"effects of {scene.name!r}: {len(cases)} effects, {repeats} run(s) each of "
-                f"{base.run.stop_time:g} s at H = {base.run.step:g} s")
+    report.note(
+        f"effects of {scene.name!r}: {len(cases)} effects, {repeats} run(s) each of "
+        f"{base.run.stop_time:g} s at H = {base.run.step:g} s"
+    )
     rows = []
     keys = [str(k) for k in settings.key_outputs]
-    with tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp, \
-            PhysicsTimer(core_classes(base)) as timer:
+    with (
+        tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp,
+        PhysicsTimer(core_classes(base)) as timer,
+    ):
         structure = pinned(validate_scene(base, fmu_dir), Path(tmp))
         baseline, spread = fastest_run(base, structure, Path(tmp) / "run", timer, repeats)
-        report.advance(f"all effects: {baseline.status}, "
-                       f"{baseline.timing.per_simulated_second:.3g} s/s")
+        report.advance(
+            f"all effects: {baseline.status}, {baseline.timing.per_simulated_second:.3g} s/s"
+        )
         if baseline.status != "finished":
-            raise StudyError(f"scene {scene.name!r}: the run with all its effects did not "
-                             f"finish ({baseline.status}): {baseline.message}")
+            raise StudyError(
+                f"scene {scene.name!r}: the run with all its effects did not "
+                f"finish ({baseline.status}): {baseline.message}"
+            )
         for case in cases:
-            run, case_spread = fastest_run(without(base, case), structure, Path(tmp) / "run",
-                                           timer, repeats)
+            run, case_spread = fastest_run(
+                without(base, case), structure, Path(tmp) / "run", timer, repeats
+            )
             rows.append(_effect_row(case, run, case_spread, baseline, spread, keys))
             report.advance(_describe(rows[-1]))
-    study = EffectsStudy(scene.name, settings, base.run.step, repeats,
-                         baseline.timing.per_simulated_second, spread, rows)
+    study = EffectsStudy(
+        scene.name,
+        settings,
+        base.run.step,
+        repeats,
+        baseline.timing.per_simulated_second,
+        spread,
+        rows,
+    )
     study.elapsed = time.perf_counter() - started
     study.files = write_effects_files(study, Path(output_dir))
     return study
@@ -276,8 +341,10 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, *, quick: boo
 def _describe(row: EffectRow) -> str:
     if row.status != "finished":
         return f"without {row.label}: {row.status} {row.message[:80]}"
-    return (f"without {row.label}: {row.wall_per_sim_s:.3g} s/s (saves "
-            f"{100 * row.saved_share:.0f} %), outputs change {row.output_change:.2e}")
+    return (
+        f"without {row.label}: {row.wall_per_sim_s:.3g} s/s (saves "
+        f"{100 * row.saved_share:.0f} %), outputs change {row.output_change:.2e}"
+    )
 
 
 # ---------------------------------------------------------------------- reports
@@ -289,27 +356,35 @@ def effects_markdown(study: EffectsStudy) -> str:
     """The summary ``effects.md``."""
     s = study.settings
     lines = [
-        f"# Effects study: {study.scene}" + (" (quick)" if s.quick else ""), "",
+        f"# Effects study: {study.scene}" + (" (quick)" if s.quick else ""),
+        "",
         f"Each effect left out in turn (with the effects that need it), at the scene's own "
         f"coupling and step H = {study.step:g} s, {s.stop_time:g} s simulated, fastest of "
         f"{study.repeats} run(s). With every effect: **{study.baseline_wall_per_sim_s:.3g} s "
-        f"per simulated second** (spread {_fmt(study.baseline_spread)} s/s).", "",
+        f"per simulated second** (spread {_fmt(study.baseline_spread)} s/s).",
+        "",
         "Output change: the largest deviation of a key output from the run with every "
-        f"effect, over its range there ({', '.join(map(str, s.key_outputs))}).", "",
+        f"effect, over its range there ({', '.join(map(str, s.key_outputs))}).",
+        "",
         "| left out | s/s without | saved s/s | saved | time | output change | worst output | "
         "spread s/s | status |",
-        "|---|---:|---:|---:|---|---:|---|---:|---|"]
+        "|---|---:|---:|---:|---|---:|---|---:|---|",
+    ]
     for r in study.rows:
-        lines.append(f"| {r.label} | {_fmt(r.wall_per_sim_s)} | {_fmt(r.saved_per_sim_s)} | "
-                     f"{_fmt(100 * r.saved_share, '.0f')} % | {r.time_verdict} | "
-                     f"{_fmt(r.output_change, '.2e')} | {r.worst_output} | "
-                     f"{_fmt(r.spread_per_sim_s)} | {r.status} |")
+        lines.append(
+            f"| {r.label} | {_fmt(r.wall_per_sim_s)} | {_fmt(r.saved_per_sim_s)} | "
+            f"{_fmt(100 * r.saved_share, '.0f')} % | {r.time_verdict} | "
+            f"{_fmt(r.output_change, '.2e')} | {r.worst_output} | "
+            f"{_fmt(r.spread_per_sim_s)} | {r.status} |"
+        )
     if not study.rows:
         lines.append("| (the scene's units include no effect) | | | | | | | | |")
-    lines += ["", "Time: *within noise* when the saving is no larger than the spread between "
-              "repeats (of this case or of the run with every effect)."]
-    lines += ["", f"The study took {study.elapsed:.0f} s. Files: `effects.csv`, `effects.png`.",
-              ""]
+    lines += [
+        "",
+        "Time: *within noise* when the saving is no larger than the spread between "
+        "repeats (of this case or of the run with every effect).",
+    ]
+    lines += ["", f"The study took {study.elapsed:.0f} s. Files: `effects.csv`, `effects.png`.", ""]
     return "\n".join(lines)
 
 
@@ -332,8 +407,9 @@ def plot_effects(study: EffectsStudy, path: Path) -> Path:
     left.invert_yaxis()
     for ax in (left, right):
         ax.grid(True, axis="x", alpha=0.3)
-    fig.suptitle(f"{study.scene}: leaving effects out (all effects: "
-                 f"{study.baseline_wall_per_sim_s:.3g} s/s)")
+    fig.suptitle(
+        f"{study.scene}: leaving effects out (all effects: {study.baseline_wall_per_sim_s:.3g} s/s)"
+    )
     fig.savefig(path)
     return path
 
@@ -352,13 +428,17 @@ def write_effects_files(study: EffectsStudy, directory: Path) -> dict[str, Path]
 
 def summary_text(study: EffectsStudy) -> str:
     """The price list as plain text (for the command line)."""
-    lines = [f"effects of {study.scene!r}: all effects {study.baseline_wall_per_sim_s:.3g} s "
-             "per simulated s"]
+    lines = [
+        f"effects of {study.scene!r}: all effects {study.baseline_wall_per_sim_s:.3g} s "
+        "per simulated s"
+    ]
     width = max((len(r.label) for r in study.rows), default=10)
     for r in study.rows:
-        lines.append(f"  without {r.label:<{width}}  saves {_fmt(r.saved_per_sim_s):>6} s/s "
-                     f"({_fmt(100 * r.saved_share, '.0f'):>3} %, {r.time_verdict})  outputs "
-                     f"change {_fmt(r.output_change, '.2e')}  [{r.status}]")
+        lines.append(
+            f"  without {r.label:<{width}}  saves {_fmt(r.saved_per_sim_s):>6} s/s "
+            f"({_fmt(100 * r.saved_share, '.0f'):>3} %, {r.time_verdict})  outputs "
+            f"change {_fmt(r.output_change, '.2e')}  [{r.status}]"
+        )
     if not study.rows:
         lines.append("  the scene's units include no effect")
     return "\n".join(lines)

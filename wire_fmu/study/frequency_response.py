@@ -40,8 +40,14 @@ import numpy as np
 from wire_fmu.core.drive_tree import DriveTree
 from wire_fmu.core.drive_unit import DriveUnit
 
-__all__ = ["ResponsePoint", "drive_unit", "analytic_response", "simulated_response",
-           "frequency_response", "write_frequency_response"]
+__all__ = [
+    "ResponsePoint",
+    "drive_unit",
+    "analytic_response",
+    "simulated_response",
+    "frequency_response",
+    "write_frequency_response",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -67,8 +73,9 @@ class ResponsePoint:
     load: complex
 
 
-def drive_unit(parameters: Mapping[str, Any], effects: Sequence[str] = (),
-               name: str = "drive") -> DriveUnit:
+def drive_unit(
+    parameters: Mapping[str, Any], effects: Sequence[str] = (), name: str = "drive"
+) -> DriveUnit:
     """A configured :class:`DriveUnit` (not initialised) from scene-style parameters."""
     unit = DriveUnit(name)
     for key, value in parameters.items():
@@ -84,8 +91,9 @@ def _with_motor_slope(tree: DriveTree, slope: float) -> DriveTree:
     dampings = list(tree.dampings)
     for m in tree.motors:
         dampings[m % tree.n] += slope
-    return DriveTree(tree.inertias, tuple(dampings), tree.shafts, tree.names, tree.motors,
-                     tree.load)
+    return DriveTree(
+        tree.inertias, tuple(dampings), tree.shafts, tree.names, tree.motors, tree.load
+    )
 
 
 def analytic_response(unit: DriveUnit, frequency: float) -> ResponsePoint:
@@ -95,12 +103,14 @@ def analytic_response(unit: DriveUnit, frequency: float) -> ResponsePoint:
     omega = 2.0 * math.pi * frequency
     motor = model.motors[0]
     speeds = tree.speeds_per_torque(omega, motor)
-    return ResponsePoint(frequency, 1.0 / tree.driving_point_impedance(motor, omega),
-                         complex(speeds[model.load]))
+    return ResponsePoint(
+        frequency, 1.0 / tree.driving_point_impedance(motor, omega), complex(speeds[model.load])
+    )
 
 
-def _period(unit: DriveUnit, x0: np.ndarray, omega: float, steps: int,
-            samples: bool = False) -> np.ndarray:
+def _period(
+    unit: DriveUnit, x0: np.ndarray, omega: float, steps: int, samples: bool = False
+) -> np.ndarray:
     """Step ``unit`` over one period from ``x0`` with a unit sine torque on the motor."""
     model = unit.model
     model.state = np.array(x0, dtype=float)
@@ -129,7 +139,7 @@ def _periodic_state(unit: DriveUnit, omega: float, steps: int) -> np.ndarray:
         x1 = _period(unit, x0, omega, steps)
         twist0 = x0[:n] - x0[load]
         twist1 = x1[:n] - x1[load]
-        d = np.concatenate([twist1 - twist0, x1[n:2 * n] - x0[n:2 * n]])
+        d = np.concatenate([twist1 - twist0, x1[n : 2 * n] - x0[n : 2 * n]])
         return np.delete(d, load)
 
     base = mismatch(np.zeros(len(free)))
@@ -169,12 +179,14 @@ def simulated_response(unit: DriveUnit, frequency: float, steps: int = 200) -> R
         return 1j * coefficient / hold_gain  # input sin(w t) = Re(-j e^{j w t})
 
     n = model.n
-    return ResponsePoint(frequency, harmonic(states[:, n + model.motors[0]]),
-                         harmonic(states[:, n + model.load]))
+    return ResponsePoint(
+        frequency, harmonic(states[:, n + model.motors[0]]), harmonic(states[:, n + model.load])
+    )
 
 
-def frequency_response(unit: DriveUnit, frequencies: Sequence[float],
-                       simulate: Sequence[float] = ()) -> dict[str, list[ResponsePoint]]:
+def frequency_response(
+    unit: DriveUnit, frequencies: Sequence[float], simulate: Sequence[float] = ()
+) -> dict[str, list[ResponsePoint]]:
     """Analytic responses at ``frequencies`` and simulated ones at ``simulate`` (Hz)."""
     return {
         "analytic": [analytic_response(unit, f) for f in frequencies],
@@ -183,13 +195,20 @@ def frequency_response(unit: DriveUnit, frequencies: Sequence[float],
 
 
 def _scene_drives(scene) -> dict[str, DriveUnit]:
-    return {name: drive_unit(spec.parameters, spec.effects, name)
-            for name, spec in scene.units.items() if spec.fmu == DRIVE_FMU}
+    return {
+        name: drive_unit(spec.parameters, spec.effects, name)
+        for name, spec in scene.units.items()
+        if spec.fmu == DRIVE_FMU
+    }
 
 
-def write_frequency_response(scene, directory: Path, *, points: int = 200,
-                             simulate: Sequence[float] = (2.0, 8.0, 13.0, 20.0, 60.0, 150.0),
-                             ) -> Path:
+def write_frequency_response(
+    scene,
+    directory: Path,
+    *,
+    points: int = 200,
+    simulate: Sequence[float] = (2.0, 8.0, 13.0, 20.0, 60.0, 150.0),
+) -> Path:
     """Bode plots of every drive in ``scene``: formulas as lines, simulation as markers.
 
     Parameters
@@ -221,12 +240,18 @@ def write_frequency_response(scene, directory: Path, *, points: int = 200,
         colour = f"C{i}"
         _plot(axes, result["analytic"], f"{name}: 1/Z_in (paper 002)", colour, "-")
         _plot(axes, result["simulated"], f"{name}: simulated", colour, "o")
-        deviation = [abs(p.motor / analytic_response(unit, p.frequency).motor - 1.0)
-                     for p in result["simulated"]]
+        deviation = [
+            abs(p.motor / analytic_response(unit, p.frequency).motor - 1.0)
+            for p in result["simulated"]
+        ]
         axes[1, 1].plot(simulate, np.maximum(deviation, 1e-17), "o-", color=colour, label=name)
         logger.info("frequency response of %s: largest deviation %.3g", name, max(deviation))
-    titles = ("|motor speed / motor torque| = |1/Z_in|", "phase of 1/Z_in (deg)",
-              "|load speed / motor torque|", "|simulated / formula| - 1 (motor)")
+    titles = (
+        "|motor speed / motor torque| = |1/Z_in|",
+        "phase of 1/Z_in (deg)",
+        "|load speed / motor torque|",
+        "|simulated / formula| - 1 (motor)",
+    )
     for ax, title in zip(axes.flat, titles, strict=True):
         ax.set_title(title)
         ax.set_xscale("log")

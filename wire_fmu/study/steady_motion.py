@@ -38,8 +38,16 @@ from scipy.integrate import solve_ivp
 from wire_fmu.core.machine_drive import CycleStatistics, crank_press, parse_machine
 from wire_fmu.core.machine_drive_unit import MachineDriveUnit
 
-__all__ = ["CLAIMED_ORDERS", "Run", "Trajectory", "reference_trajectory", "unit_trajectory",
-           "last_delta", "compare", "steady_motion_study"]
+__all__ = [
+    "CLAIMED_ORDERS",
+    "Run",
+    "Trajectory",
+    "reference_trajectory",
+    "unit_trajectory",
+    "last_delta",
+    "compare",
+    "steady_motion_study",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -95,24 +103,41 @@ class Run:
     order: float = math.nan
 
 
-def _unit(machine: Mapping[str, Any], motor: Mapping[str, float], solver: str,
-          max_step: float, initial_speed: float) -> MachineDriveUnit:
+def _unit(
+    machine: Mapping[str, Any],
+    motor: Mapping[str, float],
+    solver: str,
+    max_step: float,
+    initial_speed: float,
+) -> MachineDriveUnit:
     unit = MachineDriveUnit("study")
-    unit.values.update({"machine": json.dumps(machine), "motor_slope": motor["b"],
-                        "motor.command": motor["a"], "solver": solver,
-                        "solver_max_step": max_step, "initial_speed": initial_speed})
+    unit.values.update(
+        {
+            "machine": json.dumps(machine),
+            "motor_slope": motor["b"],
+            "motor.command": motor["a"],
+            "solver": solver,
+            "solver_max_step": max_step,
+            "initial_speed": initial_speed,
+        }
+    )
     unit.configure()
     unit.initialize(0.0)
     return unit
 
 
-def unit_trajectory(solver: str, max_step: float, *, stop_time: float, step: float,
-                    machine: Mapping[str, Any] | None = None,
-                    motor: Mapping[str, float] | None = None,
-                    initial_speed: float = 10.0) -> Trajectory:
+def unit_trajectory(
+    solver: str,
+    max_step: float,
+    *,
+    stop_time: float,
+    step: float,
+    machine: Mapping[str, Any] | None = None,
+    motor: Mapping[str, float] | None = None,
+    initial_speed: float = 10.0,
+) -> Trajectory:
     """Step the machine unit with ``solver``; samples at every communication point."""
-    unit = _unit(machine or crank_press(), motor or DEFAULT_MOTOR, solver, max_step,
-                 initial_speed)
+    unit = _unit(machine or crank_press(), motor or DEFAULT_MOTOR, solver, max_step, initial_speed)
     n = int(round(stop_time / step))
     phi, omega = [unit.values["shaft.angle"]], [unit.values["shaft.speed"]]
     start = time.perf_counter()
@@ -123,13 +148,22 @@ def unit_trajectory(solver: str, max_step: float, *, stop_time: float, step: flo
         phi.append(unit.values["shaft.angle"])
         omega.append(unit.values["shaft.speed"])
     wall = time.perf_counter() - start
-    return Trajectory(step * np.arange(n + 1), np.array(phi), np.array(omega),
-                      int(unit.values["solver.evaluations"]), wall)
+    return Trajectory(
+        step * np.arange(n + 1),
+        np.array(phi),
+        np.array(omega),
+        int(unit.values["solver.evaluations"]),
+        wall,
+    )
 
 
-def reference_trajectory(times: np.ndarray, *, machine: Mapping[str, Any] | None = None,
-                         motor: Mapping[str, float] | None = None,
-                         initial_speed: float = 10.0) -> Trajectory:
+def reference_trajectory(
+    times: np.ndarray,
+    *,
+    machine: Mapping[str, Any] | None = None,
+    motor: Mapping[str, float] | None = None,
+    initial_speed: float = 10.0,
+) -> Trajectory:
     """DOP853 at ``rtol = atol = 1e-12`` on the Lagrange equation, sampled at ``times``."""
     spec, problems = parse_machine(machine or crank_press())
     if spec is None:
@@ -137,8 +171,15 @@ def reference_trajectory(times: np.ndarray, *, machine: Mapping[str, Any] | None
     motor = motor or DEFAULT_MOTOR
     unit = spec.machine(motor["a"], motor["b"])
     start = time.perf_counter()
-    sol = solve_ivp(unit.rhs_time, (0.0, float(times[-1])), [0.0, initial_speed],
-                    method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times)
+    sol = solve_ivp(
+        unit.rhs_time,
+        (0.0, float(times[-1])),
+        [0.0, initial_speed],
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-12,
+        t_eval=times,
+    )
     wall = time.perf_counter() - start
     if not sol.success:
         raise RuntimeError(f"reference failed: {sol.message}")
@@ -151,13 +192,19 @@ def last_delta(trajectory: Trajectory) -> float:
     t, phi, omega = trajectory.time, trajectory.phi, trajectory.omega
     stats.start(float(t[0]), float(phi[0]), float(omega[0]))
     for i in range(1, t.size):
-        stats.update(float(t[i - 1]), (phi[i - 1], omega[i - 1]), float(t[i]),
-                     (phi[i], omega[i]))
+        stats.update(float(t[i - 1]), (phi[i - 1], omega[i - 1]), float(t[i]), (phi[i], omega[i]))
     return float(stats.last["delta"])
 
 
-def compare(solver: str, max_steps: Sequence[float], *, stop_time: float, step: float,
-            reference: Trajectory, **machine_kw) -> list[Run]:
+def compare(
+    solver: str,
+    max_steps: Sequence[float],
+    *,
+    stop_time: float,
+    step: float,
+    reference: Trajectory,
+    **machine_kw,
+) -> list[Run]:
     """Accuracy and cost of ``solver`` at each internal step, with observed orders."""
     ref_delta = last_delta(reference)
     runs: list[Run] = []
@@ -168,16 +215,37 @@ def compare(solver: str, max_steps: Sequence[float], *, stop_time: float, step: 
         order = math.nan
         if runs and error > 0.0 and runs[-1].speed_error > 0.0:
             order = math.log(runs[-1].speed_error / error) / math.log(runs[-1].max_step / h)
-        runs.append(Run(solver, h, error, delta, abs(delta - ref_delta), traj.evaluations,
-                        traj.wall_time, order))
-        logger.info("%s h=%.3g: speed error %.3g, delta %.6f, %d evaluations", solver, h,
-                    error, delta, traj.evaluations)
+        runs.append(
+            Run(
+                solver,
+                h,
+                error,
+                delta,
+                abs(delta - ref_delta),
+                traj.evaluations,
+                traj.wall_time,
+                order,
+            )
+        )
+        logger.info(
+            "%s h=%.3g: speed error %.3g, delta %.6f, %d evaluations",
+            solver,
+            h,
+            error,
+            delta,
+            traj.evaluations,
+        )
     return runs
 
 
-def steady_motion_study(directory: Path, *, stop_time: float = 5.0, step: float = 0.01,
-                        max_steps: Sequence[float] = (1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4),
-                        solvers: Sequence[str] = ("energy1", "energy", "rk4")) -> dict:
+def steady_motion_study(
+    directory: Path,
+    *,
+    stop_time: float = 5.0,
+    step: float = 0.01,
+    max_steps: Sequence[float] = (1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4),
+    solvers: Sequence[str] = ("energy1", "energy", "rk4"),
+) -> dict:
     """Run the comparison and write its CSV, Markdown table and work-precision plot.
 
     Returns
@@ -189,10 +257,16 @@ def steady_motion_study(directory: Path, *, stop_time: float = 5.0, step: float 
     directory.mkdir(parents=True, exist_ok=True)
     times = step * np.arange(int(round(stop_time / step)) + 1)
     reference = reference_trajectory(times)
-    runs = [r for s in solvers for r in compare(s, max_steps, stop_time=stop_time, step=step,
-                                                  reference=reference)]
-    files = {"csv": directory / "steady_motion.csv", "md": directory / "steady_motion.md",
-             "png": directory / "steady_motion.png"}
+    runs = [
+        r
+        for s in solvers
+        for r in compare(s, max_steps, stop_time=stop_time, step=step, reference=reference)
+    ]
+    files = {
+        "csv": directory / "steady_motion.csv",
+        "md": directory / "steady_motion.md",
+        "png": directory / "steady_motion.png",
+    }
     _write_csv(files["csv"], runs)
     files["md"].write_text(_markdown(runs, last_delta(reference), reference))
     _plot(files["png"], runs)
@@ -220,9 +294,11 @@ def _markdown(runs: list[Run], ref_delta: float, reference: Trajectory) -> str:
     ]
     for r in runs:
         order = "" if math.isnan(r.order) else f"{r.order:.2f}"
-        lines.append(f"| {r.solver} | {CLAIMED_ORDERS.get(r.solver, '')} | {r.max_step:.3g} | "
-                     f"{r.speed_error:.3e} | {order} | {r.delta:.6f} | {r.delta_error:.2e} | "
-                     f"{r.evaluations} | {r.wall_time:.3f} |")
+        lines.append(
+            f"| {r.solver} | {CLAIMED_ORDERS.get(r.solver, '')} | {r.max_step:.3g} | "
+            f"{r.speed_error:.3e} | {order} | {r.delta:.6f} | {r.delta_error:.2e} | "
+            f"{r.evaluations} | {r.wall_time:.3f} |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -234,10 +310,20 @@ def _plot(path: Path, runs: list[Run]) -> None:
     for i, solver in enumerate(dict.fromkeys(r.solver for r in runs)):
         mine = [r for r in runs if r.solver == solver]
         label = f"{solver} (order {CLAIMED_ORDERS.get(solver, '?')})"
-        left.loglog([r.max_step for r in mine], [r.speed_error for r in mine], "o-",
-                    color=f"C{i}", label=label)
-        right.loglog([r.evaluations for r in mine], [r.speed_error for r in mine], "o-",
-                     color=f"C{i}", label=label)
+        left.loglog(
+            [r.max_step for r in mine],
+            [r.speed_error for r in mine],
+            "o-",
+            color=f"C{i}",
+            label=label,
+        )
+        right.loglog(
+            [r.evaluations for r in mine],
+            [r.speed_error for r in mine],
+            "o-",
+            color=f"C{i}",
+            label=label,
+        )
     left.set_xlabel("internal step (s)")
     right.set_xlabel("torque evaluations")
     for ax in (left, right):

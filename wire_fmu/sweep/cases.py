@@ -57,7 +57,7 @@ class Case:
     def label(self, width: int = 60) -> str:
         """Short ``name=value, ...`` text (last target component), cut at ``width``."""
         text = ", ".join(f"{t.rsplit('.', 1)[-1]}={_short(v)}" for t, v in self.values.items())
-        return text if len(text) <= width else text[:width - 3] + "..."
+        return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def _short(value: Any) -> str:
@@ -121,15 +121,19 @@ def _nested(container: Any, parts: list[str], where: str) -> tuple[list[str | in
                 return path, f"{where}: {part!r} is not an index of a list of {len(container)}"
             key = int(part)
         else:
-            return path, f"{where}: {'.'.join(map(str, path)) or 'the value'} is a value, " \
-                         f"not a table or list"
+            return (
+                path,
+                f"{where}: {'.'.join(map(str, path)) or 'the value'} is a value, "
+                f"not a table or list",
+            )
         path.append(key)
         container = container[key]
     return path, None
 
 
-def _parameter_path(params: Mapping[str, Any], rest: str,
-                    where: str) -> tuple[list[str | int], str | None]:
+def _parameter_path(
+    params: Mapping[str, Any], rest: str, where: str
+) -> tuple[list[str | int], str | None]:
     """Keys of a parameter (name possibly dotted, then a path into its table)."""
     if rest in params:
         return [rest], None
@@ -142,8 +146,9 @@ def _parameter_path(params: Mapping[str, Any], rest: str,
     return [rest], None  # not set by the scene: replaces the unit's default
 
 
-def _driver_path(driver: DriverSpec, parts: list[str],
-                 where: str) -> tuple[list[str | int], str | None]:
+def _driver_path(
+    driver: DriverSpec, parts: list[str], where: str
+) -> tuple[list[str | int], str | None]:
     from wire_fmu.master.drivers import DRIVER_KINDS
 
     key, nested = parts[0], parts[1:]
@@ -185,8 +190,10 @@ def _target_problem(scene: Scene, target: str) -> str | None:
             return f"{where}: an event sets 'unit.input'"
         return problem
     if parts[0] not in RunSettings.__dataclass_fields__:
-        return f"{where}: no run setting {parts[0]!r}; known: " \
-               f"{', '.join(RunSettings.__dataclass_fields__)}"
+        return (
+            f"{where}: no run setting {parts[0]!r}; known: "
+            f"{', '.join(RunSettings.__dataclass_fields__)}"
+        )
     return None
 
 
@@ -199,8 +206,10 @@ def _parameter_exists(scene: Scene, structure: Structure, target: str) -> str | 
     md = structure.descriptions[parts[0]]
     names = [v.name for v in md.modelVariables if v.causality in ("parameter", "input")]
     if path[0] not in names:
-        return f"axis {target!r}: unit {parts[0]!r} has no parameter {path[0]!r}; its " \
-               f"parameters: {', '.join(names)}"
+        return (
+            f"axis {target!r}: unit {parts[0]!r} has no parameter {path[0]!r}; its "
+            f"parameters: {', '.join(names)}"
+        )
     return None
 
 
@@ -215,8 +224,10 @@ def _column_problem(scene: Scene, structure: Structure | None, figure: Figure) -
         return None
     ref = VarRef.parse(column)
     if ref is None or ref.unit not in scene.units:
-        return f"{where}: {column!r} is neither 'unit.output' of a unit of the scene " \
-               f"({', '.join(scene.units)}) nor a bond or energy channel"
+        return (
+            f"{where}: {column!r} is neither 'unit.output' of a unit of the scene "
+            f"({', '.join(scene.units)}) nor a bond or energy channel"
+        )
     if structure is None or ref.unit not in structure.descriptions:
         return None
     var = structure.variable(ref)
@@ -325,8 +336,12 @@ def apply_case(scene: Scene, values: Mapping[str, Any]) -> Scene:
                 events[i] = replace(events[i], values={**events[i].values, ref: value})
         else:
             run[parts[0]] = tuple(value) if parts[0] == "order" else value
-    changed = replace(scene, units=units, drivers=tuple(drivers),
-                      events=tuple(sorted(events, key=lambda e: e.time)))
+    changed = replace(
+        scene,
+        units=units,
+        drivers=tuple(drivers),
+        events=tuple(sorted(events, key=lambda e: e.time)),
+    )
     return with_run_settings(changed, **run) if run else changed
 
 

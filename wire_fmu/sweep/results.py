@@ -47,8 +47,15 @@ from wire_fmu.master.plots import read_results
 from .cases import Case
 from .spec import Axis, SweepError, SweepSpec
 
-__all__ = ["CaseOutcome", "ResultStore", "summary_schema", "plot_summary", "STATUSES",
-           "DONE_STATUSES", "TIMESERIES_FILE"]
+__all__ = [
+    "CaseOutcome",
+    "ResultStore",
+    "summary_schema",
+    "plot_summary",
+    "STATUSES",
+    "DONE_STATUSES",
+    "TIMESERIES_FILE",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -57,8 +64,15 @@ DONE_STATUSES = frozenset({"finished", "stopped", "failed"})
 """Statuses a resumed sweep keeps (``lost`` cases run again; ``failed`` and
 ``stopped`` ones too when asked to rerun failures)."""
 TIMESERIES_FILE = "timeseries.csv"
-_ARROW_TYPES = MappingProxyType({"int": pa.int64(), "float": pa.float64(), "bool": pa.bool_(),
-                                 "str": pa.string(), "json": pa.string()})
+_ARROW_TYPES = MappingProxyType(
+    {
+        "int": pa.int64(),
+        "float": pa.float64(),
+        "bool": pa.bool_(),
+        "str": pa.string(),
+        "json": pa.string(),
+    }
+)
 
 
 @dataclass
@@ -100,14 +114,21 @@ class CaseOutcome:
 
 def summary_schema(spec: SweepSpec) -> pa.Schema:
     """Arrow schema of a record and of the summary table of ``spec``."""
-    fields = [pa.field("case_id", pa.string(), nullable=False), pa.field("index", pa.int64()),
-              pa.field("status", pa.string())]
+    fields = [
+        pa.field("case_id", pa.string(), nullable=False),
+        pa.field("index", pa.int64()),
+        pa.field("status", pa.string()),
+    ]
     fields += [pa.field(a.target, _ARROW_TYPES[a.kind]) for a in spec.axes]
     fields += [pa.field(f.name, pa.float64()) for f in spec.figures]
-    fields += [pa.field("error", pa.string()), pa.field("wall_time", pa.float64()),
-               pa.field("end_time", pa.float64()), pa.field("worker", pa.string()),
-               pa.field("attempts", pa.int64()),
-               pa.field("finished_at", pa.timestamp("ms", tz="UTC"))]
+    fields += [
+        pa.field("error", pa.string()),
+        pa.field("wall_time", pa.float64()),
+        pa.field("end_time", pa.float64()),
+        pa.field("worker", pa.string()),
+        pa.field("attempts", pa.int64()),
+        pa.field("finished_at", pa.timestamp("ms", tz="UTC")),
+    ]
     return pa.schema(fields)
 
 
@@ -163,13 +184,19 @@ class ResultStore:
                     f"{self.directory} holds a sweep of scene {old.get('scene')!r} as it was "
                     f"then (key {old.get('scene_key')}); this scene {manifest['scene']!r} "
                     f"differs (key {manifest['scene_key']}): choose another output folder or "
-                    "delete that one")
+                    "delete that one"
+                )
             if old.get("core") != manifest.get("core"):
-                logger.warning("the wire_fmu core changed since this sweep started; the cases "
-                               "on disk were computed with core %s, new ones with %s",
-                               old.get("core"), manifest.get("core"))
-        _write_atomic(self.manifest_path, lambda p: p.write_text(
-            json.dumps(manifest, indent=2, default=str) + "\n"))
+                logger.warning(
+                    "the wire_fmu core changed since this sweep started; the cases "
+                    "on disk were computed with core %s, new ones with %s",
+                    old.get("core"),
+                    manifest.get("core"),
+                )
+        _write_atomic(
+            self.manifest_path,
+            lambda p: p.write_text(json.dumps(manifest, indent=2, default=str) + "\n"),
+        )
         return self.read_records()
 
     def read_records(self) -> dict[str, dict[str, Any]]:
@@ -179,8 +206,7 @@ class ResultStore:
             try:
                 rows = pq.read_table(path).to_pylist()
             except (OSError, pa.ArrowException) as err:
-                logger.warning("record %s cannot be read (%s); the case will run again", path,
-                               err)
+                logger.warning("record %s cannot be read (%s); the case will run again", path, err)
                 continue
             if rows:
                 records[rows[0]["case_id"]] = rows[0]
@@ -199,28 +225,41 @@ class ResultStore:
         folder.mkdir(parents=True)
         for name, content in outcome.files.items():
             (folder / Path(name).name).write_bytes(content)
-        (folder / "case.json").write_text(json.dumps(
-            {"case_id": case.case_id, "index": case.index, "values": case.values},
-            indent=2, default=str) + "\n")
+        (folder / "case.json").write_text(
+            json.dumps(
+                {"case_id": case.case_id, "index": case.index, "values": case.values},
+                indent=2,
+                default=str,
+            )
+            + "\n"
+        )
         row = self._row(case, outcome)
         self._write_record(row)
         return row
 
     def _row(self, case: Case, outcome: CaseOutcome) -> dict[str, Any]:
-        row: dict[str, Any] = {"case_id": case.case_id, "index": case.index,
-                               "status": outcome.status}
+        row: dict[str, Any] = {
+            "case_id": case.case_id,
+            "index": case.index,
+            "status": outcome.status,
+        }
         row |= {a.target: _cell(a, case.values[a.target]) for a in self.spec.axes}
         row |= {f.name: outcome.figures.get(f.name) for f in self.spec.figures}
-        row |= {"error": outcome.error, "wall_time": outcome.wall_time,
-                "end_time": outcome.end_time, "worker": outcome.worker,
-                "attempts": outcome.attempts,
-                "finished_at": dt.datetime.now(dt.UTC)}
+        row |= {
+            "error": outcome.error,
+            "wall_time": outcome.wall_time,
+            "end_time": outcome.end_time,
+            "worker": outcome.worker,
+            "attempts": outcome.attempts,
+            "finished_at": dt.datetime.now(dt.UTC),
+        }
         return row
 
     def _write_record(self, row: Mapping[str, Any]) -> None:
         table = pa.Table.from_pylist([dict(row)], schema=self.schema)
-        _write_atomic(self.records_dir / f"{row['case_id']}.parquet",
-                      lambda p: pq.write_table(table, p))
+        _write_atomic(
+            self.records_dir / f"{row['case_id']}.parquet", lambda p: pq.write_table(table, p)
+        )
 
     # -- the summary ----------------------------------------------------------------------
     def _pending(self, case: Case) -> dict[str, Any]:
@@ -249,8 +288,10 @@ class ResultStore:
     def consolidate(self) -> list[dict[str, Any]]:
         """Write ``summary.parquet``: one row per case of the spec, in case order."""
         records = self.read_records()
-        rows = [self._complete(c, records[c.case_id]) if c.case_id in records
-                else self._pending(c) for c in self.cases]
+        rows = [
+            self._complete(c, records[c.case_id]) if c.case_id in records else self._pending(c)
+            for c in self.cases
+        ]
         table = pa.Table.from_pylist(rows, schema=self.schema)
         _write_atomic(self.summary_path, lambda p: pq.write_table(table, p))
         return rows

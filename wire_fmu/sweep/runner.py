@@ -118,13 +118,16 @@ def _figures(figures: Sequence[Figure], csv_path: Path) -> dict[str, float | Non
 
 
 def _on_local_fmus(scene: Scene, local: Mapping[str, Path]) -> Scene:
-    units = {name: dataclasses.replace(u, fmu=str(local.get(u.fmu, u.fmu)))
-             for name, u in scene.units.items()}
+    units = {
+        name: dataclasses.replace(u, fmu=str(local.get(u.fmu, u.fmu)))
+        for name, u in scene.units.items()
+    }
     return dataclasses.replace(scene, units=units)
 
 
-def execute_case(task: CaseTask, local_fmus: Mapping[str, Path] | None = None,
-                 worker: str = "local") -> CaseOutcome:
+def execute_case(
+    task: CaseTask, local_fmus: Mapping[str, Path] | None = None, worker: str = "local"
+) -> CaseOutcome:
     """Run one case in a temporary folder; its outcome with the folder's files.
 
     Parameters
@@ -151,14 +154,26 @@ def execute_case(task: CaseTask, local_fmus: Mapping[str, Path] | None = None,
             outcome = run_scene(scene, folder, plots=False)
         except CASE_ERRORS as exc:
             logger.info("case %s failed: %s", cid, exc)
-            return CaseOutcome(cid, "failed", _describe(exc), time.perf_counter() - start,
-                               files=_folder_files(folder), worker=worker)
+            return CaseOutcome(
+                cid,
+                "failed",
+                _describe(exc),
+                time.perf_counter() - start,
+                files=_folder_files(folder),
+                worker=worker,
+            )
         result = outcome.result
         status = result.status if result.status in ("finished", "stopped") else "failed"
-        return CaseOutcome(cid, status, result.message or None if status != "finished" else None,
-                           time.perf_counter() - start, result.end_time,
-                           _figures(task.figures, outcome.csv_path), _folder_files(folder),
-                           worker)
+        return CaseOutcome(
+            cid,
+            status,
+            result.message or None if status != "finished" else None,
+            time.perf_counter() - start,
+            result.end_time,
+            _figures(task.figures, outcome.csv_path),
+            _folder_files(folder),
+            worker,
+        )
 
 
 def _execute_here(task: CaseTask) -> CaseOutcome:
@@ -168,8 +183,9 @@ def _execute_here(task: CaseTask) -> CaseOutcome:
         return execute_case(task)
     except Exception as exc:  # noqa: BLE001 - recorded with its message, the sweep goes on
         logger.exception("case %s raised", task.case.case_id)
-        return CaseOutcome(task.case.case_id, "failed", _describe(exc),
-                           time.perf_counter() - start, worker="local")
+        return CaseOutcome(
+            task.case.case_id, "failed", _describe(exc), time.perf_counter() - start, worker="local"
+        )
 
 
 def _worker_fmu(directory: Path, digest: str, name: str, blob: bytes) -> Path:
@@ -189,8 +205,10 @@ def _dask_case(task: CaseTask, fmus: Mapping[str, tuple[str, bytes]]) -> CaseOut
 
     worker = get_worker()
     folder = Path(worker.local_directory) / "wire_fmu_fmus"
-    local = {client_path: _worker_fmu(folder, digest, Path(client_path).name, blob)
-             for client_path, (digest, blob) in fmus.items()}
+    local = {
+        client_path: _worker_fmu(folder, digest, Path(client_path).name, blob)
+        for client_path, (digest, blob) in fmus.items()
+    }
     return execute_case(task, local, worker.address)
 
 
@@ -236,9 +254,11 @@ class ProgressWriter:
         left = (self.total - self.done) * elapsed / ran if ran else 0.0
         error = (row.get("error") or "").strip().splitlines()
         why = f"  ({error[0][:100]})" if error else ""
-        self.note(f"[{self.done:>{self.width}}/{self.total}] {case.case_id} "
-                  f"{row['status']:<8} {row['wall_time'] or 0.0:6.2f} s  {case.label()}{why}"
-                  f"  ~{left:.0f} s left")
+        self.note(
+            f"[{self.done:>{self.width}}/{self.total}] {case.case_id} "
+            f"{row['status']:<8} {row['wall_time'] or 0.0:6.2f} s  {case.label()}{why}"
+            f"  ~{left:.0f} s left"
+        )
 
 
 # -- the sweep --------------------------------------------------------------------------------
@@ -317,8 +337,10 @@ def _prepare(scene: Scene, spec: SweepSpec, fmu_dir: Path) -> Scene:
     problems += check_targets(spec, scene, structure if not problems else None)
     if problems:
         raise SweepSpecError(f"sweep {spec.name!r} of scene {scene.name!r}", problems)
-    units = {name: dataclasses.replace(u, fmu=str(structure.paths[name].resolve()))
-             for name, u in scene.units.items()}
+    units = {
+        name: dataclasses.replace(u, fmu=str(structure.paths[name].resolve()))
+        for name, u in scene.units.items()
+    }
     return with_figures_recorded(dataclasses.replace(scene, units=units), spec.figures)
 
 
@@ -339,17 +361,25 @@ def _stale_fmus(structure: Structure) -> list[str]:
     for unit, path in structure.paths.items():
         built = _built_core(path)
         if built is not None and built != current:
-            problems.append(f"unit {unit!r}: {path} was built from another wire_fmu core "
-                            f"({built[:12]}, this one is {current[:12]}); rebuild it")
+            problems.append(
+                f"unit {unit!r}: {path} was built from another wire_fmu core "
+                f"({built[:12]}, this one is {current[:12]}); rebuild it"
+            )
     return problems
 
 
 def _manifest(scene: Scene, spec: SweepSpec, cases: Sequence[Case]) -> dict[str, Any]:
-    return {"scene": scene.name, "scene_key": scene_key(scene),
-            "scene_file": str(scene.source) if scene.source else None,
-            "spec_name": spec.name, "spec_file": str(spec.source) if spec.source else None,
-            "spec": copy.deepcopy(dict(spec.data)), "cases": len(cases),
-            "wire_fmu": wire_fmu.__version__, "core": fingerprint(package_dir())[:16]}
+    return {
+        "scene": scene.name,
+        "scene_key": scene_key(scene),
+        "scene_file": str(scene.source) if scene.source else None,
+        "spec_name": spec.name,
+        "spec_file": str(spec.source) if spec.source else None,
+        "spec": copy.deepcopy(dict(spec.data)),
+        "cases": len(cases),
+        "wire_fmu": wire_fmu.__version__,
+        "core": fingerprint(package_dir())[:16],
+    }
 
 
 def _to_run(cases: Sequence[Case], records: Mapping[str, dict], rerun_failed: bool) -> list[Case]:
@@ -357,8 +387,9 @@ def _to_run(cases: Sequence[Case], records: Mapping[str, dict], rerun_failed: bo
     return [c for c in cases if records.get(c.case_id, {}).get("status") not in keep]
 
 
-def _tasks(base: Scene, spec: SweepSpec, cases: Sequence[Case],
-           sink: Callable[[CaseOutcome], None]) -> list[CaseTask]:
+def _tasks(
+    base: Scene, spec: SweepSpec, cases: Sequence[Case], sink: Callable[[CaseOutcome], None]
+) -> list[CaseTask]:
     """Tasks of the cases; a case whose values cannot be applied is recorded as failed."""
     tasks = []
     for case in cases:
@@ -437,24 +468,47 @@ def run_sweep(
     store = ResultStore(out_dir, spec, cases)
     todo = _to_run(cases, store.open(_manifest(scene, spec, cases)), rerun_failed)
     reused = len(cases) - len(todo)
-    logger.info("sweep %r of scene %r: %d cases, %d on disk, %d to run", spec.name, scene.name,
-                len(cases), reused, len(todo))
+    logger.info(
+        "sweep %r of scene %r: %d cases, %d on disk, %d to run",
+        spec.name,
+        scene.name,
+        len(cases),
+        reused,
+        len(todo),
+    )
     writer = ProgressWriter(len(cases), reused, stream) if progress else None
     if writer:
-        writer.note(f"sweep {spec.name!r} of scene {scene.name!r}: {len(cases)} cases, "
-                    f"{reused} already in {out_dir}, {len(todo)} to run")
+        writer.note(
+            f"sweep {spec.name!r} of scene {scene.name!r}: {len(cases)} cases, "
+            f"{reused} already in {out_dir}, {len(todo)} to run"
+        )
     sink = _Sink(store, cases, writer, on_case)
     startup, finished = 0.0, False
     try:
         tasks = _tasks(base, spec, todo, sink)
-        startup = _execute(tasks, sink, workers, scheduler, retries=retries,
-                           max_attempts=max_attempts, writer=writer)
+        startup = _execute(
+            tasks,
+            sink,
+            workers,
+            scheduler,
+            retries=retries,
+            max_attempts=max_attempts,
+            writer=writer,
+        )
         finished = True
     finally:
         rows = store.consolidate()
     drawn = plot_summary(rows, spec, store.plots_dir) if plots and finished else []
-    result = SweepResult(store.directory, store.summary_path, rows, drawn, len(sink.written),
-                         reused, time.perf_counter() - wall, startup)
+    result = SweepResult(
+        store.directory,
+        store.summary_path,
+        rows,
+        drawn,
+        len(sink.written),
+        reused,
+        time.perf_counter() - wall,
+        startup,
+    )
     logger.info("sweep %r: %s in %.3g s", spec.name, result.counts, result.wall_time)
     return result
 
@@ -462,8 +516,13 @@ def run_sweep(
 class _Sink:
     """Where each case's outcome goes: the store, the progress lines, the caller's callback."""
 
-    def __init__(self, store: ResultStore, cases: Sequence[Case], writer: ProgressWriter | None,
-                 on_case: CaseCallback | None) -> None:
+    def __init__(
+        self,
+        store: ResultStore,
+        cases: Sequence[Case],
+        writer: ProgressWriter | None,
+        on_case: CaseCallback | None,
+    ) -> None:
         self.store, self.writer, self.on_case = store, writer, on_case
         self.cases = {c.case_id: c for c in cases}
         self.written: set[str] = set()
@@ -479,8 +538,16 @@ class _Sink:
             self.on_case(row)
 
 
-def _execute(tasks: Sequence[CaseTask], sink: _Sink, workers: int, scheduler: str | None, *,
-             retries: int, max_attempts: int, writer: ProgressWriter | None) -> float:
+def _execute(
+    tasks: Sequence[CaseTask],
+    sink: _Sink,
+    workers: int,
+    scheduler: str | None,
+    *,
+    retries: int,
+    max_attempts: int,
+    writer: ProgressWriter | None,
+) -> float:
     """Run the tasks here (``workers=0``) or on Dask; seconds it took to reach the cluster."""
     if not tasks:
         return 0.0
@@ -494,8 +561,7 @@ def _execute(tasks: Sequence[CaseTask], sink: _Sink, workers: int, scheduler: st
         startup = time.perf_counter() - started
         if writer:
             writer.restart_clock()
-        _run_on_dask(client, tasks, sink, sink.written, retries=retries,
-                     max_attempts=max_attempts)
+        _run_on_dask(client, tasks, sink, sink.written, retries=retries, max_attempts=max_attempts)
     return startup
 
 
@@ -511,9 +577,12 @@ def _client(workers: int, scheduler: str | None) -> Iterator[Any]:
         return
     if workers < 1:
         raise ValueError(f"workers must be >= 1 for a local cluster (0: serial), got {workers}")
-    with (LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                       dashboard_address=":0") as cluster,
-          Client(cluster) as client):
+    with (
+        LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         yield client
 
 
@@ -532,14 +601,18 @@ def _check_workers(client: Any) -> None:
     try:
         found = client.run(_worker_core)
     except Exception as exc:  # noqa: BLE001 - any failure here means the workers cannot run us
-        raise SweepError(f"the Dask workers cannot run wire_fmu ({_describe(exc)}); install "
-                         f"wire_fmu {expected[0]} on every worker") from exc
+        raise SweepError(
+            f"the Dask workers cannot run wire_fmu ({_describe(exc)}); install "
+            f"wire_fmu {expected[0]} on every worker"
+        ) from exc
     wrong = {addr: core for addr, core in found.items() if tuple(core) != expected}
     if wrong:
         lines = ", ".join(f"{a}: {v} core {f[:12]}" for a, (v, f) in wrong.items())
-        raise SweepError(f"workers with another wire_fmu than this client ({expected[0]} core "
-                         f"{expected[1][:12]}): {lines}; install the same version on every "
-                         "worker (the FMUs are built from this one)")
+        raise SweepError(
+            f"workers with another wire_fmu than this client ({expected[0]} core "
+            f"{expected[1][:12]}): {lines}; install the same version on every "
+            "worker (the FMUs are built from this one)"
+        )
 
 
 class _Shipment:
@@ -564,15 +637,21 @@ class _Shipment:
 
 
 def _lost(task: CaseTask, attempt: int, exc: BaseException) -> CaseOutcome:
-    return CaseOutcome(task.case.case_id, "lost", f"worker lost {attempt} times; last: "
-                       f"{_describe(exc)}", worker="", attempts=attempt)
+    return CaseOutcome(
+        task.case.case_id,
+        "lost",
+        f"worker lost {attempt} times; last: {_describe(exc)}",
+        worker="",
+        attempts=attempt,
+    )
 
 
 class _DaskRun:
     """Cases submitted to a Dask cluster, each outcome handed on as it completes."""
 
-    def __init__(self, client: Any, tasks: Sequence[CaseTask], *, retries: int,
-                 max_attempts: int) -> None:
+    def __init__(
+        self, client: Any, tasks: Sequence[CaseTask], *, retries: int, max_attempts: int
+    ) -> None:
         self.client = client
         self.retries = retries
         self.max_attempts = max_attempts
@@ -584,8 +663,13 @@ class _DaskRun:
         """Submit one case (``attempt`` counts from 1)."""
         self.submitted += 1
         future = self.client.submit(
-            _dask_case, task, self.shipment.argument(), retries=self.retries, pure=False,
-            key=f"wire-fmu-case-{task.case.case_id}-{attempt}-{self.submitted}")
+            _dask_case,
+            task,
+            self.shipment.argument(),
+            retries=self.retries,
+            pure=False,
+            key=f"wire-fmu-case-{task.case.case_id}-{attempt}-{self.submitted}",
+        )
         self.pending[future.key] = (task, attempt)
         return future
 
@@ -611,8 +695,11 @@ class _DaskRun:
             outcome = future.result()
         except (KilledWorker, CancelledError) as exc:
             if attempt < self.max_attempts:
-                logger.warning("case %s: worker lost (%s); submitting it again",
-                               task.case.case_id, _describe(exc))
+                logger.warning(
+                    "case %s: worker lost (%s); submitting it again",
+                    task.case.case_id,
+                    _describe(exc),
+                )
                 self.shipment.refresh()
                 return None
             return _lost(task, attempt, exc)
@@ -622,8 +709,15 @@ class _DaskRun:
         return outcome
 
 
-def _run_on_dask(client: Any, tasks: Sequence[CaseTask], sink: Callable[[CaseOutcome], None],
-                 written: set[str], *, retries: int, max_attempts: int) -> None:
+def _run_on_dask(
+    client: Any,
+    tasks: Sequence[CaseTask],
+    sink: Callable[[CaseOutcome], None],
+    written: set[str],
+    *,
+    retries: int,
+    max_attempts: int,
+) -> None:
     """Run ``tasks`` on the cluster; then once more any that left no record (never expected)."""
     run = _DaskRun(client, tasks, retries=retries, max_attempts=max_attempts)
     run.run(tasks, sink)
