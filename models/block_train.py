@@ -1,10 +1,10 @@
 """FMI facade of the block train: rope reeved over sheaves and anchors.
 
 The reeving (JSON text) and the effects are string parameters, so one FMU
-serves every reeving; see :mod:`wire_fmu.core.block_train_unit` for ports.
+serves every reeving; see :mod:`wire_fmu.core.units.block_train.unit` for ports.
 """
 
-from wire_fmu.core.block_train_unit import BlockTrainUnit
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 from wire_fmu.export.facade import CoreFacade
 
 

@@ -1,10 +1,10 @@
 """FMI facade of the hydraulic cylinder with gas accumulator (riser tensioner spring).
 
 The effects are a string parameter, so one FMU serves every effect set; see
-:mod:`wire_fmu.core.hydraulics_unit` for the port and parameters.
+:mod:`wire_fmu.core.units.hydraulics.unit` for the port and parameters.
 """
 
-from wire_fmu.core.hydraulics_unit import HydraulicsUnit
+from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 from wire_fmu.export.facade import CoreFacade
 
 

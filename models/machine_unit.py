@@ -1,11 +1,11 @@
 """FMI facade of paper 004's machine unit with variable reduced inertia.
 
-See :mod:`wire_fmu.core.machine_drive_unit` for ports and parameters; the
+See :mod:`wire_fmu.core.units.machine.unit` for ports and parameters; the
 solver parameter chooses paper 004's energy-form integrator (``energy``,
 ``energy1``) or a reference integrator.
 """
 
-from wire_fmu.core.machine_drive_unit import MachineDriveUnit
+from wire_fmu.core.units.machine.unit import MachineDriveUnit
 from wire_fmu.export.facade import CoreFacade
 
 

@@ -1,10 +1,10 @@
 """FMI facade of the winch (drawworks): drum, band brake, motor, drive train.
 
 The effects and the drive train (JSON text) are string parameters, so one
-FMU serves every configuration; see :mod:`wire_fmu.core.winch_unit` for ports.
+FMU serves every configuration; see :mod:`wire_fmu.core.units.winch.unit` for ports.
 """
 
-from wire_fmu.core.winch_unit import WinchUnit
+from wire_fmu.core.units.winch.unit import WinchUnit
 from wire_fmu.export.facade import CoreFacade
 
 

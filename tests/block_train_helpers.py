@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from wire_fmu.core.block_train_unit import BlockTrainUnit
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 
 
 def make_unit(reeving: dict, effects: str = "", **params) -> BlockTrainUnit:

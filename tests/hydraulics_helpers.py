@@ -6,7 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from wire_fmu.core.hydraulics_unit import HydraulicsUnit
+from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 
 ALL_EFFECTS = (
     "polytropic_gas,line_losses,line_inertance,oil_compressibility,seal_friction,end_stops"

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.block_train_unit import BlockTrainUnit
-from wire_fmu.core.interface import Causality
-from wire_fmu.core.reevings import drilling_block_train
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.block_train.reevings import drilling_block_train
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 
 from .block_train_helpers import make_unit
 

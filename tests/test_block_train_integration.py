@@ -15,7 +15,7 @@ if str(SUPPORT) not in sys.path:
 from fmi_test_tools import FmiLog, LoadedFmu  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
-from wire_fmu.core.reevings import drilling_block_train  # noqa: E402
+from wire_fmu.core.units.block_train.reevings import drilling_block_train  # noqa: E402
 from wire_fmu.export.builder import build_fmu  # noqa: E402
 
 from .block_train_helpers import make_unit  # noqa: E402

@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
+from wire_fmu.core.components.rope import snap_load
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.reevings import drilling_block_train, single_fall
-from wire_fmu.core.rope import snap_load
+from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
 
 from .block_train_helpers import make_unit, run
 
@@ -301,7 +301,7 @@ class TestBadInput:
             make_unit(drilling_block_train(4), "bearing_friction")
 
     def test_bad_json_and_solver(self):
-        from wire_fmu.core.block_train_unit import BlockTrainUnit
+        from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 
         unit = BlockTrainUnit()
         unit.values["reeving"] = "{not json"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from wire_fmu.core.drive_train import (
+from wire_fmu.core.components.drive_train import (
     ChainElement,
     DriveChain,
     default_drive_train,

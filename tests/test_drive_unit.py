@@ -17,16 +17,16 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from wire_fmu.core.drive_train import DriveChain
-from wire_fmu.core.drive_tree import (
+from wire_fmu.core.components.drive_train import DriveChain
+from wire_fmu.core.components.drive_tree import (
     DriveTree,
     default_multimass_drive,
     parse_drive,
     two_motor_drive,
 )
-from wire_fmu.core.drive_unit import DriveUnit
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Causality
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.multimass_drive.unit import DriveUnit
 from wire_fmu.study.frequency_response import analytic_response, drive_unit, simulated_response
 
 ROOT = Path(__file__).resolve().parents[1]

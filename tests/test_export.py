@@ -30,7 +30,7 @@ from wire_fmu_test_units import (  # noqa: E402
 
 from wire_fmu._fingerprint import bundled_files, fingerprint  # noqa: E402
 from wire_fmu.core.errors import ConfigurationError  # noqa: E402
-from wire_fmu.core.interface import StepResult, Unit, input_, output, parameter  # noqa: E402
+from wire_fmu.core.framework.unit import StepResult, Unit, input_, output, parameter  # noqa: E402
 from wire_fmu.export.builder import BuildError, build_fmu, unique_module_name  # noqa: E402
 from wire_fmu.export.facade import CoreFacade, FacadeError, Phase  # noqa: E402
 from wire_fmu.export.guard import (  # noqa: E402

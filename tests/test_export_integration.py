@@ -76,7 +76,7 @@ def test_fmu_bundles_core_under_a_unique_module_name(fmus):
     binaries = sorted(n for n in names if n.startswith("binaries/"))
     assert binaries == [f"binaries/{platform_folder()[0]}/Oscillator{platform_folder()[1]}"]
     assert "resources/slavemodule.txt" not in names
-    assert "resources/wire_fmu/core/interface.py" in names
+    assert "resources/wire_fmu/core/framework/unit.py" in names
     assert "resources/wire_fmu/export/facade.py" in names
     assert not any("__pycache__" in n or "/master/" in n or n.endswith("cli.py") for n in names)
     version, core_print, _ = imported_core()
@@ -307,7 +307,7 @@ def test_bundled_core_runs_without_the_repository(fmus):
 INLINE_MODEL = textwrap.dedent(
     '''
     """A gain as a self-contained facade script."""
-    from wire_fmu.core.interface import StepResult, Unit, input_, output, parameter
+    from wire_fmu.core.framework.unit import StepResult, Unit, input_, output, parameter
     from wire_fmu.export.facade import CoreFacade
 
 

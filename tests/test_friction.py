@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wire_fmu.core.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 
 
 def one_link(mass=2.0):

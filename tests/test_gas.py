@@ -7,7 +7,7 @@ import math
 import pytest
 from scipy.integrate import quad
 
-from wire_fmu.core.gas import (
+from wire_fmu.core.components.gas import (
     ADIABATIC_DIATOMIC,
     ISOTHERMAL,
     PolytropicGas,

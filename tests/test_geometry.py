@@ -12,8 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from wire_fmu.core.errors import GeometryError
-from wire_fmu.core.geometry import (
+from wire_fmu.core.components.sheave_geometry import (
     Circle,
     PathNode,
     check_path,
@@ -23,6 +22,7 @@ from wire_fmu.core.geometry import (
     segment_tangent_points,
     solve_fleet_tangent,
 )
+from wire_fmu.core.errors import GeometryError
 
 Z = (0.0, 0.0, 1.0)
 PI = math.pi

@@ -25,9 +25,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
-from wire_fmu.core.hydraulics import damping_ratio_for_restitution
-from wire_fmu.core.reevings import single_fall
-from wire_fmu.core.rope import snap_load
+from wire_fmu.core.components.rope import snap_load
+from wire_fmu.core.units.block_train.reevings import single_fall
+from wire_fmu.core.units.hydraulics.model import damping_ratio_for_restitution
 from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results
 from wire_fmu.master.run import find_scene, run_scene, with_run_settings

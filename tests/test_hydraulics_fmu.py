@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from wire_fmu.core.hydraulics import HYDRAULICS_EFFECTS
-from wire_fmu.core.hydraulics_unit import HydraulicsUnit
-from wire_fmu.core.interface import Causality
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
+from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 from wire_fmu.export.model_description import check_units
 
 from .hydraulics_helpers import ALL_EFFECTS, make_free_rod, make_unit, run
@@ -211,7 +211,7 @@ def test_ode_view_integrates_like_the_unit(effects):
     """As a piece of a monolithic model the unit is the same hybrid ODE: integrated
     by the shared solver with a held force it matches the unit's own steps, and the
     external work it integrates is force times displacement."""
-    from wire_fmu.core.hybrid import SolverSettings, make_solver
+    from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
     force = F0 * 1.02
     stepped = make_unit(effects, solver="radau", solver_rtol=1e-10, solver_atol=1e-10)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from wire_fmu.core.hydraulic_line import HydraulicLine
+from wire_fmu.core.components.hydraulic_line import HydraulicLine
 
 LINE = HydraulicLine(
     length=15.0,

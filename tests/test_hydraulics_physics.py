@@ -16,13 +16,13 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 from scipy.optimize import brentq, curve_fit
 
-from wire_fmu.core.block_train_unit import BlockTrainUnit
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.hydraulics import (
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
+from wire_fmu.core.units.hydraulics.model import (
     damping_ratio_for_restitution,
     restitution_of_damping_ratio,
 )
-from wire_fmu.core.hydraulics_unit import HydraulicsUnit
+from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 
 from .hydraulics_helpers import (
     ALL_EFFECTS,

@@ -18,15 +18,15 @@ import pytest
 from scipy.integrate import quad
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Causality
-from wire_fmu.core.machine_drive import (
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.machine.model import (
     CrankSliderInertia,
     CycleStatistics,
     FourierSeries,
     crank_press,
     parse_machine,
 )
-from wire_fmu.core.machine_drive_unit import MachineDriveUnit
+from wire_fmu.core.units.machine.unit import MachineDriveUnit
 from wire_fmu.study.steady_motion import (
     compare,
     last_delta,

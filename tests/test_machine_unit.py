@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from wire_fmu.core.machine_unit import (
+from wire_fmu.core.framework.energy_integrator import (
     EnergyFormBreakdownError,
     EnergyFormIntegrator,
     MachineUnit,

@@ -139,7 +139,7 @@ def test_check_command_lists_problems_and_exits_nonzero(fmus, tmp_path, capsys):
 
 def test_configuration_problems_come_back_through_fmi(tmp_path):
     """A bad reeving inside our BlockTrain is reported by the FMU itself, all problems."""
-    from wire_fmu.core.reevings import drilling_block_train
+    from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
     reeving = drilling_block_train(4)
     reeving["sheaves"]["crown_0"]["radius"] = -1

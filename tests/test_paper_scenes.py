@@ -24,9 +24,9 @@ from fmi_test_tools import FmiLog, LoadedFmu  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from wire_fmu.cli import main  # noqa: E402
-from wire_fmu.core.drive_unit import DriveUnit  # noqa: E402
-from wire_fmu.core.machine_drive_unit import MachineDriveUnit  # noqa: E402
-from wire_fmu.core.scissor_jack_unit import ScissorJackUnit  # noqa: E402
+from wire_fmu.core.units.machine.unit import MachineDriveUnit  # noqa: E402
+from wire_fmu.core.units.multimass_drive.unit import DriveUnit  # noqa: E402
+from wire_fmu.core.units.scissor_jack.unit import ScissorJackUnit  # noqa: E402
 from wire_fmu.export.builder import build_fmu  # noqa: E402
 from wire_fmu.master.plots import read_results  # noqa: E402
 from wire_fmu.master.run import find_scene  # noqa: E402

@@ -11,7 +11,7 @@ import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from wire_fmu.core.interface import Causality, Unit
+from wire_fmu.core.framework.unit import Causality, Unit
 from wire_fmu.export.builder import build_fmu
 from wire_fmu.master import catalog
 from wire_fmu.registry import BY_NAME, MODELS_DIR, UNIT_TYPES, unit_type

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wire_fmu.core.rope import RopeProperties, rope_forces
+from wire_fmu.core.components.rope import RopeProperties, rope_forces
 
 ROPE = RopeProperties(axial_stiffness=1.0e7, damping=1.0e5)
 LENGTH, STRETCH = 10.0, 1.0e-3  # m

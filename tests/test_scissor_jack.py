@@ -16,16 +16,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Causality
-from wire_fmu.core.scissor_jack_unit import ScissorJackUnit
-from wire_fmu.core.screw_nut import (
+from wire_fmu.core.components.screw_nut import (
     BodyState,
     RigidBody,
     ScrewNutJoint,
     ScrewNutSystem,
     ScrewThread,
 )
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.scissor_jack.unit import ScissorJackUnit
 
 ROOT = Path(__file__).resolve().parents[1]
 

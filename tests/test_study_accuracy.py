@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.reevings import single_fall
+from wire_fmu.core.units.block_train.reevings import single_fall
 from wire_fmu.master.scene import SceneError, VarRef, load_scene, parse_scene
 from wire_fmu.study.accuracy import (
     RunRow,
@@ -167,7 +167,7 @@ def test_scene_study_table_must_be_a_table():
 
 
 def test_a_failing_reference_is_a_study_error(monkeypatch):
-    from wire_fmu.core.hybrid import IntegrationError
+    from wire_fmu.core.framework.hybrid import IntegrationError
     from wire_fmu.study import accuracy
 
     def chattering(*args, **kwargs):

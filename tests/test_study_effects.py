@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from wire_fmu.cli import _parser
-from wire_fmu.core.reevings import drilling_block_train
+from wire_fmu.core.units.block_train.reevings import drilling_block_train
 from wire_fmu.master.scene import parse_scene
 from wire_fmu.study.effects import (
     EffectCase,

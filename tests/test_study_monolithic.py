@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.reevings import single_fall
+from wire_fmu.core.units.block_train.reevings import single_fall
 from wire_fmu.master.scene import SceneError, parse_scene
 from wire_fmu.study.monolithic import run_monolithic
 

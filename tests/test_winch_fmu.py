@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Causality
-from wire_fmu.core.winch_unit import WinchUnit
+from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.winch.unit import WinchUnit
 from wire_fmu.export.model_description import check_units
 
 from .winch_helpers import make_unit, run

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from wire_fmu.core.drive_train import DriveChain
-from wire_fmu.core.winch import BandBrake
+from wire_fmu.core.components.drive_train import DriveChain
+from wire_fmu.core.units.winch.model import BandBrake
 
 from .winch_helpers import make_unit, one_mass, run, two_mass
 
@@ -576,7 +576,7 @@ class LeverRamp:
 
 def test_ode_view_engages_a_ramped_brake_and_stops_the_drum():
     """F = 1000 (t - 0.2) N: omega = omega0 - k 1000 (t - 0.2)^2 / (2 J), then held."""
-    from wire_fmu.core.hybrid import SolverSettings, make_solver
+    from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
     w0 = 10.0
     k = capacities(1.0)[0]  # capacity per newton of lever force
@@ -596,7 +596,7 @@ def test_ode_view_engages_a_ramped_brake_and_stops_the_drum():
 
 
 def test_ode_view_of_the_kinetostatic_winch_pays_out_the_rope_geometry():
-    from wire_fmu.core.hybrid import SolverSettings, make_solver
+    from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
     unit = make_unit("rope_layers", **LAYERED, **{"drum.speed_command": 3.0})
     view = unit.ode()

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from wire_fmu.core.winch_unit import WinchUnit
+from wire_fmu.core.units.winch.unit import WinchUnit
 
 
 def one_mass(inertia: float, damping: float = 0.0, motor_ratio: float = 1.0) -> str:

@@ -36,11 +36,14 @@ class UnitType:
         Its facade script in :data:`MODELS_DIR`.
     core : str
         Its core unit class, ``"module:Class"``.
+    effects : str or None
+        Its effect catalogue, ``"module:NAME"``, if a scene can choose its effects.
     """
 
     name: str
     facade: str
     core: str
+    effects: str | None = None
 
     @property
     def facade_path(self) -> Path:
@@ -49,17 +52,38 @@ class UnitType:
 
     def core_class(self) -> type:
         """The core unit class (imports the physics core)."""
-        module, _, cls = self.core.partition(":")
-        return getattr(importlib.import_module(module), cls)
+        return _load(self.core)
+
+    def effect_catalogue(self) -> object | None:
+        """The effect catalogue (imports the physics core), or None."""
+        return _load(self.effects) if self.effects else None
 
 
+def _load(target: str) -> object:
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+_UNITS = "wire_fmu.core.units"
 UNIT_TYPES = (
-    UnitType("BlockTrain", "block_train.py", "wire_fmu.core.block_train_unit:BlockTrainUnit"),
-    UnitType("Winch", "winch.py", "wire_fmu.core.winch_unit:WinchUnit"),
-    UnitType("Hydraulics", "hydraulics.py", "wire_fmu.core.hydraulics_unit:HydraulicsUnit"),
-    UnitType("ScissorJack", "scissor_jack.py", "wire_fmu.core.scissor_jack_unit:ScissorJackUnit"),
-    UnitType("MultiMassDrive", "drive.py", "wire_fmu.core.drive_unit:DriveUnit"),
-    UnitType("MachineUnit", "machine_unit.py", "wire_fmu.core.machine_drive_unit:MachineDriveUnit"),
+    UnitType(
+        "BlockTrain",
+        "block_train.py",
+        f"{_UNITS}.block_train.unit:BlockTrainUnit",
+        f"{_UNITS}.block_train.model:BLOCK_TRAIN_EFFECTS",
+    ),
+    UnitType(
+        "Winch", "winch.py", f"{_UNITS}.winch.unit:WinchUnit", f"{_UNITS}.winch.model:WINCH_EFFECTS"
+    ),
+    UnitType(
+        "Hydraulics",
+        "hydraulics.py",
+        f"{_UNITS}.hydraulics.unit:HydraulicsUnit",
+        f"{_UNITS}.hydraulics.model:HYDRAULICS_EFFECTS",
+    ),
+    UnitType("ScissorJack", "scissor_jack.py", f"{_UNITS}.scissor_jack.unit:ScissorJackUnit"),
+    UnitType("MultiMassDrive", "drive.py", f"{_UNITS}.multimass_drive.unit:DriveUnit"),
+    UnitType("MachineUnit", "machine_unit.py", f"{_UNITS}.machine.unit:MachineDriveUnit"),
 )
 """Every unit type we ship, in the order they are built and listed."""
 

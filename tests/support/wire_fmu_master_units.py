@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.interface import StepResult, Unit, input_, output, parameter
+from wire_fmu.core.framework.unit import StepResult, Unit, input_, output, parameter
 
 __all__ = ["CoupledMassUnit"]
 

@@ -12,9 +12,9 @@ import json
 import logging
 
 from wire_fmu.bench.common import Case, command_line, run_cases
-from wire_fmu.core.block_train import BLOCK_TRAIN_EFFECTS
-from wire_fmu.core.block_train_unit import BlockTrainUnit
-from wire_fmu.core.reevings import drilling_block_train
+from wire_fmu.core.units.block_train.model import BLOCK_TRAIN_EFFECTS
+from wire_fmu.core.units.block_train.reevings import drilling_block_train
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 
 logger = logging.getLogger(__name__)
 

@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from wire_fmu.core.interface import Unit
+from wire_fmu.core.framework.unit import Unit
 
 __all__ = ["Case", "Row", "measure", "table", "ROOT", "run_cases", "command_line"]
 

@@ -15,8 +15,8 @@ import logging
 import math
 
 from wire_fmu.bench.common import Case, command_line, run_cases
-from wire_fmu.core.hydraulics import HYDRAULICS_EFFECTS
-from wire_fmu.core.hydraulics_unit import DEFAULT_ROD_FORCE, HydraulicsUnit
+from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
+from wire_fmu.core.units.hydraulics.unit import DEFAULT_ROD_FORCE, HydraulicsUnit
 
 logger = logging.getLogger(__name__)
 

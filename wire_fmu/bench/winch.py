@@ -19,8 +19,8 @@ from __future__ import annotations
 import logging
 
 from wire_fmu.bench.common import Case, command_line, run_cases
-from wire_fmu.core.winch import WINCH_EFFECTS
-from wire_fmu.core.winch_unit import WinchUnit
+from wire_fmu.core.units.winch.model import WINCH_EFFECTS
+from wire_fmu.core.units.winch.unit import WinchUnit
 
 logger = logging.getLogger(__name__)
 

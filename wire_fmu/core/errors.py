@@ -1,7 +1,7 @@
 """The project's exception hierarchy.
 
 Bad arguments raise one of these; numerical failure inside a step is a
-:class:`~wire_fmu.core.interface.StepResult` with a message instead.
+:class:`~wire_fmu.core.framework.unit.StepResult` with a message instead.
 """
 
 from __future__ import annotations

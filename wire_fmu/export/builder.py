@@ -34,7 +34,7 @@ from pythonfmu import FmuBuilder
 import wire_fmu
 from wire_fmu._fingerprint import bundled_files, fingerprint, package_dir
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Unit
+from wire_fmu.core.framework.unit import Unit
 from wire_fmu.export.binary import compiled_binary, platform_folder
 from wire_fmu.export.facade import CoreFacade
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo, imported_core

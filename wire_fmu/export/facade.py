@@ -2,7 +2,7 @@
 
 A facade script only names the core unit::
 
-    from wire_fmu.core.block_train import BlockTrainUnit
+    from wire_fmu.core.units.block_train.model import BlockTrainUnit
     from wire_fmu.export.facade import CoreFacade
 
     class BlockTrain(CoreFacade):
@@ -58,7 +58,7 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variabil
 
 import wire_fmu
 from wire_fmu.core.errors import ConfigurationError, WireFmuError
-from wire_fmu.core.interface import Causality, Unit, Variability, Variable
+from wire_fmu.core.framework.unit import Causality, Unit, Variability, Variable
 from wire_fmu.export.guard import check_core
 from wire_fmu.export.state import json_copy
 
@@ -133,7 +133,7 @@ def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
 
 
 class CoreFacade(Fmi2Slave):
-    """pythonfmu slave that exposes one core :class:`~wire_fmu.core.interface.Unit`.
+    """pythonfmu slave that exposes one core :class:`~wire_fmu.core.framework.unit.Unit`.
 
     Subclasses set :attr:`unit_class` and nothing else.
 
@@ -176,7 +176,7 @@ class CoreFacade(Fmi2Slave):
         unit_class = cls.unit_class
         if not (isinstance(unit_class, type) and issubclass(unit_class, Unit)):
             raise TypeError(
-                f"{cls.__name__}.unit_class must be a wire_fmu.core.interface.Unit subclass, "
+                f"{cls.__name__}.unit_class must be a wire_fmu.core.framework.unit.Unit subclass, "
                 f"got {unit_class!r}"
             )
         return unit_class

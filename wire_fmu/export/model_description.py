@@ -27,7 +27,7 @@ from collections.abc import Iterable, Mapping
 from xml.etree import ElementTree as ET
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.interface import Causality, Unit, Variable
+from wire_fmu.core.framework.unit import Causality, Unit, Variable
 from wire_fmu.export.units import UNITS
 
 __all__ = ["CAPABILITIES", "check_units", "patch_model_description"]

@@ -32,7 +32,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from wire_fmu.core.interface import StepResult, Unit, output, parameter
+from wire_fmu.core.framework.unit import StepResult, Unit, output, parameter
 
 __all__ = ["make_unit_class", "MODES", "EVENT_TOLERANCE"]
 

@@ -4,16 +4,16 @@
 steps: :func:`reeving_drawing` turns a reeving description into drawing
 primitives (pure data: sheave outlines, rope spans and wrapped arcs, anchors,
 line ends, body boxes, floors, in 2-D plane coordinates, m) using the core's
-own geometry (:func:`~wire_fmu.core.reeving.parse_reeving`,
-:func:`~wire_fmu.core.geometry.path_geometry`,
-:func:`~wire_fmu.core.geometry.planar_frame`) -- no tangent is re-derived
+own geometry (:func:`~wire_fmu.core.units.block_train.reeving.parse_reeving`,
+:func:`~wire_fmu.core.components.sheave_geometry.path_geometry`,
+:func:`~wire_fmu.core.components.sheave_geometry.planar_frame`) -- no tangent is re-derived
 here -- and a renderer draws those with matplotlib's Agg canvas on a
 :class:`~matplotlib.figure.Figure` object (no pyplot, no global rcParams).
 
 The view
 --------
 The drawing plane is the rope path's plane (from
-:func:`~wire_fmu.core.geometry.planar_frame`); a non-planar reeving is
+:func:`~wire_fmu.core.components.sheave_geometry.planar_frame`); a non-planar reeving is
 projected onto its best-fit plane (least squares through the sheave centres,
 points and tangent points) and the title says so. The plane is seen from the
 side its normal's largest component points to (a reeving in the x-y plane is
@@ -50,15 +50,15 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.errors import GeometryError
-from wire_fmu.core.geometry import (
+from wire_fmu.core.components.sheave_geometry import (
     Circle,
     PathGeometry,
     PathNode,
     path_geometry,
     planar_frame,
 )
-from wire_fmu.core.reeving import Reeving, parse_reeving
+from wire_fmu.core.errors import GeometryError
+from wire_fmu.core.units.block_train.reeving import Reeving, parse_reeving
 
 __all__ = [
     "SheaveShape",
@@ -538,7 +538,7 @@ def reeving_drawing(reeving: Mapping[str, Any]) -> ReevingDrawing:
     Parameters
     ----------
     reeving : mapping
-        JSON-compatible reeving description (see :mod:`wire_fmu.core.reeving`).
+        JSON-compatible reeving description (see :mod:`wire_fmu.core.units.block_train.reeving`).
 
     Returns
     -------
@@ -550,8 +550,8 @@ def reeving_drawing(reeving: Mapping[str, Any]) -> ReevingDrawing:
     Raises
     ------
     ConfigurationError
-        From :func:`~wire_fmu.core.reeving.parse_reeving` (every problem of
-        the description) or :func:`~wire_fmu.core.geometry.path_geometry`
+        From :func:`~wire_fmu.core.units.block_train.reeving.parse_reeving` (every problem of
+        the description) or :func:`~wire_fmu.core.components.sheave_geometry.path_geometry`
         (a :class:`~wire_fmu.core.errors.GeometryError` with every geometric
         problem).
     """
@@ -877,7 +877,7 @@ def draw_reeving(reeving: Mapping[str, Any], path: Path, *, title: str = "") -> 
     Parameters
     ----------
     reeving : mapping
-        JSON-compatible reeving description (see :mod:`wire_fmu.core.reeving`).
+        JSON-compatible reeving description (see :mod:`wire_fmu.core.units.block_train.reeving`).
     path : Path
         PNG file to write (its folder must exist).
     title : str, optional

@@ -92,8 +92,8 @@ from typing import Any, TextIO
 import numpy as np
 
 from wire_fmu.core.errors import ModelError, WireFmuError
-from wire_fmu.core.hybrid import SOLVERS as HYBRID_SOLVERS
-from wire_fmu.core.hybrid import IntegrationError
+from wire_fmu.core.framework.hybrid import SOLVERS as HYBRID_SOLVERS
+from wire_fmu.core.framework.hybrid import IntegrationError
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results

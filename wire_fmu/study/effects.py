@@ -23,7 +23,6 @@ spread between repeats is noise.
 
 from __future__ import annotations
 
-import importlib
 import logging
 import math
 import tempfile
@@ -31,13 +30,15 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from types import MappingProxyType
 from typing import TextIO
 
-from wire_fmu.core.effects import EffectCatalogue
+from wire_fmu.core.framework.effects import EffectCatalogue
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 from wire_fmu.master.run import with_run_settings
 from wire_fmu.master.scene import Scene
 from wire_fmu.master.validate import validate_scene
+from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 from .accuracy import (
     PhysicsTimer,
@@ -73,22 +74,16 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-EFFECT_CATALOGUES = {
-    "BlockTrain": "wire_fmu.core.block_train:BLOCK_TRAIN_EFFECTS",
-    "Winch": "wire_fmu.core.winch:WINCH_EFFECTS",
-    "Hydraulics": "wire_fmu.core.hydraulics:HYDRAULICS_EFFECTS",
-}
-"""Model name -> its :class:`~wire_fmu.core.effects.EffectCatalogue` (module:attribute)."""
+EFFECT_CATALOGUES = MappingProxyType({u.name: u.effects for u in UNIT_TYPES if u.effects})
+"""Model name -> its :class:`~wire_fmu.core.framework.effects.EffectCatalogue` (module:name),
+from :mod:`wire_fmu.registry`."""
 
 QUICK_REPEATS, FULL_REPEATS = 1, 3
 
 
 def catalogue(fmu: str) -> EffectCatalogue | None:
     """The effect catalogue of one of our models (None for a foreign FMU)."""
-    if fmu not in EFFECT_CATALOGUES:
-        return None
-    module, _, name = EFFECT_CATALOGUES[fmu].partition(":")
-    return getattr(importlib.import_module(module), name)
+    return BY_NAME[fmu].effect_catalogue() if fmu in BY_NAME else None
 
 
 def _requiring(cat: EffectCatalogue | None, effect: str, present: Sequence[str]) -> list[str]:

@@ -6,9 +6,9 @@ and the load's speed is computed two ways:
 
 * **analytic**, by paper 002's electrical analogy: ``1 / Z_in(j w)`` folded
   from the drive's impedances
-  (:meth:`~wire_fmu.core.drive_tree.DriveTree.driving_point_impedance`), and
+  (:meth:`~wire_fmu.core.components.drive_tree.DriveTree.driving_point_impedance`), and
   the load speed from the nodal equations
-  (:meth:`~wire_fmu.core.drive_tree.DriveTree.speeds_per_torque`); with the
+  (:meth:`~wire_fmu.core.components.drive_tree.DriveTree.speeds_per_torque`); with the
   effect ``motor_characteristic`` each motor's slope ``b`` is a damper on
   its mass;
 * **simulated**, by stepping the core unit exactly as a master would (the
@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.drive_tree import DriveTree
-from wire_fmu.core.drive_unit import DriveUnit
+from wire_fmu.core.components.drive_tree import DriveTree
+from wire_fmu.core.units.multimass_drive.unit import DriveUnit
 
 __all__ = [
     "ResponsePoint",

@@ -10,7 +10,7 @@ whose outputs feed through — exactly the structure the master's scene
 validation proves loop-free. Drivers give their value and rate at the
 evaluation time; scheduled events are integration boundaries.
 
-Solved with SciPy's Radau (or any method of :mod:`wire_fmu.core.hybrid`)
+Solved with SciPy's Radau (or any method of :mod:`wire_fmu.core.framework.hybrid`)
 at tight tolerance with event location, it is both the accuracy reference
 for the co-simulation and the speed floor it is compared with.
 """
@@ -25,8 +25,8 @@ from types import MappingProxyType
 
 import numpy as np
 
-from wire_fmu.core.hybrid import SolverSettings, make_solver
-from wire_fmu.core.interface import Causality, OdeView, Unit
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.unit import Causality, OdeView, Unit
 from wire_fmu.master.algorithms import step_order
 from wire_fmu.master.manipulators import DriverSet, ScheduledEvents
 from wire_fmu.master.scene import Scene, SceneError, VarRef
@@ -68,7 +68,7 @@ class _Instant:
 
 
 class MonolithicModel:
-    """A scene's core units as one :class:`~wire_fmu.core.hybrid.HybridSystem`.
+    """A scene's core units as one :class:`~wire_fmu.core.framework.hybrid.HybridSystem`.
 
     Parameters
     ----------
@@ -259,7 +259,7 @@ def run_monolithic(
     scene : Scene
         A scene of our units.
     method : str
-        A solver of :mod:`wire_fmu.core.hybrid` (default SciPy's Radau, stiff).
+        A solver of :mod:`wire_fmu.core.framework.hybrid` (default SciPy's Radau, stiff).
     rtol, atol : float
         Tolerances (the reference uses ``rtol <= 1e-10``).
     output_interval : float, optional

@@ -1,7 +1,7 @@
 """Paper 004's method against a reference: accuracy and cost of the machine unit's steady motion.
 
-The machine (:func:`~wire_fmu.core.machine_drive.crank_press` by default)
-is solved by the :class:`~wire_fmu.core.machine_drive_unit.MachineDriveUnit`
+The machine (:func:`~wire_fmu.core.units.machine.model.crank_press` by default)
+is solved by the :class:`~wire_fmu.core.units.machine.unit.MachineDriveUnit`
 stepped as a master would, with paper 004's energy form (``energy1``: the
 first-order step (9)/(15) alone; ``energy``: with successive second-order
 refinement (12)/(18)) and, for comparison, classical RK4, at a range of
@@ -35,8 +35,8 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from wire_fmu.core.machine_drive import CycleStatistics, crank_press, parse_machine
-from wire_fmu.core.machine_drive_unit import MachineDriveUnit
+from wire_fmu.core.units.machine.model import CycleStatistics, crank_press, parse_machine
+from wire_fmu.core.units.machine.unit import MachineDriveUnit
 
 __all__ = [
     "CLAIMED_ORDERS",

@@ -71,7 +71,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .hybrid import SolverSettings, _FixedStepSolver
+from wire_fmu.core.framework.hybrid import SolverSettings, _FixedStepSolver
 
 __all__ = [
     "MachineUnit",
@@ -427,7 +427,7 @@ class RigidMachineSystem(Protocol):
 
     Its state is ``[phi, omega, dissipated energy, external work]``
     (rad, rad/s, J, J). Besides the
-    :class:`~wire_fmu.core.hybrid.HybridSystem` methods it offers:
+    :class:`~wire_fmu.core.framework.hybrid.HybridSystem` methods it offers:
     """
 
     def machine(self, t: float, x: np.ndarray) -> MachineUnit | None:
@@ -440,7 +440,7 @@ class RigidMachineSystem(Protocol):
 
 
 class EnergyFormSolver(_FixedStepSolver):
-    """Paper 004's integrator as a fixed-step solver of :mod:`wire_fmu.core.hybrid`.
+    """Paper 004's integrator as a fixed-step solver of :mod:`wire_fmu.core.framework.hybrid`.
 
     Takes ``ceil(H / max_step)`` equal time steps per communication step,
     each by :meth:`EnergyFormIntegrator.step_time`; guards and events are

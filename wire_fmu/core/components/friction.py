@@ -11,7 +11,7 @@ does not creep.
 
 The force a stuck link must carry is computed from the known net forces,
 which is what makes holding exact and breakaway happen exactly at capacity.
-Transitions are guards for :mod:`wire_fmu.core.hybrid`:
+Transitions are guards for :mod:`wire_fmu.core.framework.hybrid`:
 
 * stuck link: ``capacity - |holding force|`` goes negative -> breakaway;
 * sliding link: ``direction * relative velocity`` goes negative -> the

@@ -45,7 +45,7 @@ band, whose dead end is anchored so that a lowering load pulls the band
 tighter): ``r_f F (L/l) eta (e^(mu alpha) - 1)``; against hauling in:
 ``r_f F (L/l) eta (1 - e^(-mu alpha))``. A lever force ``F <= 0`` releases
 the brake (a band cannot push). While the drum is stopped the brake holds
-it exactly (:class:`~wire_fmu.core.friction.StickSlip`, holding torque from
+it exactly (:class:`~wire_fmu.core.components.friction.StickSlip`, holding torque from
 the known net torque), breaks away at capacity, slides with the capacity
 of the direction of motion and re-sticks when the motion stops.
 
@@ -69,13 +69,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .drive_train import DriveChain
-from .drum import Drum
-from .effects import Effect, EffectCatalogue
-from .errors import ModelError
-from .friction import GROUND, FrictionLink, StickSlip
-from .hybrid import RK4_STABILITY, SolverSettings, make_solver
-from .machine_unit import ENERGY_SOLVERS, MachineUnit, StepWork, make_energy_solver
+from wire_fmu.core.components.drive_train import DriveChain
+from wire_fmu.core.components.drum import Drum
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
+from wire_fmu.core.framework.energy_integrator import (
+    ENERGY_SOLVERS,
+    MachineUnit,
+    StepWork,
+    make_energy_solver,
+)
+from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings, make_solver
 
 __all__ = [
     "WINCH_EFFECTS",

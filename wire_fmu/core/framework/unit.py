@@ -316,12 +316,12 @@ class Unit(ABC):
 
 
 class OdeView(ABC):
-    """A configured, initialised unit seen as a hybrid ODE (see :mod:`wire_fmu.core.hybrid`).
+    """A configured, initialised unit seen as a hybrid ODE (see :mod:`~.framework.hybrid`).
 
     ``bind_inputs(t)`` reads the unit's inputs from its ``values`` as their
     instantaneous values at ``t``; ``rhs``, ``guards``, ``guard_directions``,
     ``handle_events`` and ``project`` are those of a
-    :class:`~wire_fmu.core.hybrid.HybridSystem`; ``publish(t, x)`` writes the
+    :class:`~wire_fmu.core.framework.hybrid.HybridSystem`; ``publish(t, x)`` writes the
     outputs for state ``x`` into ``values``; ``state``/``set_state`` move the
     continuous state in and out of the unit.
     """

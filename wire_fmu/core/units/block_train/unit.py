@@ -28,13 +28,30 @@ from typing import Any
 
 import numpy as np
 
-from .block_train import BLOCK_TRAIN_EFFECTS, BlockTrainInputs, BlockTrainModel
-from .errors import ConfigurationError
-from .hybrid import RK4_STABILITY, IntegrationError, fastest_mode
-from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
-from .reeving import BLOCK_PORTS, LINE_PORTS, MOVER_PORTS, parse_reeving
-from .reevings import drilling_block_train
-from .solver_options import solver_parameters, solver_settings
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.hybrid import RK4_STABILITY, IntegrationError, fastest_mode
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import (
+    ModelOdeView,
+    OdeView,
+    StepResult,
+    Unit,
+    input_,
+    output,
+    parameter,
+)
+from wire_fmu.core.units.block_train.model import (
+    BLOCK_TRAIN_EFFECTS,
+    BlockTrainInputs,
+    BlockTrainModel,
+)
+from wire_fmu.core.units.block_train.reeving import (
+    BLOCK_PORTS,
+    LINE_PORTS,
+    MOVER_PORTS,
+    parse_reeving,
+)
+from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
 __all__ = ["BlockTrainUnit"]
 

@@ -39,16 +39,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ConfigurationError
-from .friction import GROUND, FrictionLink, StickSlip
-from .geometry import Circle, PathNode, path_geometry, planar_frame, planar_path_lengths
-from .hybrid import SolverSettings, make_solver
-from .reeving import LINE_PORTS, Reeving
-from .rope import rope_forces, slack_guard, taut_guard
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.components.rope import rope_forces, slack_guard, taut_guard
+from wire_fmu.core.components.sheave_geometry import (
+    Circle,
+    PathNode,
+    path_geometry,
+    planar_frame,
+    planar_path_lengths,
+)
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
 
 __all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
 
-from .effects import Effect, EffectCatalogue
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 
 BLOCK_TRAIN_EFFECTS = EffectCatalogue(
     "block train",
@@ -541,7 +547,7 @@ class BlockTrainModel:
         return np.array(dirs, dtype=float)
 
     def guard_directions(self) -> np.ndarray:
-        """See :class:`~wire_fmu.core.hybrid.HybridSystem`."""
+        """See :class:`~wire_fmu.core.framework.hybrid.HybridSystem`."""
         return self._guard_dirs
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:

@@ -44,8 +44,8 @@ regularised forms; the exact one (a stuck thread does not move at all) is
 used twice: by :class:`ScrewNutSystem` in 3-D, where a stuck thread adds a
 sixth constraint and a sliding one a torque solved together with the axial
 force it depends on, and -- along the joint's one degree of freedom, the
-relative angle -- with :class:`~wire_fmu.core.friction.StickSlip` by the
-scissor jack's kinematic reduction (:mod:`wire_fmu.core.scissor_jack`).
+relative angle -- with :class:`~wire_fmu.core.components.friction.StickSlip` by the
+scissor jack's kinematic reduction (:mod:`wire_fmu.core.units.scissor_jack.model`).
 """
 
 from __future__ import annotations
@@ -477,7 +477,7 @@ class ScrewNutSystem:
 
     Thread friction (``thread_friction=True``) is exact dry friction about
     the axis, bounded by ``r_mean mu |F_axial|`` with ``F_axial`` the joint's
-    own axial multiplier. Modes as in :class:`~wire_fmu.core.friction.StickSlip`:
+    own axial multiplier. Modes as in :class:`~wire_fmu.core.components.friction.StickSlip`:
     *stuck* adds a sixth constraint, no relative rotation (the pair is a
     weld; its multiplier is the holding torque, and the relative angle is
     held at position level too), *sliding* in direction ``sigma`` applies

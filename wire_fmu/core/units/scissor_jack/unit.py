@@ -23,7 +23,7 @@ Effects: ``thread_friction`` (absent: a frictionless thread, paper 003's
 section 2; present: dry friction ``r_mean mu |F|`` with the model
 ``friction_model``: ``stick_slip`` exact, or the paper's regularised
 ``linear`` form, or ``tanh``). The physics is in
-:mod:`wire_fmu.core.scissor_jack`; the numbers default to the paper's jack.
+:mod:`wire_fmu.core.units.scissor_jack.model`; the numbers default to the paper's jack.
 """
 
 from __future__ import annotations
@@ -34,11 +34,21 @@ from typing import Any
 
 import numpy as np
 
-from .effects import Effect, EffectCatalogue
-from .errors import ConfigurationError, ModelError
-from .hybrid import IntegrationError, SolverSettings
-from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
-from .scissor_jack import (
+from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
+from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
+from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import (
+    ModelOdeView,
+    OdeView,
+    StepResult,
+    Unit,
+    input_,
+    output,
+    parameter,
+)
+from wire_fmu.core.units.scissor_jack.model import (
     FRICTION_MODELS,
     HANDLE_DRIVES,
     JackConfig,
@@ -46,8 +56,6 @@ from .scissor_jack import (
     JackInputs,
     ScissorJackModel,
 )
-from .screw_nut import REGULARISATIONS, ScrewThread
-from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["ScissorJackUnit", "JACK_EFFECTS"]
 

@@ -14,7 +14,7 @@ Ports
     Per revolution of the main shaft: ``period`` (s), ``omega_mean``,
     ``omega_max``, ``omega_min`` (rad/s) and the coefficient of
     non-uniformity ``delta = (omega_max - omega_min) / omega_mean``
-    (:class:`~wire_fmu.core.machine_drive.CycleStatistics`; extremes over the
+    (:class:`~wire_fmu.core.units.machine.model.CycleStatistics`; extremes over the
     communication points, updated by :meth:`MachineDriveUnit.advance` -- a
     monolithic model, which has no communication points, leaves them at 0).
 ``solver``
@@ -24,10 +24,10 @@ Ports
 
 Solvers: ``energy`` -- paper 004's energy-form step with successive
 second-order refinement to tolerance; ``energy1`` -- its first-order step
-alone (:mod:`wire_fmu.core.machine_unit`); or any reference integrator of
-:mod:`wire_fmu.core.hybrid` (``radau`` at tight tolerance is the reference).
+alone (:mod:`wire_fmu.core.framework.energy_integrator`); or any reference integrator of
+:mod:`wire_fmu.core.framework.hybrid` (``radau`` at tight tolerance is the reference).
 The machine's laws are the JSON parameter ``machine``
-(:func:`~wire_fmu.core.machine_drive.parse_machine`), a crank press by default.
+(:func:`~wire_fmu.core.units.machine.model.parse_machine`), a crank press by default.
 """
 
 from __future__ import annotations
@@ -39,12 +39,29 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ConfigurationError
-from .hybrid import IntegrationError, make_solver
-from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
-from .machine_drive import CycleStatistics, MachineDriveModel, crank_press, parse_machine
-from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError, make_energy_solver
-from .solver_options import solver_parameters, solver_settings
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.energy_integrator import (
+    ENERGY_SOLVERS,
+    EnergyFormBreakdownError,
+    make_energy_solver,
+)
+from wire_fmu.core.framework.hybrid import IntegrationError, make_solver
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import (
+    ModelOdeView,
+    OdeView,
+    StepResult,
+    Unit,
+    input_,
+    output,
+    parameter,
+)
+from wire_fmu.core.units.machine.model import (
+    CycleStatistics,
+    MachineDriveModel,
+    crank_press,
+    parse_machine,
+)
 
 __all__ = ["MachineDriveUnit"]
 

@@ -132,12 +132,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
-from .effects import Effect, EffectCatalogue
-from .errors import ConfigurationError, ModelError
-from .friction import GROUND, FrictionLink, StickSlip
-from .gas import ISOTHERMAL, PolytropicGas, isothermal_charge_volume
-from .hybrid import SolverSettings, make_solver
-from .hydraulic_line import HydraulicLine
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.components.gas import ISOTHERMAL, PolytropicGas, isothermal_charge_volume
+from wire_fmu.core.components.hydraulic_line import HydraulicLine
+from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
 __all__ = [
     "HYDRAULICS_EFFECTS",

@@ -1,6 +1,6 @@
 """The four solver parameters every unit declares, and reading them back.
 
-Each unit lets a scene choose its internal solver (:mod:`wire_fmu.core.hybrid`)
+Each unit lets a scene choose its internal solver (:mod:`wire_fmu.core.framework.hybrid`)
 through the same parameters ``solver``, ``solver_max_step``, ``solver_rtol``
 and ``solver_atol``; only the defaults differ. Declaring and checking them
 lives here, once.
@@ -11,8 +11,8 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping
 from typing import Any
 
-from .hybrid import SOLVERS, SolverSettings
-from .interface import Variable, parameter
+from wire_fmu.core.framework.hybrid import SOLVERS, SolverSettings
+from wire_fmu.core.framework.unit import Variable, parameter
 
 __all__ = ["solver_parameters", "solver_settings"]
 
@@ -37,7 +37,7 @@ def solver_parameters(
     rtol, atol : float
         Default tolerances of the adaptive solvers.
     also : collection of str
-        Solvers the unit offers beyond :data:`~wire_fmu.core.hybrid.SOLVERS`.
+        Solvers the unit offers beyond :data:`~wire_fmu.core.framework.hybrid.SOLVERS`.
     note : str
         Appended to the description of ``solver``.
     """

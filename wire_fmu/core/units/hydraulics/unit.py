@@ -37,7 +37,7 @@ Parameter defaults and where they come from
 -------------------------------------------
 A push-type (bore-pressurised) cylinder of a single wire-line riser
 tensioner reeved 4:1 (paper 000, Fig. 6; the reeving
-:func:`wire_fmu.core.reevings.riser_tensioner`: vertical cylinder, rod
+:func:`wire_fmu.core.units.block_train.reevings.riser_tensioner`: vertical cylinder, rod
 extending upwards, so ``gravity_along_rod = -9.81``), sized for the common
 80 kip (356 kN) wire-line tensioner class with about 50 ft (15 m) of wire
 travel: 4 x 356 kN = 1.42 MN on the rod over a 3.81 m (12.5 ft) stroke.
@@ -72,7 +72,7 @@ travel: 4 x 356 kN = 1.42 MN on the rod over a 3.81 m (12.5 ft) stroke.
   column (line time constant ``R_l C`` about 10 microseconds) and the stuck
   seal cost no more than the gas spring, and its fixed steps make FMU runs
   bit-reproducible; during stop impacts and cushion runs the model refines
-  the fixed step itself (see :mod:`wire_fmu.core.hydraulics`, Numerics).
+  the fixed step itself (see :mod:`wire_fmu.core.units.hydraulics.model`, Numerics).
   ``radau`` is the adaptive alternative, e.g. for a line restricted so much
   that its turbulent loss changes stiffness by orders of magnitude within
   one communication step (ROS2 keeps one Jacobian per step).
@@ -82,7 +82,7 @@ Connecting it to a block train
 ``rope.mover_a.force -> rod.force`` and ``rod.velocity ->
 rope.mover_a.velocity``; for the position use ``rod.displacement`` when the
 reeving is drawn at the initial extension (as
-:func:`~wire_fmu.core.reevings.riser_tensioner` is, at mid stroke, the default
+:func:`~wire_fmu.core.units.block_train.reevings.riser_tensioner` is, at mid stroke, the default
 ``initial_position``), ``rod.position`` when it is drawn fully retracted.
 """
 
@@ -95,10 +95,12 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ConfigurationError, ModelError
-from .hybrid import IntegrationError
-from .hydraulic_line import HydraulicLine
-from .hydraulics import (
+from wire_fmu.core.components.hydraulic_line import HydraulicLine
+from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.hybrid import IntegrationError
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import OdeView, StepResult, Unit, input_, output, parameter
+from wire_fmu.core.units.hydraulics.model import (
     HYDRAULICS_EFFECTS,
     AccumulatorSpec,
     CylinderSpec,
@@ -108,8 +110,6 @@ from .hydraulics import (
     OilSpec,
     SealSpec,
 )
-from .interface import OdeView, StepResult, Unit, input_, output, parameter
-from .solver_options import solver_parameters, solver_settings
 
 __all__ = ["HydraulicsUnit", "DEFAULT_ROD_FORCE"]
 
@@ -502,7 +502,7 @@ class HydraulicsUnit(Unit):
 
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`."""
-        from .gas import PolytropicGas
+        from wire_fmu.core.components.gas import PolytropicGas
 
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
@@ -572,7 +572,7 @@ class _HydraulicsOde(OdeView):
     step, so its work ``force * v`` is integrated rather than booked per step.
     The unit's own step refinement (stop impacts, cushions) is not used here;
     the monolithic solver chooses its steps. A limit still raises
-    :class:`~wire_fmu.core.hydraulics.HydraulicLimitError` from ``handle_events``.
+    :class:`~wire_fmu.core.units.hydraulics.model.HydraulicLimitError` from ``handle_events``.
     """
 
     def __init__(self, unit: HydraulicsUnit) -> None:

@@ -22,10 +22,10 @@ resistance of time ``M_c(t)`` (N m)
 The motor has the linear characteristic ``M_d = a - b omega`` (paper 004,
 eq. 6), ``a`` an input (``motor.command``), ``b`` a parameter.
 
-:class:`MachineDriveModel` is both a :class:`~wire_fmu.core.hybrid.HybridSystem`
+:class:`MachineDriveModel` is both a :class:`~wire_fmu.core.framework.hybrid.HybridSystem`
 (for the reference integrators) and a
-:class:`~wire_fmu.core.machine_unit.RigidMachineSystem` (for paper 004's
-energy-form integrator, :class:`~wire_fmu.core.machine_unit.EnergyFormSolver`),
+:class:`~wire_fmu.core.framework.energy_integrator.RigidMachineSystem` (for paper 004's
+energy-form integrator, :class:`~wire_fmu.core.framework.energy_integrator.EnergyFormSolver`),
 so the same machine is solved both ways.
 
 Steady motion and its non-uniformity
@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from .machine_unit import MachineUnit, StepWork
+from wire_fmu.core.framework.energy_integrator import MachineUnit, StepWork
 
 __all__ = [
     "FourierSeries",

@@ -1,6 +1,6 @@
 """Branched multi-mass drives (paper 002): rotating masses joined by elastic shafts in a tree.
 
-:class:`~wire_fmu.core.drive_train.DriveChain` is a chain; paper 002's
+:class:`~wire_fmu.core.components.drive_train.DriveChain` is a chain; paper 002's
 two-motor drive is a tree: two motors (masses 1 and 2) drive a common mass
 3 through their own shafts, which drives the load (mass 4)::
 
@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from .drive_train import DriveChain
+from wire_fmu.core.components.drive_train import DriveChain
 
 __all__ = ["Shaft", "DriveTree", "parse_drive", "default_multimass_drive", "two_motor_drive"]
 

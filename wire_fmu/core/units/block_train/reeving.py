@@ -53,8 +53,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from .errors import ConfigurationError
-from .rope import RopeProperties
+from wire_fmu.core.components.rope import RopeProperties
+from wire_fmu.core.errors import ConfigurationError
 
 __all__ = [
     "Body",

@@ -59,7 +59,7 @@ Thread friction models
 ``none``
     frictionless thread (the paper's section 2 experiment);
 ``stick_slip``
-    exact dry friction with :class:`~wire_fmu.core.friction.StickSlip`: a
+    exact dry friction with :class:`~wire_fmu.core.components.friction.StickSlip`: a
     stuck thread does not move at all;
 ``linear``, ``tanh``
     paper 003's regularised torque (linear inside ``|psi'| < w1``,
@@ -88,10 +88,10 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ModelError
-from .friction import GROUND, FrictionLink, StickSlip
-from .hybrid import SolverSettings, make_solver
-from .screw_nut import REGULARISATIONS, ScrewThread
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
+from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
 __all__ = [
     "JackGeometry",
@@ -358,7 +358,7 @@ class ScissorJackModel:
     config : JackConfig
         The jack.
     settings : SolverSettings
-        Internal solver of :mod:`wire_fmu.core.hybrid`.
+        Internal solver of :mod:`wire_fmu.core.framework.hybrid`.
     """
 
     def __init__(self, config: JackConfig, settings: SolverSettings) -> None:

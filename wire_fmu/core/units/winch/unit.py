@@ -22,7 +22,7 @@ Ports (power bonds)
     ``drum_inertia``); outputs ``speed``, ``angle``, ``layer``, ``radius``.
 
 All angles, speeds and torques are positive in the paying-out sense
-(:mod:`wire_fmu.core.winch`); torques are on the drum unless said otherwise.
+(:mod:`wire_fmu.core.units.winch.model`); torques are on the drum unless said otherwise.
 
 Internal solver
 ---------------
@@ -33,7 +33,7 @@ numerically (measured on a lowering-and-braking run: ledger residual 4e-3 J
 with rk4 against 12 J with ros2, at equal cost). Settings for which RK4
 cannot be stable (``|lambda| h >= 2.5``) are refused by :meth:`configure`
 with the step size that would do. ``energy``/``energy1`` select paper
-004's integrator (:mod:`wire_fmu.core.machine_unit`) for a rigid drive
+004's integrator (:mod:`wire_fmu.core.framework.energy_integrator`) for a rigid drive
 train; without ``drum_inertia`` nothing is integrated.
 """
 
@@ -46,14 +46,22 @@ from typing import Any
 
 import numpy as np
 
-from .drive_train import DriveChain, default_drive_train, parse_drive_train
-from .drum import Drum
-from .errors import ConfigurationError, ModelError
-from .hybrid import IntegrationError, SolverSettings
-from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
-from .machine_unit import ENERGY_SOLVERS, EnergyFormBreakdownError
-from .solver_options import solver_parameters, solver_settings
-from .winch import (
+from wire_fmu.core.components.drive_train import DriveChain, default_drive_train, parse_drive_train
+from wire_fmu.core.components.drum import Drum
+from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS, EnergyFormBreakdownError
+from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import (
+    ModelOdeView,
+    OdeView,
+    StepResult,
+    Unit,
+    input_,
+    output,
+    parameter,
+)
+from wire_fmu.core.units.winch.model import (
     RK4_STABILITY,
     WINCH_EFFECTS,
     BandBrake,

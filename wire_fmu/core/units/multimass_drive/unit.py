@@ -1,7 +1,7 @@
 """Paper 002's multi-mass elastic drive as a co-simulation unit.
 
 A chain or a tree of rotating masses joined by elastic shafts
-(:mod:`wire_fmu.core.drive_tree`), every quantity reduced to the motor
+(:mod:`wire_fmu.core.components.drive_tree`), every quantity reduced to the motor
 shaft, with one or two motors and one load.
 
 Ports
@@ -26,9 +26,9 @@ Ports
 
 Parameters
 ----------
-``drive`` (JSON, :func:`~wire_fmu.core.drive_tree.parse_drive`) and
+``drive`` (JSON, :func:`~wire_fmu.core.components.drive_tree.parse_drive`) and
 ``masses_kept``: a chain may be reduced to fewer masses by paper 002's
-delta-star elimination (:meth:`~wire_fmu.core.drive_train.DriveChain.reduced`,
+delta-star elimination (:meth:`~wire_fmu.core.components.drive_train.DriveChain.reduced`,
 interior masses smallest first; motor and load are kept). ``mode_k``
 outputs give the damped natural frequencies (Hz) and damping ratios of the
 model actually simulated, so a scene shows what the reduction kept.
@@ -36,7 +36,7 @@ model actually simulated, so a scene shows what the reduction kept.
 The equations are linear: ``J w' = -K theta - B w + torques``; the
 internal solver is ``rk4`` with steps refused when ``|lambda| h`` exceeds
 RK4's stability (the fastest eigenvalue of the state matrix), or any solver
-of :mod:`wire_fmu.core.hybrid`.
+of :mod:`wire_fmu.core.framework.hybrid`.
 """
 
 from __future__ import annotations
@@ -48,12 +48,20 @@ from typing import Any
 
 import numpy as np
 
-from .drive_tree import DriveTree, default_multimass_drive, parse_drive
-from .effects import Effect, EffectCatalogue
-from .errors import ConfigurationError
-from .hybrid import IntegrationError, SolverSettings, make_solver
-from .interface import ModelOdeView, OdeView, StepResult, Unit, input_, output, parameter
-from .solver_options import solver_parameters, solver_settings
+from wire_fmu.core.components.drive_tree import DriveTree, default_multimass_drive, parse_drive
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
+from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings, make_solver
+from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.unit import (
+    ModelOdeView,
+    OdeView,
+    StepResult,
+    Unit,
+    input_,
+    output,
+    parameter,
+)
 
 __all__ = ["DriveUnit", "DriveModel", "DRIVE_EFFECTS", "MAX_MASSES", "MODES_REPORTED"]
 

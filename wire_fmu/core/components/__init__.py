@@ -1,0 +1,1 @@
+"""Physics pieces units are assembled from; each with its own energy bookkeeping."""

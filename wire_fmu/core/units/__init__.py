@@ -1,0 +1,1 @@
+"""One folder per unit type: ``model.py`` (the physics) and ``unit.py`` (the co-simulation unit)."""

@@ -1,0 +1,1 @@
+"""The hydraulic cylinder with gas accumulator (riser tensioner, heave compensator)."""

@@ -1,0 +1,1 @@
+"""The machine unit in steady motion, with paper 004's energy-form integrator."""

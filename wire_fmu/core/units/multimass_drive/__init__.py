@@ -1,0 +1,1 @@
+"""Multi-mass and branched two-motor drives (paper 002)."""

@@ -1,0 +1,1 @@
+"""The scissor jack of paper 001: screw-nut connection, self-locking."""

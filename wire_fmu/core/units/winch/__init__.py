@@ -1,0 +1,1 @@
+"""The winch (drawworks): drum, band brake, motor and drive train."""
