@@ -24,12 +24,15 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any, ClassVar
 
 import numpy as np
+
+from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.hybrid import IntegrationError
 
 __all__ = [
     "Causality",
@@ -42,7 +45,19 @@ __all__ = [
     "output",
     "OdeView",
     "ModelOdeView",
+    "STEP_ERRORS",
+    "HeldInputsUnit",
 ]
+
+
+STEP_ERRORS: tuple[type[Exception], ...] = (
+    IntegrationError,
+    ModelError,
+    ArithmeticError,
+    ValueError,
+)
+"""What a model raises when the physics or the numerics cannot take a step (a refusal, not a
+bug): the integrators' errors, a model's own, overflow, division by zero, non-finite values."""
 
 
 class Causality(StrEnum):
@@ -268,9 +283,64 @@ class Unit(ABC):
     def initialize(self, start_time: float) -> None:
         """Set the initial state from parameters and inputs; fill outputs."""
 
-    @abstractmethod
     def advance(self, time: float, step: float) -> StepResult:
-        """Advance from ``time`` by ``step`` (s) with the inputs held."""
+        """Advance from ``time`` by ``step`` (s) with the inputs held: the life cycle all share.
+
+        Refuses the step when :meth:`input_problems` finds inputs the unit cannot take; else
+        saves the state, lets :meth:`_advance` integrate the model and, when it raises one of
+        :data:`STEP_ERRORS` (the physics or the numerics cannot go on), restores the state
+        and refuses the step with the reason. A step taken moves :attr:`time` and the
+        outputs. Every refusal names the unit, the time and the reason.
+
+        Parameters
+        ----------
+        time : float
+            Start of the step, s.
+        step : float
+            Its length, s.
+        """
+        who = f"{self.who} at t = {time:.6g} s"
+        bad = self.input_problems()
+        if bad:
+            return StepResult(False, f"{who}: step refused: " + "; ".join(bad))
+        saved = self.get_state()
+        try:
+            events = self._advance(time, step)
+            self.time = time + step
+            self._update_outputs()
+        except STEP_ERRORS as err:
+            self.set_state(saved)
+            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
+        return StepResult(True, events=tuple(events))
+
+    def _advance(self, time: float, step: float) -> Sequence[str]:
+        """Integrate the model from ``time`` by ``step`` (s); return its events, as text."""
+        raise NotImplementedError(f"{type(self).__name__} implements neither advance nor _advance")
+
+    def input_problems(self) -> list[str]:
+        """Inputs now in :attr:`values` that the unit cannot step with (none by default)."""
+        return []
+
+    def _update_outputs(self) -> None:
+        """Fill the outputs in :attr:`values` from the model's state (after a step)."""
+        raise NotImplementedError(f"{type(self).__name__} fills no outputs")
+
+    def non_finite_inputs(self, names: Sequence[str]) -> list[str]:
+        """A problem naming the inputs among ``names`` that are not finite (or none)."""
+        bad = [n for n in names if not math.isfinite(float(self.values[n]))]
+        return [f"inputs {bad} are not finite"] if bad else []
+
+    @property
+    def who(self) -> str:
+        """``"<NAME> '<instance>'"``, the prefix of the unit's messages."""
+        return f"{self.NAME} {self.instance_name!r}"
+
+    def _require_model(self) -> Any:
+        """The model :meth:`configure` built (raises before it)."""
+        model = getattr(self, "model", None)
+        if model is None:
+            raise RuntimeError(f"{self.who}: configure() first")
+        return model
 
     @abstractmethod
     def get_state(self) -> dict[str, Any]:
@@ -313,6 +383,38 @@ class Unit(ABC):
         return {
             v.name: self.values[v.name] for v in self.VARIABLES if v.causality is Causality.output
         }
+
+
+class HeldInputsUnit(Unit):
+    """A unit whose model takes its inputs as one object held over the step.
+
+    The subclass's ``_inputs()`` builds that object from :attr:`values` (with a
+    ``problems()`` method naming inputs it cannot take); its model offers
+    ``initialize(t, inputs)``, ``advance(t, h, inputs)``, ``stored_energy()``
+    and ``last_events`` (``(time, text)`` pairs of the last step).
+    """
+
+    def initialize(self, start_time: float) -> None:
+        """Initial state for the parameters and inputs set; outputs filled."""
+        model = self._require_model()
+        model.initialize(start_time, self._inputs())
+        self.time = start_time
+        self.initial_energy = model.stored_energy()
+        self._update_outputs()
+
+    def input_problems(self) -> list[str]:
+        """Inputs the model cannot step with, as its inputs object names them."""
+        return self._inputs().problems()
+
+    def _advance(self, time: float, step: float) -> list[str]:
+        """Integrate the model with the inputs held; its events as text."""
+        model = self._require_model()
+        model.advance(time, step, self._inputs())
+        return [f"t = {t:.9g} s: {text}" for t, text in model.last_events]
+
+    @abstractmethod
+    def _inputs(self) -> Any:
+        """The model's inputs object, from :attr:`values`."""
 
 
 class OdeView(ABC):

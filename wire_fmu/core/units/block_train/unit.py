@@ -29,12 +29,11 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.framework.hybrid import RK4_STABILITY, IntegrationError, fastest_mode
+from wire_fmu.core.framework.hybrid import RK4_STABILITY, fastest_mode
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
     OdeView,
-    StepResult,
     Unit,
     input_,
     output,
@@ -245,30 +244,20 @@ class BlockTrainUnit(Unit):
             "(L-stable)"
         ]
 
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with the inputs held."""
-        model = self._require_model()
-        saved = self.get_state()
-        inputs = self._inputs()
+    def input_problems(self) -> list[str]:
+        """A commanded break of a segment the reeving does not have."""
         segment = int(self.values["break_segment"])
-        if not 0 <= segment <= model.n_segments:
-            return StepResult(
-                False,
-                f"{self.NAME} {self.instance_name!r}: break_segment "
-                f"{segment} does not exist (0 for none, 1..{model.n_segments})",
-            )
-        try:
-            model.advance(time, step, inputs, segment - 1 if segment else None)
-        except (IntegrationError, FloatingPointError, ValueError) as err:
-            self.set_state(saved)
-            return StepResult(
-                False,
-                f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s: "
-                f"step of {step:.3g} s refused: {err}",
-            )
-        self.time = time + step
-        self._update_outputs()
-        return StepResult(True, events=tuple(model.last_events))
+        n = self._require_model().n_segments
+        if 0 <= segment <= n:
+            return []
+        return [f"break_segment {segment} does not exist (0 for none, 1..{n})"]
+
+    def _advance(self, time: float, step: float) -> list[str]:
+        """Integrate the rope (breaking a commanded segment first); its events as text."""
+        model = self._require_model()
+        segment = int(self.values["break_segment"])
+        model.advance(time, step, self._inputs(), segment - 1 if segment else None)
+        return list(model.last_events)
 
     def evaluate_outputs(self) -> None:
         """Outputs for the inputs now set, at the current time; the state is untouched."""
@@ -319,11 +308,6 @@ class BlockTrainUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> BlockTrainModel:
-        if self.model is None:
-            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
-        return self.model
-
     def _inputs(self) -> BlockTrainInputs:
         v = self.values
         return BlockTrainInputs(

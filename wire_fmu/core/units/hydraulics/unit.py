@@ -97,9 +97,8 @@ import numpy as np
 
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
 from wire_fmu.core.errors import ConfigurationError, ModelError
-from wire_fmu.core.framework.hybrid import IntegrationError
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
-from wire_fmu.core.framework.unit import OdeView, StepResult, Unit, input_, output, parameter
+from wire_fmu.core.framework.unit import OdeView, Unit, input_, output, parameter
 from wire_fmu.core.units.hydraulics.model import (
     HYDRAULICS_EFFECTS,
     AccumulatorSpec,
@@ -442,27 +441,11 @@ class HydraulicsUnit(Unit):
         self.initial_energy = model.stored_energy()
         self._update_outputs()
 
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with ``rod.force`` held; refuse at a limit."""
+    def _advance(self, time: float, step: float) -> list[str]:
+        """Integrate the cylinder with ``rod.force`` held; refuse at a limit (ModelError)."""
         model = self._require_model()
-        saved = self.get_state()
-        try:
-            model.advance(time, step, float(self.values["rod.force"]))
-            self.time = time + step
-            self._update_outputs()
-        except (
-            ModelError,
-            IntegrationError,
-            FloatingPointError,
-            ValueError,
-            ZeroDivisionError,
-            OverflowError,
-        ) as err:
-            self.set_state(saved)
-            message = f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
-            logger.debug("%s", message)
-            return StepResult(False, message)
-        return StepResult(True, events=tuple(model.last_events))
+        model.advance(time, step, float(self.values["rod.force"]))
+        return list(model.last_events)
 
     def evaluate_outputs(self) -> None:
         """Feedthrough outputs for the ``rod.force`` now set; the state is untouched."""
@@ -525,11 +508,6 @@ class HydraulicsUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> HydraulicsModel:
-        if self.model is None:
-            raise RuntimeError(f"{self.who}: configure() first")
-        return self.model
-
     def _update_outputs(self) -> None:
         m = self._require_model()
         r = m.report()

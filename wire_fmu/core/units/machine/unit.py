@@ -42,15 +42,13 @@ import numpy as np
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_integrator import (
     ENERGY_SOLVERS,
-    EnergyFormBreakdownError,
     make_energy_solver,
 )
-from wire_fmu.core.framework.hybrid import IntegrationError, make_solver
+from wire_fmu.core.framework.hybrid import make_solver
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
     OdeView,
-    StepResult,
     Unit,
     input_,
     output,
@@ -215,33 +213,18 @@ class MachineDriveUnit(Unit):
         self.cycles.start(start_time, model.state[0], model.state[1])
         self._update_outputs()
 
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with the inputs held."""
+    def input_problems(self) -> list[str]:
+        """Inputs that are not finite."""
+        return self.non_finite_inputs(("motor.command", "load.torque"))
+
+    def _advance(self, time: float, step: float) -> list[str]:
+        """Integrate the machine unit with paper 004's integrator; book its cycles."""
         model = self._require_model()
-        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = [
-            n for n in ("motor.command", "load.torque") if not math.isfinite(float(self.values[n]))
-        ]
-        if bad:
-            return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
-        saved = self.get_state()
-        try:
-            self._bind(model)
-            x0 = model.state.copy()
-            model.state, _ = self.solver.advance(model, time, x0, time + step)
-            self.cycles.update(time, x0, time + step, model.state)
-            self.time = time + step
-            self._update_outputs()
-        except (
-            IntegrationError,
-            FloatingPointError,
-            ValueError,
-            ZeroDivisionError,
-            EnergyFormBreakdownError,
-        ) as err:
-            self.set_state(saved)
-            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
-        return StepResult(True)
+        self._bind(model)
+        x0 = model.state.copy()
+        model.state, _ = self.solver.advance(model, time, x0, time + step)
+        self.cycles.update(time, x0, time + step, model.state)
+        return []
 
     def evaluate_outputs(self) -> None:
         """Motor and load torques for the inputs now set; the state is untouched."""
@@ -291,11 +274,6 @@ class MachineDriveUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> MachineDriveModel:
-        if self.model is None:
-            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
-        return self.model
-
     def _bind(self, model: MachineDriveModel) -> None:
         model.set_inputs(float(self.values["motor.command"]), float(self.values["load.torque"]))
 

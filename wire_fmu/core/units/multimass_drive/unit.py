@@ -51,12 +51,11 @@ import numpy as np
 from wire_fmu.core.components.drive_tree import DriveTree, default_multimass_drive, parse_drive
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
-from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
     OdeView,
-    StepResult,
     Unit,
     input_,
     output,
@@ -365,25 +364,16 @@ class DriveUnit(Unit):
         self.initial_energy = model.stored_energy()
         self._update_outputs()
 
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with the torques held."""
+    def input_problems(self) -> list[str]:
+        """Torque inputs that are not finite."""
+        return self.non_finite_inputs((*_MOTOR_INPUTS, "load.torque"))
+
+    def _advance(self, time: float, step: float) -> list[str]:
+        """Integrate the drive with the torques held."""
         model = self._require_model()
-        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = [
-            n for n in (*_MOTOR_INPUTS, "load.torque") if not math.isfinite(float(self.values[n]))
-        ]
-        if bad:
-            return StepResult(False, f"{who}: step refused: inputs {bad} are not finite")
-        saved = self.get_state()
-        try:
-            self._bind(model)
-            model.advance(time, step)
-            self.time = time + step
-            self._update_outputs()
-        except (IntegrationError, FloatingPointError, ValueError) as err:
-            self.set_state(saved)
-            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
-        return StepResult(True)
+        self._bind(model)
+        model.advance(time, step)
+        return []
 
     def evaluate_outputs(self) -> None:
         """The motors' torques for the commands now set; the state is untouched."""
@@ -425,11 +415,6 @@ class DriveUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> DriveModel:
-        if self.model is None:
-            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
-        return self.model
-
     def _bind(self, model: DriveModel) -> None:
         v = self.values
         model.commands = np.array([float(v[name]) for name in _MOTOR_INPUTS[: len(model.motors)]])

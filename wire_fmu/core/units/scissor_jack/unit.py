@@ -35,15 +35,14 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
-from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
-from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings
+from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
+    HeldInputsUnit,
     ModelOdeView,
     OdeView,
-    StepResult,
-    Unit,
     input_,
     output,
     parameter,
@@ -231,7 +230,7 @@ def _outputs():
     )
 
 
-class ScissorJackUnit(Unit):
+class ScissorJackUnit(HeldInputsUnit):
     """Scissor jack with screw-nut drive and thread friction (SPEC section 10, paper 003)."""
 
     NAME = "ScissorJack"
@@ -258,33 +257,6 @@ class ScissorJackUnit(Unit):
         if problems:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
         self.model = ScissorJackModel(config, settings)
-
-    def initialize(self, start_time: float) -> None:
-        """Start at the initial height; outputs filled."""
-        model = self._require_model()
-        model.initialize(start_time, self._inputs())
-        self.time = start_time
-        self.initial_energy = model.stored_energy()
-        self._update_outputs()
-
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with the inputs held."""
-        model = self._require_model()
-        inputs = self._inputs()
-        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = inputs.problems()
-        if bad:
-            return StepResult(False, f"{who}: step refused: " + "; ".join(bad))
-        saved = self.get_state()
-        try:
-            model.advance(time, step, inputs)
-            self.time = time + step
-            self._update_outputs()
-        except (IntegrationError, FloatingPointError, ValueError, ModelError) as err:
-            self.set_state(saved)
-            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
-        events = tuple(f"t = {t:.9g} s: {text}" for t, text in model.last_events)
-        return StepResult(True, events=events)
 
     def evaluate_outputs(self) -> None:
         """Feedthrough outputs for the inputs now set; the state is untouched."""
@@ -313,11 +285,6 @@ class ScissorJackUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> ScissorJackModel:
-        if self.model is None:
-            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
-        return self.model
-
     def _inputs(self) -> JackInputs:
         return JackInputs(
             float(self.values["handle.speed_command"]), float(self.values["handle.torque_command"])

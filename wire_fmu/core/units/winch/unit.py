@@ -48,15 +48,14 @@ import numpy as np
 
 from wire_fmu.core.components.drive_train import DriveChain, default_drive_train, parse_drive_train
 from wire_fmu.core.components.drum import Drum
-from wire_fmu.core.errors import ConfigurationError, ModelError
-from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS, EnergyFormBreakdownError
-from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings
+from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS
+from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
+    HeldInputsUnit,
     ModelOdeView,
     OdeView,
-    StepResult,
-    Unit,
     input_,
     output,
     parameter,
@@ -251,7 +250,7 @@ def _outputs():
     )
 
 
-class WinchUnit(Unit):
+class WinchUnit(HeldInputsUnit):
     """Winch (drawworks) with band brake, motor and drive train (SPEC sections 7-9)."""
 
     NAME = "Winch"
@@ -294,39 +293,6 @@ class WinchUnit(Unit):
         )
         self.model = build_winch(config, settings)
 
-    def initialize(self, start_time: float) -> None:
-        """Start the drum (at rest unless ``initial_drum_speed``); outputs filled."""
-        model = self._require_model()
-        model.initialize(start_time, self._inputs())
-        self.time = start_time
-        self.initial_energy = model.stored_energy()
-        self._update_outputs()
-
-    def advance(self, time: float, step: float) -> StepResult:
-        """Advance by ``step`` seconds with the inputs held."""
-        model = self._require_model()
-        inputs = self._inputs()
-        who = f"{self.NAME} {self.instance_name!r} at t = {time:.6g} s"
-        bad = inputs.problems()
-        if bad:
-            return StepResult(False, f"{who}: step refused: " + "; ".join(bad))
-        saved = self.get_state()
-        try:
-            model.advance(time, step, inputs)
-            self.time = time + step
-            self._update_outputs()
-        except (
-            IntegrationError,
-            FloatingPointError,
-            ValueError,
-            ModelError,
-            EnergyFormBreakdownError,
-        ) as err:
-            self.set_state(saved)
-            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
-        events = tuple(f"t = {t:.9g} s: {text}" for t, text in model.last_events)
-        return StepResult(True, events=events)
-
     def evaluate_outputs(self) -> None:
         """Feedthrough outputs for the inputs now set; the state is untouched."""
         model = self._require_model()
@@ -356,11 +322,6 @@ class WinchUnit(Unit):
         self._update_outputs()
 
     # -------------------------------------------------------------- helpers
-    def _require_model(self) -> WinchModel | KinetostaticWinch:
-        if self.model is None:
-            raise RuntimeError(f"{self.NAME} {self.instance_name!r}: configure() first")
-        return self.model
-
     def _inputs(self) -> WinchInputs:
         v = self.values
         return WinchInputs(
