@@ -54,3 +54,34 @@ def run(
         for name in record:
             out[name][i + 1] = unit.values[name]
     return out
+
+
+FALL_MASS, FALL_LENGTH, FALL_EA, FALL_PRETENSION = 1000.0, 10.0, 1.0e7, 5000.0
+"""The released fall of the study tests: kg, m, N, N."""
+
+
+def fall_scene(**extra):
+    """A mass released on a taut single fall (``extra`` adds or replaces scene sections)."""
+    from pathlib import Path
+
+    from wire_fmu.core.units.block_train.reevings import single_fall
+    from wire_fmu.master.scene import parse_scene
+
+    data = {
+        "name": "fall",
+        "run": {"stop_time": 1.0, "step": 0.01},
+        "units": {
+            "rope": {
+                "fmu": "BlockTrain",
+                "parameters": {
+                    "reeving": single_fall(
+                        mass=FALL_MASS, length=FALL_LENGTH, axial_stiffness=FALL_EA
+                    ),
+                    "initial_equilibrium": False,
+                    "pretension": FALL_PRETENSION,
+                },
+            }
+        },
+    }
+    data.update(extra)
+    return parse_scene(data, base_dir=Path("."))

@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.units.block_train.reevings import single_fall
 from wire_fmu.master.scene import SceneError, VarRef, load_scene, parse_scene
 from wire_fmu.study.accuracy import (
     RunRow,
@@ -36,37 +35,30 @@ from wire_fmu.study.accuracy import (
     with_stop_time,
 )
 
+from .block_train_helpers import (
+    FALL_EA,
+    FALL_LENGTH,
+    FALL_MASS,
+    FALL_PRETENSION,
+)
+from .block_train_helpers import fall_scene as released_fall
+
 ROOT = Path(__file__).resolve().parents[1]
 COUPLED_FALLS = ROOT / "docs" / "scenes" / "coupled_falls.toml"
 WINCH_HOIST = ROOT / "docs" / "scenes" / "winch_hoist.toml"
 RK4 = SolverChoice("rk4 h=4e-3", {"solver": "rk4", "solver_max_step": 4e-3})
 G = 9.81
-MASS, LENGTH, EA, PRETENSION = 1000.0, 10.0, 1.0e7, 5000.0
+MASS, LENGTH, EA, PRETENSION = FALL_MASS, FALL_LENGTH, FALL_EA, FALL_PRETENSION
 
 
 def fall_scene(**extra):
-    """A mass released on a taut rope (see tests/test_study_monolithic.py)."""
-    data = {
-        "name": "fall",
-        "run": {"stop_time": 1.0, "step": 0.01},
-        "units": {
-            "rope": {
-                "fmu": "BlockTrain",
-                "parameters": {
-                    "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
-                    "initial_equilibrium": False,
-                    "pretension": PRETENSION,
-                },
-            }
-        },
-        "study": {
-            "key_outputs": ["rope.block_a.position"],
-            "steps": [0.02, 0.01],
-            "output_interval": 0.02,
-        },
+    """A mass released on a taut rope, studied over two steps (see block_train_helpers)."""
+    study = {
+        "key_outputs": ["rope.block_a.position"],
+        "steps": [0.02, 0.01],
+        "output_interval": 0.02,
     }
-    data.update(extra)
-    return parse_scene(data, base_dir=Path("."))
+    return released_fall(**{"study": study, **extra})
 
 
 def row(

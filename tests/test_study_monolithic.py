@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,30 +11,22 @@ from wire_fmu.core.units.block_train.reevings import single_fall
 from wire_fmu.master.scene import SceneError, parse_scene
 from wire_fmu.study.monolithic import run_monolithic
 
+from .block_train_helpers import (
+    FALL_EA,
+    FALL_LENGTH,
+    FALL_MASS,
+    FALL_PRETENSION,
+)
+from .block_train_helpers import fall_scene as released_fall
+
 G = 9.81
-MASS, LENGTH, EA, PRETENSION = 1000.0, 10.0, 1.0e7, 5000.0
+MASS, LENGTH, EA, PRETENSION = FALL_MASS, FALL_LENGTH, FALL_EA, FALL_PRETENSION
 
 
 def fall_scene(**extra):
-    data = {
-        "name": "fall",
-        "run": {"stop_time": 1.0, "step": 0.01},
-        "units": {
-            "rope": {
-                "fmu": "BlockTrain",
-                "parameters": {
-                    "reeving": single_fall(mass=MASS, length=LENGTH, axial_stiffness=EA),
-                    "initial_equilibrium": False,
-                    "pretension": PRETENSION,
-                },
-            }
-        },
-        "outputs": {
-            "variables": ["rope.block_a.position", "rope.line_a.tension", "rope.energy_balance"]
-        },
-    }
-    data.update(extra)
-    return parse_scene(data, base_dir=Path("."))
+    """A mass released on a taut rope, recording its position, tension and ledger."""
+    outputs = {"variables": ["rope.block_a.position", "rope.line_a.tension", "rope.energy_balance"]}
+    return released_fall(**{"outputs": outputs, **extra})
 
 
 def test_free_oscillation_matches_the_closed_form():
