@@ -104,9 +104,9 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_draw(args: argparse.Namespace) -> int:
     """Draw every block train's reeving in a scene."""
-    from wire_fmu.master.draw import draw_reeving
     from wire_fmu.master.run import find_scene
     from wire_fmu.master.scene import SceneError, load_scene
+    from wire_fmu.tools.draw import draw_reeving
 
     scene = load_scene(find_scene(args.scene))
     out = Path(args.output or Path("results") / scene.name)
