@@ -393,3 +393,45 @@ def test_a_sweep_spec_path_that_is_a_device_is_refused(tmp_path):
 
     with pytest.raises(SweepSpecError, match="character device"):
         load_sweep_spec(Path("/dev/zero"))
+
+
+def test_an_fmu_path_that_is_a_pipe_is_refused_without_opening_it(tmp_path, fmu_dir):
+    """A pipe named as a unit's FMU hung check (the model description reader waited)."""
+    import os
+
+    os.mkfifo(tmp_path / "unit.fmu")
+    path = tmp_path / "pipe_fmu.toml"
+    path.write_text('name = "p"\n[units.u]\nfmu = "unit.fmu"\n')
+    only(problems_of(path, fmu_dir), "unit 'u'", "not a regular file")
+
+
+@pytest.mark.parametrize(
+    ("axis", "words"),
+    [
+        ("linspace = [100.0, 400.0, 30000]", "30000 cases, more than max_cases = 10000"),
+        ("linspace = [100.0, 400.0, 10000000000]", "more than 100000"),
+    ],
+)
+def test_a_sweep_of_absurdly_many_cases_is_refused_saying_how_to_allow_it(tmp_path, axis, words):
+    from wire_fmu.sweep import load_sweep_spec
+    from wire_fmu.sweep.spec import SweepSpecError
+
+    path = tmp_path / "huge.toml"
+    path.write_text(f'[[axes]]\ntarget = "units.j.parameters.load_mass"\n{axis}\n')
+    with pytest.raises(SweepSpecError) as caught:
+        load_sweep_spec(path)
+    assert any(words in p for p in caught.value.problems), caught.value.problems
+    path.write_text(path.read_text().replace("30000", "3") + "max_cases = 2\n")
+    if "30000]" in axis:
+        with pytest.raises(SweepSpecError, match="3 cases, more than max_cases = 2"):
+            load_sweep_spec(path)
+
+
+def test_a_recorded_text_output_reads_as_nan_not_a_traceback(tmp_path):
+    from wire_fmu.master.plots import read_results
+
+    csv = tmp_path / "timeseries.csv"
+    csv.write_text("time,j.load.height,j.solver\n0.0,1.5,rk4\n0.01,1.6,rk4\n")
+    columns = read_results(csv)
+    assert list(columns["j.load.height"]) == [1.5, 1.6]
+    assert all(v != v for v in columns["j.solver"])

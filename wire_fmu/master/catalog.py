@@ -53,6 +53,8 @@ def resolve_fmu(
         return None, f"{fmu!r} is neither one of our FMUs ({known}) nor a path to a .fmu file"
     if not path.exists():
         return None, f"FMU file {path} does not exist"
+    if not path.is_file():  # a folder, a pipe or a device would hang or fail the reader
+        return None, f"FMU file {path} is not a regular file"
     return path, None
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import logging
+import math
 from pathlib import Path
 
 import numpy as np
@@ -17,14 +18,24 @@ logger = logging.getLogger(__name__)
 
 
 def read_results(csv_path: Path) -> dict[str, np.ndarray]:
-    """Columns of a results file as float arrays, by name."""
+    """Columns of a results file as float arrays, by name (a text cell reads as NaN)."""
     with Path(csv_path).open(newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], rows[1:]
     data = (
-        np.array([[float(c) for c in row] for row in body]) if body else np.zeros((0, len(header)))
+        np.array([[_number(c) for c in row] for row in body])
+        if body
+        else np.zeros((0, len(header)))
     )
     return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def _number(cell: str) -> float:
+    """A recorded cell as a number; a String or Boolean output's text is no number: NaN."""
+    try:
+        return float(cell)
+    except ValueError:
+        return math.nan
 
 
 def _figure(title: str, ylabel: str):

@@ -68,6 +68,7 @@ trapezoidal, over the recorded span). The column is a recorded output
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import tomllib
@@ -176,7 +177,11 @@ RESERVED_COLUMNS = frozenset(
 )
 """Columns every summary row has; a key figure may not take one of these names."""
 
-_TOP_KEYS = frozenset({"name", "description", "axes", "sampling", "figures"})
+_TOP_KEYS = frozenset({"name", "description", "axes", "sampling", "figures", "max_cases"})
+MAX_CASES = 10_000
+"""Default most cases a sweep may have (``max_cases`` in the spec allows more)."""
+MAX_AXIS_VALUES = 100_000
+"""Most values one ``linspace`` or ``logspace`` axis may list."""
 _AXIS_KEYS = frozenset(
     {
         "target",
@@ -413,6 +418,8 @@ def parse_sweep_spec(data: Mapping[str, Any], *, source: Path | None = None) -> 
             "'-', '.', no '..'), since it names the sweep's results folder"
         )
         name = "sweep"
+    if not problems:
+        _check_case_count(data.get("max_cases", MAX_CASES), axes, sampling, problems)
     if problems:
         raise SweepSpecError(f"sweep spec {name!r}", problems)
     return SweepSpec(
@@ -489,12 +496,29 @@ def _spaced(spec: Mapping[str, Any], key: str, where: str, problems: list[str]) 
         )
         return []
     start, stop, count = raw
+    if count > MAX_AXIS_VALUES:
+        problems.append(f"{where}: '{key}' asks for {count} values, more than {MAX_AXIS_VALUES}")
+        return []
     if key == "logspace":
         if start <= 0 or stop <= 0:
             problems.append(f"{where}: 'logspace' needs start and stop > 0, got {raw!r}")
             return []
         return [float(v) for v in np.geomspace(start, stop, count)]
     return [float(v) for v in np.linspace(start, stop, count)]
+
+
+def _check_case_count(limit: Any, axes: list, sampling: Any, problems: list[str]) -> None:
+    """Refuse a sweep of more cases than ``max_cases``, saying how many and how to allow it."""
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        problems.append(f"'max_cases' must be a whole number >= 1, got {limit!r}")
+        return
+    count = math.prod(len(a.values) for a in axes if a.values)
+    count *= sampling.samples if sampling else 1
+    if count > limit:
+        problems.append(
+            f"the sweep has {count} cases, more than max_cases = {limit}; set max_cases in the "
+            "spec to allow it, or take fewer values"
+        )
 
 
 def _grid_values(
@@ -582,11 +606,12 @@ def _parse_axis(i: int, spec: Any, problems: list[str]) -> Axis | None:
 
 
 def _check_duplicates(values: tuple[Any, ...], where: str, problems: list[str]) -> None:
-    seen: list[Any] = []
+    seen: set[str] = set()  # by their JSON text: linear, and unhashable values compare too
     for value in values:
-        if value in seen:
+        key = json.dumps(value, sort_keys=True, default=repr)
+        if key in seen:
             problems.append(f"{where}: value {value!r} appears twice (each case must differ)")
-        seen.append(value)
+        seen.add(key)
 
 
 def _parse_axes(data: Any, problems: list[str]) -> list[Axis]:
@@ -623,6 +648,9 @@ def _parse_sampling(data: Any, axes: list[Axis], problems: list[str]) -> Samplin
     )
     if not isinstance(samples, int) or isinstance(samples, bool) or samples < 1:
         problems.append(f"sampling.samples must be a whole number >= 1, got {samples!r}")
+        return None
+    if samples > MAX_AXIS_VALUES:
+        problems.append(f"sampling.samples = {samples}: more than {MAX_AXIS_VALUES}")
         return None
     if method not in SAMPLING_METHODS:
         problems.append(
