@@ -421,7 +421,7 @@ def test_a_sweep_of_absurdly_many_cases_is_refused_saying_how_to_allow_it(tmp_pa
     with pytest.raises(SweepSpecError) as caught:
         load_sweep_spec(path)
     assert any(words in p for p in caught.value.problems), caught.value.problems
-    path.write_text(path.read_text().replace("30000", "3") + "max_cases = 2\n")
+    path.write_text("max_cases = 2\n" + path.read_text().replace("30000", "3"))
     if "30000]" in axis:
         with pytest.raises(SweepSpecError, match="3 cases, more than max_cases = 2"):
             load_sweep_spec(path)
