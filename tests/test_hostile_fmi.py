@@ -294,3 +294,28 @@ def test_freeing_without_terminate_and_many_instances_in_one_process(built, log)
         if n % 3 == 0:
             _status(lambda inst=instance: inst.doStep(5.0, 0.01))  # an error on the way
         instance.freeInstance()
+
+
+def test_setup_experiment_after_initialisation_is_an_error(built, log):
+    fmu = built["winch"]
+    instance = _started(fmu, log)
+    _refused(log, lambda: instance.setupExperiment(startTime=5.0), "fmi2SetupExperiment")
+    instance.doStep(0.0, 0.01)
+    instance.freeInstance()
+
+
+def test_a_state_with_a_time_that_is_not_finite_is_refused(built, log):
+    """Such a state was accepted, and every step after it passed the time check (NaN)."""
+    import json
+
+    fmu = built["winch"]
+    instance = _started(fmu, log)
+    state = instance.getFMUstate()
+    data = json.loads(bytes(instance.serializeFMUstate(state)).decode())
+    data["time"] = float("nan")
+    bad = instance.deSerializeFMUstate(json.dumps(data).encode())
+    _refused(log, lambda: instance.setFMUstate(bad), "fmi2SetFMUstate", "not finite")
+    _refused(log, lambda: instance.doStep(7.0, 0.01), "communication point")
+    for s in (state, bad):
+        instance.freeFMUstate(s)
+    instance.freeInstance()

@@ -161,7 +161,10 @@ def test_a_failing_initialisation_runs_to_a_failed_status_with_results_kept(tmp_
     [
         ("stop_time = 1e300", ("macro steps", "max_steps")),
         ("step = 1e-12", ("macro steps", "max_steps")),
-        ("stop_time = 100000000000000000000000000000000000000000", ("run.stop_time",)),
+        (
+            "stop_time = 100000000000000000000000000000000000000000",
+            ("run.stop_time", "nanoseconds"),
+        ),
         ("iterations = 2.5", ("run.iterations",)),
         ("energy_guard = -1.0", ("run.energy_guard",)),
         ('adaptive = "yes"', ("run.adaptive",)),
@@ -196,19 +199,25 @@ def test_the_step_count_message_says_how_to_allow_it(tmp_path, fmu_dir):
 @pytest.mark.parametrize(
     ("value", "expected"),
     [
-        ('"high"', "a number"),
+        ('"high"', "a whole number"),
         ("[1.0, 2.0]", "finite number"),
-        ("true", "a number"),
+        ("true", "a whole number"),
+        ("2.5", "a whole number"),
         ("nan", "finite number"),
     ],
 )
 def test_an_event_value_of_the_wrong_type_is_named(tmp_path, fmu_dir, value, expected):
-    event = (
-        f'\n[[events]]\ntime = 1.0\nlabel = "push"\nset = {{ "cylinder.rod.force" = {value} }}\n'
-    )
+    event = f'\n[[events]]\ntime = 1.0\nlabel = "cut"\nset = {{ "rope.break_segment" = {value} }}\n'
     path = variant(tmp_path, append=event)
-    problem = only(problems_of(path, fmu_dir), "cylinder.rod.force")
+    problem = only(problems_of(path, fmu_dir), "rope.break_segment")
     assert expected in problem
+
+
+def test_an_event_on_an_input_a_bond_feeds_is_refused(tmp_path, fmu_dir):
+    """It used to cut the bond silently from the event on (the rod ran away at 10 m/s)."""
+    event = '\n[[events]]\ntime = 0.05\nlabel = "push"\nset = { "cylinder.rod.force" = 0.0 }\n'
+    problem = only(problems_of(variant(tmp_path, append=event), fmu_dir), "cylinder.rod.force")
+    assert "fed by bond 'rod' effort" in problem and "event 'push'" in problem
 
 
 @pytest.mark.parametrize("time", ['"soon"', "-1.0", "nan"])
@@ -279,7 +288,7 @@ def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
             EFFORT: EFFORT.replace("cylinder.rod", "piston.rod"),
         },
         sections={CYL: "no_such_parameter = 1.0"},
-        append='\n[[events]]\ntime = 1.0\nset = { "cylinder.rod.force" = "x" }\n',
+        append='\n[[events]]\ntime = 1.0\nset = { "rope.break_segment" = "x" }\n',
     )
     problems = problems_of(path, fmu_dir)
     for words in (
@@ -287,7 +296,7 @@ def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
         ("no unit 'piston'",),
         ("'no_such_parameter'",),
         ("'pretension'",),
-        ("event", "cylinder.rod.force"),
+        ("event", "rope.break_segment"),
     ):
         only(problems, *words)
 
@@ -313,14 +322,19 @@ def test_check_on_the_command_line_exits_1_listing_the_problem(tmp_path, fmu_dir
     assert out.out.count("precharge_pressure") <= 1
 
 
-def test_an_output_interval_below_the_round_off_records_every_step_and_ends(tmp_path, fmu_dir):
-    """A loop adding the interval to the next output time ran for ever once the interval was
-    below the round-off of the time (1e-300 s); every step is recorded instead."""
-    path = variant(tmp_path, replace={"output_interval = 0.01": "output_interval = 1e-300"})
+def test_an_output_interval_below_the_step_records_every_step_quickly(tmp_path, fmu_dir):
+    """The recorder added the interval to the next output time until it passed the time: two
+    million additions a row at 1 ns (and for ever below the round-off, now refused with
+    run.output_interval under 1 ns). The next output time is computed instead."""
+    path = variant(tmp_path, replace={"output_interval = 0.01": "output_interval = 1e-9"})
     outcome = run_scene(path, tmp_path / "out", fmu_dir=fmu_dir, stop_time=0.01, plots=False)
     assert outcome.result.status == "finished"
     rows = outcome.csv_path.read_text().splitlines()
     assert len(rows) == 1 + 1 + 5  # header, start, five steps of 2 ms
+    tiny = variant(
+        tmp_path, replace={"output_interval = 0.01": "output_interval = 1e-300"}, name="tiny"
+    )
+    only(problems_of(tiny, fmu_dir), "run.output_interval", "nanoseconds")
 
 
 @pytest.mark.parametrize(

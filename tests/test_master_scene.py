@@ -50,7 +50,7 @@ def test_parse_errors_are_all_listed(tmp_path):
         "run.algorithm must be one of",
         "run.extrapolation must be one of",
         "unit 'a': 'fmu' must name",
-        "may not contain '.'",
+        "unit 'b.c': a unit name is a letter or '_'",
         "'effects' must be a list",
         "'kind' must be one of",
         "'flow' is required",

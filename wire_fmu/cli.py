@@ -104,13 +104,12 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_draw(args: argparse.Namespace) -> int:
     """Draw every block train's reeving in a scene."""
-    from wire_fmu.master.run import find_scene
+    from wire_fmu.master.run import find_scene, make_results_folder
     from wire_fmu.master.scene import SceneError, load_scene
     from wire_fmu.tools.draw import draw_reeving
 
     scene = load_scene(find_scene(args.scene))
-    out = Path(args.output or Path("results") / scene.name)
-    out.mkdir(parents=True, exist_ok=True)
+    out = make_results_folder(Path(args.output or Path("results") / scene.name))
     drawn = 0
     for name, unit in scene.units.items():
         reeving = unit.parameters.get("reeving")

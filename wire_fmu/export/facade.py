@@ -309,6 +309,9 @@ class CoreFacade(Fmi2Slave):
         self, start_time: float, stop_time: float | None = None, tolerance: float | None = None
     ) -> None:
         """Remember the start time (pythonfmu passes only ``start_time``)."""
+        self._require("fmi2SetupExperiment", Phase.instantiated)
+        if not math.isfinite(start_time):
+            raise FacadeError(f"start time {start_time!r} s: must be finite")
         self._start_time = float(start_time)
 
     @fmi_entry("fmi2EnterInitializationMode")
@@ -439,6 +442,9 @@ class CoreFacade(Fmi2Slave):
             raise FacadeError(
                 f"the FMU state belongs to unit {state.get('unit')!r}, not {self.unit.NAME!r}"
             )
+        times = [state.get("start_time"), state.get("time", state.get("start_time"))]
+        if not all(isinstance(t, int | float) and math.isfinite(t) for t in times):
+            raise FacadeError(f"the FMU state's times {times} are not finite numbers")
         expected = {v.name for v in self.unit.VARIABLES}
         if set(state["values"]) != expected:
             raise FacadeError("the FMU state's variables differ from this FMU's variables")

@@ -180,6 +180,8 @@ class CsvRecorder:
 
 
 def _cell(value: Any) -> Any:
+    if isinstance(value, bytes):  # fmpy reads a String variable as bytes
+        return value.decode("utf-8", "replace")
     if isinstance(value, bool):
         return int(value)
     if isinstance(value, float):

@@ -164,8 +164,9 @@ def run_scene(
         scene = load_scene_file(find_scene(scene))
     if run_overrides:
         scene = with_run_settings(scene, **run_overrides)
-    structure = validate_scene(scene, fmu_dir)
     directory = Path(results) if results else Path("results") / scene.name
+    make_results_folder(directory)
+    structure = validate_scene(scene, fmu_dir)
     recorder = CsvRecorder(directory, scene.run.output_interval)
     chain = [recorder, *observers] + ([Progress()] if progress else [])
     sim = Simulation(scene, structure, chain)
@@ -174,6 +175,22 @@ def run_scene(
     if plots and scene.plots:
         outcome.plots = _plots(scene, recorder.csv_path, directory)
     return outcome
+
+
+def make_results_folder(directory: Path) -> Path:
+    """Create ``directory`` (and its parents) for results, or say why it cannot be.
+
+    Raises
+    ------
+    SceneError
+        When it is a file, a device, or cannot be created.
+    """
+    try:
+        Path(directory).mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        reason = err.strerror or type(err).__name__
+        raise SceneError(str(directory), [f"cannot be the results folder: {reason}"]) from None
+    return Path(directory)
 
 
 def _plots(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:

@@ -110,6 +110,8 @@ __all__ = [
 
 ALGORITHMS = ("jacobi", "gauss_seidel")
 EXTRAPOLATIONS = ("constant", "linear", "quadratic")
+MIN_TIME, MAX_TIME = 1e-9, 1e12
+"""Shortest step and latest time a run can count (whole nanoseconds in 64 bits), s."""
 MAX_SCENE_BYTES = 16 * 2**20
 """The largest scene file read (a scene is a few kilobytes; a reeving table a few more)."""
 MAX_ITERATIONS = 1000
@@ -383,9 +385,15 @@ def read_scene_data(
         study=dict(study),
     )
     problems += _unknown_unit_problems(scene)
+    problems += [
+        f"run.order names {name!r}, which is no unit of the scene"
+        for name in run.order
+        if name not in units
+    ]
     return scene, problems
 
 
+_UNIT_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,127}")
 
 
@@ -431,6 +439,22 @@ def _unknown_unit_problems(scene: Scene) -> list[str]:
     ]
 
 
+def _unknown_keys(spec: Mapping, known: set[str], where: str, problems: list[str]) -> None:
+    """A problem naming the keys of ``spec`` that are not ``known`` (typos silently ignored
+    would change what runs)."""
+    unknown = sorted(str(k) for k in set(spec) - known)
+    if unknown:
+        problems.append(f"{where}: unknown keys {unknown}; known: {', '.join(sorted(known))}")
+
+
+def _text(value: Any, where: str, key: str, problems: list[str], default: str) -> str:
+    """A name, label or title: text, else a problem and ``default``."""
+    if isinstance(value, str):
+        return value
+    problems.append(f"{where}: {key!r} must be text, got {value!r}")
+    return default
+
+
 def _as_list(value: Any, where: str, problems: list[str]) -> list:
     if isinstance(value, list):
         return value
@@ -445,8 +469,11 @@ def _parse_units(data: Any, problems: list[str]) -> dict[str, UnitSpec]:
         return units
     for name, spec in data.items():
         where = f"unit {name!r}"
-        if "." in name:
-            problems.append(f"{where}: a unit name may not contain '.'")
+        if not _UNIT_NAME.fullmatch(name):
+            problems.append(
+                f"{where}: a unit name is a letter or '_', then letters, digits or '_' (it "
+                "names the unit's variables, 'unit.variable')"
+            )
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: must be a table")
             continue
@@ -492,7 +519,7 @@ def _parse_bonds(data: Any, problems: list[str], units: set[str]) -> tuple[Bond,
         if not isinstance(spec, Mapping):
             problems.append(f"bond {i}: must be a table")
             continue
-        name = str(spec.get("name", f"bond{i}"))
+        name = _text(spec.get("name", f"bond{i}"), f"bond {i}", "name", problems, f"bond{i}")
         where = f"bond {name!r}"
         if name in names:
             problems.append(f"{where}: defined twice")
@@ -536,6 +563,7 @@ def _parse_connections(data: Any, problems: list[str]) -> tuple[Connection, ...]
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: must be a table with 'from' and 'to'")
             continue
+        _unknown_keys(spec, {"from", "to", "extrapolation"}, where, problems)
         source, target = VarRef.parse(spec.get("from")), VarRef.parse(spec.get("to"))
         if source is None or target is None:
             problems.append(f"{where}: 'from' and 'to' must be 'unit.variable'")
@@ -562,7 +590,8 @@ def _parse_drivers(data: Any, problems: list[str]) -> tuple[DriverSpec, ...]:
         if rate is not None and rate_ref is None:
             problems.append(f"driver {i}: 'rate_target' must be 'unit.input'")
         body = {k: v for k, v in spec.items() if k not in ("target", "rate_target", "label")}
-        out.append(DriverSpec(target, body, rate_ref, str(spec.get("label", ""))))
+        label = _text(spec.get("label", ""), f"driver {i}", "label", problems, "")
+        out.append(DriverSpec(target, body, rate_ref, label))
     return tuple(out)
 
 
@@ -573,9 +602,12 @@ def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
         if not isinstance(spec, Mapping):
             problems.append(f"{where}: must be a table")
             continue
+        _unknown_keys(spec, {"time", "set", "label"}, where, problems)
         time = spec.get("time")
-        if not _finite(time) or time < 0:
-            problems.append(f"{where}: 'time' must be a number of seconds >= 0, got {time!r}")
+        if not _finite(time) or not 0 <= time <= MAX_TIME:
+            problems.append(
+                f"{where}: 'time' must be a number of seconds from 0 to {MAX_TIME:g}, got {time!r}"
+            )
             continue
         values = {}
         raw = spec.get("set", {})
@@ -592,7 +624,8 @@ def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
                 )
             else:
                 values[ref] = value
-        out.append(EventSpec(float(time), values, str(spec.get("label", f"event {i}"))))
+        label = _text(spec.get("label", f"event {i}"), where, "label", problems, f"event {i}")
+        out.append(EventSpec(float(time), values, label))
     return tuple(sorted(out, key=lambda e: e.time))
 
 
@@ -600,6 +633,7 @@ def _parse_outputs(data: Any, problems: list[str]) -> tuple[VarRef, ...] | None:
     if not isinstance(data, Mapping):
         problems.append("[outputs] must be a table with 'variables'")
         return None
+    _unknown_keys(data, {"variables"}, "[outputs]", problems)
     variables = data.get("variables", "all")
     if variables == "all":
         return None
@@ -622,13 +656,16 @@ def _parse_plots(data: Any, problems: list[str]) -> tuple[PlotSpec, ...]:
         if not isinstance(spec, Mapping) or not isinstance(spec.get("variables"), list):
             problems.append(f"plot {i}: needs 'title' and a list 'variables'")
             continue
+        _unknown_keys(spec, {"title", "variables", "ylabel"}, f"plot {i}", problems)
         refs = [VarRef.parse(v) for v in spec["variables"]]
-        if any(r is None for r in refs):
-            problems.append(f"plot {i}: every variable must be 'unit.variable'")
+        if not refs or any(r is None for r in refs):
+            problems.append(f"plot {i}: 'variables' must list at least one 'unit.variable'")
             continue
-        out.append(
-            PlotSpec(str(spec.get("title", f"plot {i}")), tuple(refs), str(spec.get("ylabel", "")))
-        )
+        title = _text(spec.get("title", f"plot {i}"), f"plot {i}", "title", problems, "plot")
+        if not title.strip() or len(title) > 100:
+            problems.append(f"plot {i}: 'title' must be 1 to 100 characters (it names the PNG)")
+        ylabel = _text(spec.get("ylabel", ""), f"plot {i}", "ylabel", problems, "")
+        out.append(PlotSpec(title, tuple(refs), ylabel))
     return tuple(out)
 
 
@@ -708,6 +745,15 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
         problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):
         problems.append(f"run.order must be a list of unit names, got {s.order!r}")
+    elif len(set(s.order)) != len(s.order):
+        problems.append(f"run.order names a unit more than once: {list(s.order)}")
+    for key in ("stop_time", "step", "min_step", "max_step", "output_interval"):
+        value = getattr(s, key)
+        if _positive(value) and not MIN_TIME <= value <= MAX_TIME:
+            problems.append(
+                f"run.{key} = {value!r} s: times are counted in whole nanoseconds, from "
+                f"{MIN_TIME:g} to {MAX_TIME:g} s"
+            )
     if not isinstance(s.max_steps, int) or isinstance(s.max_steps, bool) or s.max_steps < 1:
         problems.append(f"run.max_steps must be an integer >= 1, got {s.max_steps!r}")
     elif _positive(s.stop_time) and _positive(s.step):

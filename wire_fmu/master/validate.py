@@ -115,7 +115,12 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
         if p_src is not None or p_dst is not None:
             continue
         src, dst = structure.variable(c.source), structure.variable(c.target)
-        if src.type != dst.type:
+        if src.type != "Real" or dst.type != "Real":
+            problems.append(
+                f"{what} {c.source} -> {c.target}: connects a {src.type} to a "
+                f"{dst.type}; the master connects Real variables only"
+            )
+        elif src.type != dst.type:
             problems.append(f"{what} {c.source} -> {c.target}: type {src.type} feeds {dst.type}")
         elif src.type == "Real" and (src.unit or "") != (dst.unit or ""):
             problems.append(
@@ -126,6 +131,14 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
         for ref in (d.target, d.rate_target):
             if ref is not None:
                 fed[ref].append("a driver")
+    for e in scene.events:
+        for ref in e.values:
+            if fed.get(ref):  # an event would cut a connection or a driver from then on
+                problems.append(
+                    f"event {e.label!r} sets {ref}, which is fed by "
+                    f"{' and by '.join(fed[ref])}; an event may set only inputs "
+                    "nothing else feeds"
+                )
     for target, sources in fed.items():
         if len(sources) > 1:
             problems.append(f"input {target} is fed twice: by {' and by '.join(sources)}")
@@ -162,22 +175,25 @@ def feedthrough_loops(scene: Scene, structure: Structure) -> list[list[str]]:
         for output, inputs in structure.dependencies(unit).items():
             for name in inputs:
                 graph[f"{unit}.{name}"].append(f"{unit}.{output}")
-    loops, colour, stack = [], {}, []
-
-    def visit(node: str) -> None:
-        colour[node] = 1
-        stack.append(node)
-        for nxt in graph.get(node, ()):
-            if colour.get(nxt) == 1:
-                loops.append(stack[stack.index(nxt) :] + [nxt])
+    loops: list[list[str]] = []
+    colour: dict[str, int] = {}  # 1: on the path now, 2: done
+    for root in list(graph):
+        if root in colour:
+            continue
+        # depth first without recursion: a chain of thousands of connections is fine
+        path, pending = [root], [iter(graph.get(root, ()))]
+        colour[root] = 1
+        while pending:
+            nxt = next(pending[-1], None)
+            if nxt is None:
+                colour[path.pop()] = 2
+                pending.pop()
+            elif colour.get(nxt) == 1:
+                loops.append(path[path.index(nxt) :] + [nxt])
             elif nxt not in colour:
-                visit(nxt)
-        stack.pop()
-        colour[node] = 2
-
-    for node in list(graph):
-        if node not in colour:
-            visit(node)
+                colour[nxt] = 1
+                path.append(nxt)
+                pending.append(iter(graph.get(nxt, ())))
     return loops
 
 

@@ -726,6 +726,8 @@ def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsT
     try:
         sim = Simulation(scene, structure, [timing, recorder])
         result = sim.run()
+        if result.status == "interrupted":  # Ctrl-C ends the study, not just this run
+            raise KeyboardInterrupt
     except Exception as exc:  # noqa: BLE001 - one configuration failing must not end a study
         logger.debug("run failed: %s", exc, exc_info=True)
         return TimedRun("failed", f"{type(exc).__name__}: {exc}", {}, Timing())

@@ -163,6 +163,8 @@ def execute_case(
                 worker=worker,
             )
         result = outcome.result
+        if result.status == "interrupted":  # Ctrl-C ends the sweep, the case is not done
+            raise KeyboardInterrupt
         status = result.status if result.status in ("finished", "stopped") else "failed"
         return CaseOutcome(
             cid,
