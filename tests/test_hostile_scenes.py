@@ -449,3 +449,74 @@ def test_a_recorded_text_output_reads_as_nan_not_a_traceback(tmp_path):
     columns = read_results(csv)
     assert list(columns["j.load.height"]) == [1.5, 1.6]
     assert all(v != v for v in columns["j.solver"])
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        ('\n[[events]]\ntime = 1.0\nsett = 5\nset = { "rope.break_segment" = 0 }\n', "'sett'"),
+        ('\n[[connections]]\nfrm = "rope.tension_max"\nto = "cylinder.rod.force"\n', "'frm'"),
+        (
+            '\n[[plots]]\ntitle = "x"\ncolour = "red"\nvariables = ["rope.tension_max"]\n',
+            "'colour'",
+        ),
+        ('\n[[plots]]\ntitle = 5\nvariables = ["rope.tension_max"]\n', "'title' must be text"),
+        ('\n[[plots]]\ntitle = ""\nvariables = ["rope.tension_max"]\n', "1 to 100 characters"),
+        ('\n[[plots]]\ntitle = "e"\nvariables = []\n', "at least one"),
+        (
+            '\n[[events]]\ntime = 1.0\nlabel = { a = 1 }\nset = { "rope.break_segment" = 0 }\n',
+            "'label' must be text",
+        ),
+        ('\n[units."a -> b"]\nfmu = "Winch"\n', "a unit name is a letter"),
+        ('\n[units.""]\nfmu = "Winch"\n', "a unit name is a letter"),
+    ],
+)
+def test_typos_and_names_of_the_wrong_kind_are_named(tmp_path, fmu_dir, extra, words):
+    problems = problems_of(variant(tmp_path, append=extra), fmu_dir)
+    assert any(words in p for p in problems), problems
+
+
+@pytest.mark.parametrize(
+    ("line", "words"),
+    [
+        ('order = ["ghost"]', "run.order names 'ghost'"),
+        ('order = ["rope", "rope"]', "more than once"),
+        ("step = 1e-12", "nanoseconds"),
+        ("stop_time = 1e300", "nanoseconds"),
+    ],
+)
+def test_run_order_and_times_a_run_cannot_count_are_refused(tmp_path, fmu_dir, line, words):
+    key = line.split(" =")[0]
+    text = RISER.read_text(encoding="utf-8")
+    replace = {m.group(0): "" for m in re.finditer(rf"^{key} = .*\n", text, flags=re.M)}
+    problems = problems_of(variant(tmp_path, replace=replace, sections={"[run]": line}), fmu_dir)
+    assert any(words in p for p in problems), problems
+
+
+def test_an_integer_connection_is_refused_before_it_fails(tmp_path, fmu_dir):
+    extra = '\n[[connections]]\nfrom = "rope.slack_spans"\nto = "rope.break_segment"\n'
+    problems = problems_of(variant(tmp_path, append=extra), fmu_dir)
+    assert any("connects a Integer to a Integer" in p for p in problems), problems
+
+
+def test_a_results_folder_that_is_a_file_is_said_before_anything_runs(tmp_path, fmu_dir, capsys):
+    (tmp_path / "taken").write_text("")
+    code = cli(
+        ["--fmu-dir", str(fmu_dir), "run", "-q", "-o", str(tmp_path / "taken"), "riser_tensioner"]
+    )
+    out = capsys.readouterr().out
+    assert code == 1 and "cannot be the results folder" in out and "Traceback" not in out
+
+
+def test_thousands_of_chained_connections_need_no_recursion(tmp_path):
+    """The algebraic-loop search recursed once per connection: 3000 gave a RecursionError."""
+    from wire_fmu.master.scene import read_scene_data
+    from wire_fmu.master.validate import Structure, feedthrough_loops
+
+    chain = [{"from": f"a.x{i}", "to": f"a.x{i + 1}"} for i in range(5000)]
+    chain.append({"from": "a.x5000", "to": "a.x0"})
+    scene, _ = read_scene_data(
+        {"units": {"a": {"fmu": "A.fmu"}}, "connections": chain}, base_dir=tmp_path
+    )
+    (loop,) = feedthrough_loops(scene, Structure({}, {}))
+    assert len(loop) == 5002 and loop[0] == loop[-1]
