@@ -520,3 +520,38 @@ def test_thousands_of_chained_connections_need_no_recursion(tmp_path):
     )
     (loop,) = feedthrough_loops(scene, Structure({}, {}))
     assert len(loop) == 5002 and loop[0] == loop[-1]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"), [("mass", "true"), ("mass", '"120000"'), ("damping", "[1.0]")]
+)
+def test_a_reeving_number_of_the_wrong_type_is_refused_not_cast(tmp_path, fmu_dir, field, value):
+    """``mass = true`` was a 1 kg block (fast-line tension 0.98 N instead of 117.7 kN)."""
+    text = DRAWWORKS.read_text(encoding="utf-8")
+    match = re.search(rf"\b{field} = [0-9.e+]+", text)
+    if match is None:
+        pytest.skip(f"the drawworks reeving sets no {field}")
+    path = variant(tmp_path, DRAWWORKS, replace={match.group(0): f"{field} = {value}"})
+    problems = problems_of(path, fmu_dir)
+    assert any(f"'{field}' must be a number" in p for p in problems), problems
+
+
+def test_plot_files_never_overwrite_each_other_or_the_energy_plot():
+    from wire_fmu.master.plots import _file_names
+
+    assert _file_names(["Energy", "energy", "Tension", ""], taken={"energy"}) == [
+        "energy_2",
+        "energy_3",
+        "tension",
+        "plot",
+    ]
+
+
+@pytest.mark.parametrize(
+    "args", [["--repeats", "0"], ["--repeats", "-1"], ["--stop-time", "-1"], ["--stop-time", "nan"]]
+)
+def test_study_options_out_of_range_are_refused_by_the_command_line(args, capsys):
+    with pytest.raises(SystemExit) as caught:
+        cli(["study", "effects", "--quick", *args, "scissor_jack"])
+    assert caught.value.code == 2
+    assert "expected" in capsys.readouterr().err

@@ -240,6 +240,30 @@ def cmd_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive_int(text: str) -> int:
+    """A whole number >= 1 from the command line (argparse names the option on error)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    """A finite number > 0 from the command line."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a number of seconds > 0, got {text!r}"
+        ) from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a number of seconds > 0, got {text}")
+    return value
+
+
 def _study_parser(sub) -> None:
     p = sub.add_parser("study", help="what accuracy and effects cost in time")
     kinds = p.add_subparsers(dest="study", required=True)
@@ -256,11 +280,14 @@ def _study_parser(sub) -> None:
             "--quick", action="store_true", help="a few configurations, short stop time (for CI)"
         )
         q.add_argument(
-            "--repeats", type=int, default=None, help="runs per configuration, the fastest counts"
+            "--repeats",
+            type=_positive_int,
+            default=None,
+            help="runs per configuration, the fastest counts",
         )
         q.add_argument(
             "--stop-time",
-            type=float,
+            type=_positive_float,
             default=None,
             help="simulated seconds per run (default: [study] stop_time, else the "
             "scene's, at most 10 s; 1 s with --quick)",

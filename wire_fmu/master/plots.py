@@ -54,17 +54,33 @@ def _slug(text: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in text.lower()).strip("_")
 
 
+def _file_names(titles: list[str], taken: set[str]) -> list[str]:
+    """One file name per plot title, none twice and none in ``taken`` (``_2``, ``_3`` ...)."""
+    names = []
+    used = set(taken)
+    for title in titles:
+        base = _slug(title) or "plot"
+        name, n = base, 1
+        while name in used:
+            n += 1
+            name = f"{base}_{n}"
+        used.add(name)
+        names.append(name)
+    return names
+
+
 def plot_scene(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
     """One PNG per scene plot, plus the energy channels; returns the files."""
     columns = read_results(csv_path)
     time = columns["time"]
     written = []
-    for spec in scene.plots:
+    names = _file_names([spec.title for spec in scene.plots], taken={"energy"})
+    for spec, name in zip(scene.plots, names, strict=True):
         fig, ax = _figure(spec.title, spec.ylabel)
         for ref in spec.variables:
             ax.plot(time, columns[str(ref)], label=str(ref))
         ax.legend(loc="best", fontsize="small")
-        path = Path(directory) / f"{_slug(spec.title)}.png"
+        path = Path(directory) / f"{name}.png"
         fig.savefig(path)
         written.append(path)
     energy = [c for c in columns if c.endswith(".energy_residual") or c == LEDGER_CHANNEL]

@@ -208,10 +208,13 @@ class _Problems:
         if value is None:
             self.add(where, f"'{key}' is required")
             return math.nan
+        if isinstance(value, bool) or not isinstance(value, int | float):  # no silent casts
+            self.add(where, f"'{key}' must be a number, got {value!r}")
+            return math.nan
         try:
             value = float(value)
-        except (TypeError, ValueError):
-            self.add(where, f"'{key}' must be a number, got {value!r}")
+        except OverflowError:
+            self.add(where, f"'{key}' is too large, got {value!r}")
             return math.nan
         if math.isnan(value):
             self.add(where, f"'{key}' must be a number, got NaN")
@@ -228,10 +231,12 @@ class _Problems:
     ) -> Vector:
         value = data.get(key, default)
         try:
+            if any(isinstance(c, bool) or not isinstance(c, int | float) for c in value):
+                raise TypeError
             vec = tuple(float(c) for c in value)
             if len(vec) != 3 or not all(math.isfinite(c) for c in vec):
                 raise ValueError
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             self.add(where, f"'{key}' must be three finite numbers [x, y, z] (m), got {value!r}")
             return (math.nan, math.nan, math.nan)
         if unit:
