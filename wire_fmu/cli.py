@@ -123,7 +123,14 @@ def cmd_draw(args: argparse.Namespace) -> int:
                     f"scene {scene.name!r}",
                     [f"unit {name!r}: parameter 'reeving' is not JSON ({exc})"],
                 ) from None
-        path = draw_reeving(reeving, out / f"{name}_reeving.png", title=f"{scene.name}: {name}")
+        try:
+            path = draw_reeving(reeving, out / f"{name}_reeving.png", title=f"{scene.name}: {name}")
+        except WireFmuError:
+            raise
+        except (ValueError, ArithmeticError) as exc:
+            raise SceneError(
+                f"scene {scene.name!r}", [f"unit {name!r}: the reeving cannot be drawn: {exc}"]
+            ) from None
         _print(f"drawn: {path.resolve()}")
         drawn += 1
     if not drawn:

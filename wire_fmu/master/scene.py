@@ -102,6 +102,9 @@ __all__ = [
     "read_scene",
     "read_scene_data",
     "is_plain_name",
+    "unknown_unit_problems",
+    "valid_time",
+    "is_scalar",
     "MAX_SCENE_BYTES",
     "ALGORITHMS",
     "EXTRAPOLATIONS",
@@ -384,7 +387,7 @@ def read_scene_data(
         source,
         study=dict(study),
     )
-    problems += _unknown_unit_problems(scene)
+    problems += unknown_unit_problems(scene)
     problems += [
         f"run.order names {name!r}, which is no unit of the scene"
         for name in run.order
@@ -413,7 +416,7 @@ def _scene_name(name: Any, problems: list[str]) -> str:
     return "scene"
 
 
-def _unknown_unit_problems(scene: Scene) -> list[str]:
+def unknown_unit_problems(scene: Scene) -> list[str]:
     """Every reference to a unit the scene does not have, naming where it is."""
     units = set(scene.units)
     known = ", ".join(sorted(units)) or "none"
@@ -694,6 +697,16 @@ def _parse_run(data: Any, problems: list[str]) -> RunSettings:
                 valid[key] = value
         settings = replace(defaults, **valid)
     return settings
+
+
+def valid_time(value: Any) -> bool:
+    """A time a run can count: a number of seconds from 0 to :data:`MAX_TIME`, not a boolean."""
+    return _finite(value) and 0 <= value <= MAX_TIME
+
+
+def is_scalar(value: Any) -> bool:
+    """A finite number, a boolean or text: what one FMI variable can hold."""
+    return _scalar(value)
 
 
 def _scalar(value: Any) -> bool:

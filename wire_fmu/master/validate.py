@@ -22,7 +22,7 @@ from pathlib import Path
 from fmpy import read_model_description
 
 from .catalog import DEFAULT_FMU_DIR, is_ours, resolve_fmu
-from .scene import BOND_KINDS, Scene, SceneError, VarRef
+from .scene import BOND_KINDS, Scene, SceneError, VarRef, unknown_unit_problems
 from .slave import value_problem
 
 __all__ = [
@@ -267,7 +267,8 @@ def _short(value) -> str:
 
 def check_structure(scene: Scene, structure: Structure) -> list[str]:
     """Every structural problem of ``scene`` (empty when sound)."""
-    problems = _connection_problems(scene, structure) + _bond_problems(scene, structure)
+    problems = unknown_unit_problems(scene)  # also for scenes not read from a file (sweeps)
+    problems += _connection_problems(scene, structure) + _bond_problems(scene, structure)
     for loop in feedthrough_loops(scene, structure):
         problems.append("algebraic loop through direct feedthrough: " + " -> ".join(loop))
     problems += _other_problems(scene, structure)

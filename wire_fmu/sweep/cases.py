@@ -23,7 +23,16 @@ from typing import Any
 
 from wire_fmu.master.observers import BOND_CHANNELS, LEDGER_CHANNEL
 from wire_fmu.master.run import with_run_settings
-from wire_fmu.master.scene import DriverSpec, RunSettings, Scene, UnitSpec, VarRef
+from wire_fmu.master.scene import (
+    DriverSpec,
+    RunSettings,
+    Scene,
+    SceneError,
+    UnitSpec,
+    VarRef,
+    is_scalar,
+    valid_time,
+)
 from wire_fmu.master.validate import Structure
 
 from .spec import Figure, SweepSpec, SweepSpecError
@@ -270,15 +279,17 @@ def _set(container: Any, path: list[str | int], value: Any) -> None:
     container[path[-1]] = value
 
 
-def _effects(value: Any) -> tuple[str, ...]:
+def _effects(value: Any, target: str) -> tuple[str, ...]:
     if isinstance(value, str):
         return tuple(e.strip() for e in value.replace(",", " ").split() if e.strip())
-    return tuple(str(e) for e in value)
+    if isinstance(value, list | tuple) and all(isinstance(e, str) for e in value):
+        return tuple(value)
+    raise SceneError(target, [f"{value!r}: effects are a list of effect names"])
 
 
 def _apply_unit(unit: UnitSpec, parts: list[str], value: Any, target: str) -> UnitSpec:
     if parts[1] == "effects":
-        return replace(unit, effects=_effects(value))
+        return replace(unit, effects=_effects(value, target))
     params = copy.deepcopy(unit.parameters)
     path, problem = _parameter_path(params, ".".join(parts[2:]), f"axis {target!r}")
     if problem:
@@ -330,12 +341,22 @@ def apply_case(scene: Scene, values: Mapping[str, Any]) -> Scene:
         elif root == "events":
             i = int(parts[0])
             if parts[1] == "time":
+                if not valid_time(value):
+                    raise SceneError(target, [f"{value!r} is no time of an event (s, 0 to 1e12)"])
                 events[i] = replace(events[i], time=float(value))
             else:
+                if not is_scalar(value):
+                    raise SceneError(
+                        target, [f"{value!r}: an event sets a number, true/false or text"]
+                    )
                 ref = VarRef.parse(".".join(parts[2:]))
                 events[i] = replace(events[i], values={**events[i].values, ref: value})
+        elif parts[0] == "order":
+            if not isinstance(value, list | tuple) or not all(isinstance(u, str) for u in value):
+                raise SceneError(target, [f"{value!r}: run.order is a list of unit names"])
+            run["order"] = tuple(value)
         else:
-            run[parts[0]] = tuple(value) if parts[0] == "order" else value
+            run[parts[0]] = value
     changed = replace(
         scene,
         units=units,

@@ -562,6 +562,12 @@ def _distribution(
         problems.append(f"{where}: 'low' must be below 'high', got {a!r} and {b!r}")
     elif name == "log_uniform" and a <= 0:
         problems.append(f"{where}: a log_uniform distribution needs 'low' > 0, got {a!r}")
+    spread = (a - 8.0 * b, a + 8.0 * b) if name == "normal" else (a, b - a)
+    if not all(math.isfinite(v) and abs(v) < 1e300 for v in spread):
+        problems.append(
+            f"{where}: the {name} distribution's samples would overflow "
+            f"({' and '.join(keys)} {a!r}, {b!r})"
+        )
     return str(name), (a, b)
 
 

@@ -203,6 +203,7 @@ class _Problems:
         positive: bool = False,
         nonnegative: bool = False,
         at_most: float | None = None,
+        finite: bool = True,
     ) -> float:
         value = data.get(key, default)
         if value is None:
@@ -218,6 +219,8 @@ class _Problems:
             return math.nan
         if math.isnan(value):
             self.add(where, f"'{key}' must be a number, got NaN")
+        elif finite and math.isinf(value):
+            self.add(where, f"'{key}' must be finite, got {value:g}")
         elif positive and not value > 0:
             self.add(where, f"'{key}' must be > 0, got {value:g}")
         elif nonnegative and value < 0:
@@ -300,7 +303,7 @@ def _parse_rope(data: Mapping, p: _Problems) -> RopeProperties:
         fill = p.number(data, "fill_factor", where, 1.0, positive=True, at_most=1.0)
         viscosity = p.number(data, "viscosity", where, 0.0, nonnegative=True)
         ea, damping = area * fill * modulus, area * fill * viscosity
-    breaking = p.number(data, "breaking_load", where, math.inf, positive=True)
+    breaking = p.number(data, "breaking_load", where, math.inf, positive=True, finite=False)
     linear_mass = p.number(data, "linear_mass", where, 0.0, nonnegative=True)
     return RopeProperties(ea, damping, breaking, linear_mass)
 
