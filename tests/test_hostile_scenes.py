@@ -555,3 +555,10 @@ def test_study_options_out_of_range_are_refused_by_the_command_line(args, capsys
         cli(["study", "effects", "--quick", *args, "scissor_jack"])
     assert caught.value.code == 2
     assert "expected" in capsys.readouterr().err
+
+
+def test_an_infinite_block_mass_is_named_by_check(tmp_path, fmu_dir):
+    """It failed the run with "FloatingPointError: rope span 0 has no unstretched rope left"."""
+    path = variant(tmp_path, DRAWWORKS, replace={"mass = 120000.0": "mass = inf"})
+    problems = problems_of(path, fmu_dir)
+    assert any("'mass' must be finite" in p for p in problems), problems

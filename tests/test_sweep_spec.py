@@ -236,3 +236,36 @@ def test_check_targets_names_what_the_scene_lacks():
     ):
         assert expected in text, expected
     assert len(problems) == 9
+
+
+@pytest.mark.parametrize(
+    ("target", "value", "words"),
+    [
+        ("events.0.time", -5.0, "no time of an event"),
+        ("events.0.time", True, "no time of an event"),
+        ("events.0.time", "soon", "no time of an event"),
+        ("events.0.set.a.force", {"x": 1}, "an event sets a number"),
+        ("units.a.effects", [True, False], "list of effect names"),
+        ("run.order", "ab", "list of unit names"),
+    ],
+)
+def test_a_case_value_the_scene_would_refuse_is_refused(target, value, words):
+    """Such values were taken as they came: -5 s, True as 1.0 s, "ab" as the units a and b."""
+    with pytest.raises(SceneError, match=words):
+        apply_case(scene(), {target: value})
+
+
+def test_a_distribution_whose_samples_overflow_is_refused():
+    data = spec_data()
+    data["axes"] = [
+        {
+            "target": "units.a.parameters.mass",
+            "distribution": "normal",
+            "mean": 1e308,
+            "std": 1e308,
+            "integer": True,
+        }
+    ]
+    data["sampling"] = {"samples": 3}
+    with pytest.raises(SweepSpecError, match="would overflow"):
+        parse_sweep_spec(data)
