@@ -29,7 +29,10 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -387,6 +390,32 @@ EXIT_INTERRUPTED = 130
 """Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
 
 
+class _CtrlC:
+    """Remembers a Ctrl-C for the whole command, also one that a unit's code turned into an
+    FMI error on its way out (an FMU being instantiated), so the command exits 130."""
+
+    def __init__(self) -> None:
+        self.pressed = False
+        self._previous = None
+
+    def _handle(self, signum: int, frame: object) -> None:
+        self.pressed = True
+        raise KeyboardInterrupt
+
+    def __enter__(self) -> _CtrlC:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._previous is None:
+            return
+        # After a Ctrl-C the command is over: the same Ctrl-C may still be delivered again
+        # (the FMU binary hands an interrupt a unit caught back to the host), and must not
+        # end the exiting process with a signal instead of its exit status.
+        signal.signal(signal.SIGINT, signal.SIG_IGN if self.pressed else self._previous)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``wire-fmu`` command."""
     args = _parser().parse_args(argv)
@@ -394,15 +423,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.DEBUG if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    with _CtrlC() as ctrl_c:
+        code = _command(args, ctrl_c)
+    if code == EXIT_INTERRUPTED and argv is None:
+        # The command line itself: end now with 130. A Ctrl-C a unit caught is delivered to
+        # this process once more by the FMU binary, and would otherwise end it by SIGINT.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(EXIT_INTERRUPTED)
+    return code
+
+
+def _command(args: argparse.Namespace, ctrl_c: _CtrlC) -> int:
+    """Run the chosen command; every ending is an exit status and a message, no traceback."""
     try:
         return args.func(args)
-    except WireFmuError as err:
-        _print(f"error: {err}")
-        return 1
     except KeyboardInterrupt:
         _print("\ninterrupted")
         return EXIT_INTERRUPTED
+    except WireFmuError as err:
+        if ctrl_c.pressed:
+            _print("\ninterrupted")
+            return EXIT_INTERRUPTED
+        _print(f"error: {err}")
+        return 1
     except Exception as exc:  # noqa: BLE001 - a command ends with a message, never a traceback
+        if ctrl_c.pressed:
+            _print("\ninterrupted")
+            return EXIT_INTERRUPTED
         logger.debug("unexpected failure", exc_info=True)
         _print(
             f"error: unexpected {type(exc).__name__}: {exc}"
