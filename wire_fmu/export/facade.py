@@ -101,7 +101,7 @@ class Phase(StrEnum):
 
 
 def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
-    """Decorate a method that pythonfmu calls: log why it fails, then re-raise.
+    """Decorate a method the FMU binary calls: log why it fails, then re-raise.
 
     Parameters
     ----------
@@ -140,7 +140,7 @@ class CoreFacade(Fmi2Slave):
     Parameters
     ----------
     **kwargs
-        As passed by pythonfmu: ``instance_name``, ``resources`` (the FMU's
+        As passed by the FMU binary: ``instance_name``, ``resources`` (the FMU's
         resources folder; ``None`` when the facade is used directly from
         Python, which skips the core-version guard), ``visible``, ``logger``.
 
@@ -186,7 +186,7 @@ class CoreFacade(Fmi2Slave):
             check_core(self.resources, unit_class.NAME, self.instance_name)
         except WireFmuError as exc:
             # The instance does not exist yet, so its log queue never reaches
-            # the master: pythonfmu logs the exception's repr as fmi2Fatal, and
+            # the master: the FMU binary logs the exception as fmi2Fatal, and
             # the Python logger reaches the master's process.
             logger.error("%s", exc)
             raise
@@ -308,7 +308,7 @@ class CoreFacade(Fmi2Slave):
     def setup_experiment(
         self, start_time: float, stop_time: float | None = None, tolerance: float | None = None
     ) -> None:
-        """Remember the start time (pythonfmu passes only ``start_time``)."""
+        """Remember the start time (before initialisation only; it must be finite)."""
         self._require("fmi2SetupExperiment", Phase.instantiated)
         if not math.isfinite(start_time):
             raise FacadeError(f"start time {start_time!r} s: must be finite")
@@ -420,9 +420,8 @@ class CoreFacade(Fmi2Slave):
 
     @staticmethod
     def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:
-        # pythonfmu calls this on the class, so an exception here could not be
-        # logged for the instance: unreadable bytes become a state that
-        # _set_fmu_state refuses with a logged message.
+        # Unreadable bytes become a state that _set_fmu_state refuses with a
+        # logged message (fmi2SetFMUstate), so deserialising never fails.
         try:
             return json.loads(state.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:

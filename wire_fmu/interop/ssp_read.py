@@ -45,7 +45,6 @@ import json
 import logging
 import math
 import re
-import stat
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -60,6 +59,7 @@ from wire_fmu.master.archive import (
     extract_archive,
     extract_cached,
 )
+from wire_fmu.master.files import UnreadableFileError, read_regular
 from wire_fmu.master.scene import Scene, SceneError, parse_scene
 
 from .plan import TypedValue
@@ -185,21 +185,9 @@ def _parser() -> etree.XMLParser:
 def _read_xml(path: Path, label: str, problems: list[str]) -> etree._Element | None:
     """The root element of the XML file ``path`` (bounded in size), or a problem."""
     try:
-        info = path.stat()
-        if not stat.S_ISREG(info.st_mode):
-            problems.append(f"{label}: not a regular file")
-            return None
-        if info.st_size > MAX_XML_BYTES:
-            problems.append(
-                f"{label}: {info.st_size} bytes, more than the {MAX_XML_BYTES >> 20} MiB "
-                "allowed for an SSP XML file"
-            )
-            return None
-        with path.open("rb") as handle:
-            data = handle.read(MAX_XML_BYTES + 1)
-    except (OSError, ValueError) as err:
-        reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
-        problems.append(f"{label}: cannot be read ({reason})")
+        data = read_regular(path, MAX_XML_BYTES)
+    except UnreadableFileError as err:
+        problems.append(f"{label}: cannot be read ({err})")
         return None
     try:
         return etree.fromstring(data, _parser())

@@ -621,7 +621,7 @@ def _parse_events(data: Any, problems: list[str]) -> tuple[EventSpec, ...]:
             ref = VarRef.parse(key)
             if ref is None:
                 problems.append(f"{where}: {key!r} is not 'unit.input'")
-            elif not _scalar(value):
+            elif not is_scalar(value):
                 problems.append(
                     f"{where}: {key} = {value!r}: must be a finite number, true/false or text"
                 )
@@ -705,11 +705,6 @@ def valid_time(value: Any) -> bool:
 
 
 def is_scalar(value: Any) -> bool:
-    """A finite number, a boolean or text: what one FMI variable can hold."""
-    return _scalar(value)
-
-
-def _scalar(value: Any) -> bool:
     """A finite number, a boolean or text: what one FMI variable can hold."""
     return isinstance(value, bool | str) or _finite(value)
 

@@ -208,9 +208,9 @@ class Slave:
     def terminate(self) -> None:
         """Terminate and free the instance (errors ignored: we are cleaning up).
 
-        The FMU's shared library stays loaded until the process ends: unloading
-        a pythonfmu binary while the interpreter it shares with us still holds
-        objects it created crashes the process at exit.
+        The FMU's shared library stays loaded until the process ends: a Python
+        FMU's code runs in the interpreter it shares with us, which may still
+        hold objects whose code lives in it.
         """
         if self._fmu is None:
             self._remove_unzipdir()
@@ -243,6 +243,9 @@ class Slave:
                 raise UnitFailedError(f"unit {self.name!r} has no variable {name!r}", self.name)
             refs, vals = groups[var.type]
             refs.append(var.valueReference)
+            if type(value) is float and var.type == "Real":  # per step (drivers): the FMU
+                vals.append(value)  # itself refuses a value that is not finite
+                continue
             problem = value_problem(var, value)
             if problem:
                 raise UnitFailedError(
