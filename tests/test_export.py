@@ -136,8 +136,9 @@ def test_registers_one_variable_per_declaration():
     }
     assert facade.modelName == "Oscillator"
     assert facade.description == OscillatorUnit.DESCRIPTION
-    assert len(facade.vars) == len(OscillatorUnit.VARIABLES)
-    pairs = zip(facade.vars.values(), OscillatorUnit.VARIABLES, strict=True)
+    *declared, timing = facade.vars.values()
+    assert (timing.name, timing.causality) == ("physics_seconds", Fmi2Causality.local)
+    pairs = zip(declared, OscillatorUnit.VARIABLES, strict=True)
     for ref, (scalar, var) in enumerate(pairs):
         assert (scalar.name, scalar.value_reference) == (var.name, ref)
         assert isinstance(scalar, kinds[var.type])
@@ -145,6 +146,16 @@ def test_registers_one_variable_per_declaration():
         assert scalar.variability == Fmi2Variability[var.variability.value]
         assert scalar.initial == initial[var.causality.value]
         assert scalar.description == var.description
+
+
+def test_physics_seconds_counts_the_time_spent_in_steps(monkeypatch):
+    facade = initialised(make())
+    timing = vr(facade, "physics_seconds")
+    assert facade.get_real([timing]) == [0.0]
+    clock = iter([10.0, 10.25, 20.0, 20.5])  # two steps: 0.25 s and 0.5 s in advance
+    monkeypatch.setattr("wire_fmu.core.framework.unit.clock.perf_counter", lambda: next(clock))
+    run(facade, 0.0, steps=2)
+    assert facade.get_real([timing]) == [0.75]
 
 
 def test_getters_and_setters_map_onto_unit_values():

@@ -84,7 +84,11 @@ def test_every_registered_unit_builds_validates_and_round_trips_its_state(built,
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
     slave.exitInitializationMode()
+    timing = next(v for v in md.modelVariables if v.name == "physics_seconds")
+    assert (timing.causality, timing.unit) == ("local", "s")
+    assert slave.getReal([timing.valueReference]) == [0.0]
     slave.doStep(0.0, 0.01)
+    assert slave.getReal([timing.valueReference])[0] > 0.0  # the step's physics, timed
     state = slave.getFMUstate()
     saved = slave.getReal(outputs)
     slave.doStep(0.01, 0.01)

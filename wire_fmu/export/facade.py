@@ -23,7 +23,7 @@ What the facade does at each FMI call
     ``unit.initialize(start_time)``.
 ``fmi2DoStep``
     Refuses a step that is not finite and positive or does not start at the
-    unit's time; then ``unit.advance(t, h)``. A step the unit refuses is
+    unit's time; then ``unit.timed_advance(t, h)`` (advance, timed). A step the unit refuses is
     logged (status Discard, with the unit's message) and returns ``False``
     (the binary answers ``fmi2Discard``; the state is that before the step).
 ``fmi2Get/SetFMUstate``
@@ -67,9 +67,11 @@ __all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
 logger = logging.getLogger(__name__)
 
 STATE_FORMAT = "wire_fmu.fmu_state/1"
+"""Tag of the FMU state layout written by :meth:`CoreFacade._get_fmu_state`."""
 STEP_TIME_TOLERANCE = 1e-9
 """Relative tolerance (of max(1 s, t)) between a step's start and the unit's time."""
-"""Tag of the FMU state layout written by :meth:`CoreFacade._get_fmu_state`."""
+PHYSICS_SECONDS = "physics_seconds"
+"""Local variable of every unit: wall-clock time spent in its physics since instantiation, s."""
 
 _SCALAR = {float: Real, int: Integer, bool: Boolean, str: String}
 _CAUSALITY = {
@@ -169,6 +171,7 @@ class CoreFacade(Fmi2Slave):
         self._initial_outputs_stale = True
         for var in unit_class.variables():
             self._register(var)
+        self._register_timing()
 
     # -- construction -----------------------------------------------------------
     @classmethod
@@ -203,6 +206,18 @@ class CoreFacade(Fmi2Slave):
         )
         # nested=False: dotted names are plain keys of unit.values.
         self.register_variable(scalar, nested=False)
+
+    def _register_timing(self) -> None:
+        # the unit base's timing hook, readable by any master (studies time the physics)
+        timing = Real(
+            PHYSICS_SECONDS,
+            causality=Fmi2Causality.local,
+            variability=Fmi2Variability.continuous,
+            initial=Fmi2Initial.calculated,
+            description="wall-clock time spent in the unit's physics since instantiation, s",
+            getter=lambda: self.unit.physics_seconds,
+        )
+        self.register_variable(timing, nested=False)
 
     @property
     def phase(self) -> Phase:
@@ -337,7 +352,7 @@ class CoreFacade(Fmi2Slave):
         """Advance the unit; log and return ``False`` if it refuses the step."""
         self._require("fmi2DoStep", Phase.step)
         self._check_step(current_time, step_size)
-        result = self.unit.advance(current_time, step_size)
+        result = self.unit.timed_advance(current_time, step_size)
         for event in result.events:
             self._report(f"t = {current_time + step_size!r} s: {event}", Fmi2Status.ok)
         if not result.success:

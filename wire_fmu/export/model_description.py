@@ -27,7 +27,8 @@ from collections.abc import Iterable, Mapping
 from xml.etree import ElementTree as ET
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.framework.unit import Causality, Unit, Variable
+from wire_fmu.core.framework.unit import Causality, Unit, Variable, output
+from wire_fmu.export.facade import PHYSICS_SECONDS
 from wire_fmu.export.units import UNITS
 
 __all__ = ["CAPABILITIES", "check_units", "patch_model_description"]
@@ -44,6 +45,8 @@ CAPABILITIES = {
 """``CoSimulation`` attributes every FMU of this project declares."""
 
 _INITIAL = {Causality.parameter: "exact", Causality.output: "calculated"}
+_TIMING_DESCRIPTION = "wall-clock time spent in the unit's physics since instantiation"
+_TIMING_UNIT = output(PHYSICS_SECONDS, "s", _TIMING_DESCRIPTION)  # its unit is defined
 
 
 def check_units(unit_class: type[Unit]) -> list[str]:
@@ -130,15 +133,23 @@ def _model_structure(unit_class: type[Unit], index_of: Mapping[str, int]) -> ET.
 
 
 def _check_variables(root: ET.Element, unit_class: type[Unit]) -> list[ET.Element]:
+    """The nodes of the declared variables (the facade's timing variable follows them)."""
     nodes = list(root.find("ModelVariables"))
     names = [n.get("name") for n in nodes]
-    declared = [v.name for v in unit_class.variables()]
+    declared = [v.name for v in unit_class.variables()] + [PHYSICS_SECONDS]
     if names != declared:
         raise ConfigurationError(
             f"{unit_class.NAME} modelDescription.xml",
             [f"variables {names} do not match the declarations {declared}"],
         )
-    return nodes
+    _patch_timing(nodes[-1])
+    return nodes[:-1]
+
+
+def _patch_timing(node: ET.Element) -> None:
+    node.set("description", _TIMING_DESCRIPTION)
+    node[0].attrib.clear()
+    node[0].set("unit", "s")
 
 
 def _insert_before(root: ET.Element, element: ET.Element, successors: tuple[str, ...]) -> None:
@@ -188,7 +199,8 @@ def patch_model_description(xml: bytes, unit_class: type[Unit], generation_tool:
         for old in root.findall(tag):
             root.remove(old)
     successors = ("TypeDefinitions", "LogCategories", "DefaultExperiment", "ModelVariables")
-    _insert_before(root, _unit_definitions(unit_class.variables()), successors)
+    used = (*unit_class.variables(), _TIMING_UNIT)
+    _insert_before(root, _unit_definitions(used), successors)
     index_of = {v.name: i + 1 for i, v in enumerate(unit_class.variables())}
     root.append(_model_structure(unit_class, index_of))
     ET.indent(root, space="  ")

@@ -23,6 +23,7 @@ Sign convention, stated once for every unit
 from __future__ import annotations
 
 import math
+import time as clock
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -236,6 +237,8 @@ class Unit(ABC):
     def __init__(self, instance_name: str = "unit") -> None:
         self.instance_name = instance_name
         self.values: dict[str, Any] = {v.name: v.start for v in self.VARIABLES}
+        self.physics_seconds = 0.0
+        """Wall-clock time spent in :meth:`advance` since construction, s (the timing hook)."""
 
     # -- declarations -------------------------------------------------------
     @classmethod
@@ -312,6 +315,22 @@ class Unit(ABC):
             self.set_state(saved)
             return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
         return StepResult(True, events=tuple(events))
+
+    def timed_advance(self, time: float, step: float) -> StepResult:
+        """:meth:`advance`, its wall-clock time added to :attr:`physics_seconds` (timing hook).
+
+        Parameters
+        ----------
+        time : float
+            Start of the step, s.
+        step : float
+            Its length, s.
+        """
+        started = clock.perf_counter()
+        try:
+            return self.advance(time, step)
+        finally:
+            self.physics_seconds += clock.perf_counter() - started
 
     def _advance(self, time: float, step: float) -> Sequence[str]:
         """Integrate the model from ``time`` by ``step`` (s); return its events, as text."""
