@@ -34,6 +34,7 @@ import numpy as np
 
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.hybrid import IntegrationError
+from wire_fmu.core.framework.ports import Port
 
 __all__ = [
     "Causality",
@@ -233,6 +234,8 @@ class Unit(ABC):
     NAME: ClassVar[str] = "Unit"
     DESCRIPTION: ClassVar[str] = ""
     VARIABLES: ClassVar[tuple[Variable, ...]] = ()
+    PORTS: ClassVar[tuple[Port, ...]] = ()
+    """The unit's power ports (:mod:`~wire_fmu.core.framework.ports`), over its variables."""
 
     def __init__(self, instance_name: str = "unit") -> None:
         self.instance_name = instance_name
@@ -269,6 +272,13 @@ class Unit(ABC):
                 problems.append(
                     f"{cls.NAME}.{var.name}: depends_on names {unknown}, which are not inputs"
                 )
+        causality = {v.name: v.causality.value for v in cls.VARIABLES}
+        units = {v.name: v.unit for v in cls.VARIABLES if v.type is float}
+        ports = [p.name for p in cls.PORTS]
+        for name in sorted({n for n in ports if ports.count(n) > 1}):
+            problems.append(f"{cls.NAME}: port {name!r} declared twice")
+        for port in cls.PORTS:
+            problems += [f"{cls.NAME}: {p}" for p in port.problems(causality, units)]
         return problems
 
     # -- life cycle ---------------------------------------------------------

@@ -30,6 +30,7 @@ import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, fastest_mode
+from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
@@ -161,6 +162,29 @@ class BlockTrainUnit(Unit):
     NAME = "BlockTrain"
     DESCRIPTION = "Rope reeved over sheaves and anchors (block train), wire_fmu"
     VARIABLES = _variables()
+    PORTS = tuple(
+        Port(
+            f"line_{e}",
+            "rope",
+            PortSide.effort,
+            f"line_{e}.tension",
+            f"line_{e}.payout_rate",
+            f"line_{e}.payout",
+            f"rope line end {e}",
+        )
+        for e in "ab"
+    ) + tuple(
+        Port(
+            f"mover_{e}",
+            "translational",
+            PortSide.effort,
+            f"mover_{e}.force",
+            f"mover_{e}.velocity",
+            f"mover_{e}.position",
+            f"driven body port {e}",
+        )
+        for e in "ab"
+    )
 
     def __init__(self, instance_name: str = "block_train") -> None:
         super().__init__(instance_name)

@@ -97,6 +97,7 @@ import numpy as np
 
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
 from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import OdeView, Unit, input_, output, parameter
 from wire_fmu.core.units.hydraulics.model import (
@@ -328,6 +329,17 @@ class HydraulicsUnit(Unit):
     NAME = "Hydraulics"
     DESCRIPTION = "Hydraulic cylinder with gas accumulator (hydro-pneumatic spring), wire_fmu"
     VARIABLES = _variables()
+    PORTS = (
+        Port(
+            "rod",
+            "translational",
+            PortSide.flow,
+            "rod.force",
+            "rod.velocity",
+            "rod.displacement",
+            "the cylinder rod (position: extension since the start)",
+        ),
+    )
 
     def __init__(self, instance_name: str = "hydraulics") -> None:
         super().__init__(instance_name)

@@ -51,6 +51,7 @@ from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import SolverSettings
+from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     HeldInputsUnit,
@@ -256,6 +257,17 @@ class WinchUnit(HeldInputsUnit):
     NAME = "Winch"
     DESCRIPTION = "Winch (drawworks): drum, band brake, motor, drive train, wire_fmu"
     VARIABLES = _parameters() + _inputs() + _outputs()
+    PORTS = (
+        Port(
+            "rope",
+            "rope",
+            PortSide.flow,
+            "rope.tension",
+            "rope.payout_rate",
+            "rope.payout",
+            "the rope leaving the drum",
+        ),
+    )
 
     def __init__(self, instance_name: str = "winch") -> None:
         super().__init__(instance_name)

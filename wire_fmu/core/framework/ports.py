@@ -1,0 +1,97 @@
+"""Ports: the named places where a unit exchanges power with another.
+
+A port groups the variables of one power bond on one unit: the *effort*
+(force, tension, torque), the *flow* (velocity, payout rate, speed) and
+optionally the *position* the flow integrates to. Across a bond, one unit
+computes the effort from the motion it is given (its port is on the
+``effort`` side: effort an output, flow and position inputs) and the other
+computes the motion from the effort it is given (``flow`` side: the reverse).
+
+A unit declares its ports in ``PORTS``; the FMU carries them in its model
+description (``VendorAnnotations``), so that a scene can bond two ports by
+name, ``"cylinder.rod <-> rope.mover_a"``, and the master derives the three
+connections.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+__all__ = ["PORT_KINDS", "Port", "PortSide"]
+
+PORT_KINDS = {
+    # kind: (effort unit, flow unit, position unit)
+    "translational": ("N", "m/s", "m"),
+    "rope": ("N", "m/s", "m"),
+    "rotational": ("N.m", "rad/s", "rad"),
+}
+"""Kinds of power port and the SI units of their effort, flow and position."""
+
+
+class PortSide(StrEnum):
+    """Which of the bond's two quantities the unit computes at this port."""
+
+    effort = "effort"
+    """The unit outputs the effort and takes the flow (and position) as inputs."""
+    flow = "flow"
+    """The unit outputs the flow (and position) and takes the effort as input."""
+
+
+@dataclass(frozen=True)
+class Port:
+    """One power port of a unit.
+
+    Parameters
+    ----------
+    name : str
+        The port's name, unique in its unit (``"rod"``, ``"line_a"``).
+    kind : str
+        One of :data:`PORT_KINDS`.
+    side : PortSide
+        Which quantity the unit computes here.
+    effort, flow : str
+        Names of the unit's effort and flow variables at the port.
+    position : str or None
+        Name of the position variable the flow integrates to, if any.
+    description : str
+        What the port is, for listings.
+    """
+
+    name: str
+    kind: str
+    side: PortSide
+    effort: str
+    flow: str
+    position: str | None = None
+    description: str = ""
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        """The port's variable names: effort, flow and (if any) position."""
+        return (self.effort, self.flow) + ((self.position,) if self.position else ())
+
+    def problems(self, causality: dict[str, str], units: dict[str, str]) -> list[str]:
+        """What is wrong with the port against its unit's variables (empty when sound).
+
+        Parameters
+        ----------
+        causality : dict of str to str
+            Causality (``"input"``, ``"output"``, ...) of every variable of the unit, by name.
+        units : dict of str to str
+            SI unit of every Real variable of the unit, by name.
+        """
+        if self.kind not in PORT_KINDS:
+            return [f"port {self.name!r}: kind {self.kind!r} is not one of {sorted(PORT_KINDS)}"]
+        gives = "output" if self.side is PortSide.effort else "input"
+        takes = "input" if gives == "output" else "output"
+        wanted = {self.effort: gives, self.flow: takes}
+        if self.position:
+            wanted[self.position] = takes
+        problems = []
+        for (name, want), unit in zip(wanted.items(), PORT_KINDS[self.kind], strict=False):
+            if causality.get(name) != want:
+                problems.append(f"port {self.name!r}: {name!r} must be an {want} of the unit")
+            elif units.get(name) != unit:
+                problems.append(f"port {self.name!r}: {name!r} must be in {unit}")
+        return problems
