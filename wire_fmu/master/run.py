@@ -121,7 +121,7 @@ class Outcome:
 
 def with_run_settings(scene: Scene, **changes) -> Scene:
     """A copy of ``scene`` with some run settings replaced (checked like the file's)."""
-    from .scene import _check_run
+    from .scene.checks import _check_run
 
     settings = replace(scene.run, **{k: v for k, v in changes.items() if v is not None})
     problems: list[str] = []
