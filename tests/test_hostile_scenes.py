@@ -74,7 +74,13 @@ RISER_ROD = (
     '"rod.force" = -1.424e6        # N, 4 x 356 kN at the start: the rod begins in equilibrium'
 )
 CYL = "[units.cylinder.parameters]"
-EFFORT = 'effort = "rope.mover_a.force -> cylinder.rod.force"'
+PORTS = 'ports = "cylinder.rod <-> rope.mover_a"'
+LONG_BOND = (  # the riser's bond written out, with its effort going to an unknown unit
+    'kind = "translational"\n'
+    'effort = "rope.mover_a.force -> piston.rod.force"\n'
+    'flow = "cylinder.rod.velocity -> rope.mover_a.velocity"\n'
+    'position = "cylinder.rod.displacement -> rope.mover_a.position"'
+)
 
 
 # -- parameters of the wrong type: named, with the type they need -----------------------
@@ -229,7 +235,7 @@ def test_an_event_time_that_is_not_a_time_is_named(tmp_path, fmu_dir, time):
 def test_an_unknown_unit_in_a_bond_is_named_as_unknown(tmp_path, fmu_dir):
     path = variant(
         tmp_path,
-        replace={EFFORT: EFFORT.replace("cylinder.rod", "piston.rod")},
+        replace={PORTS: LONG_BOND},
     )
     problems = problems_of(path, fmu_dir)
     only(problems, "bond 'rod' effort", "no unit 'piston'")
@@ -285,7 +291,7 @@ def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
         replace={
             "step = 0.002": "step = -1.0",
             "pretension = 356.0e3": 'pretension = "high"',
-            EFFORT: EFFORT.replace("cylinder.rod", "piston.rod"),
+            PORTS: LONG_BOND,
         },
         sections={CYL: "no_such_parameter = 1.0"},
         append='\n[[events]]\ntime = 1.0\nset = { "rope.break_segment" = "x" }\n',

@@ -13,7 +13,10 @@ and no ``InitialUnknowns``. :func:`patch_model_description` adds:
 * ``ModelStructure/InitialUnknowns``: every output (all have
   ``initial="calculated"``) in index order, depending on the knowns of
   initialisation mode -- parameters (``initial="exact"``) and inputs;
-* ``canGetAndSetFMUstate``/``canSerializeFMUstate`` true.
+* ``canGetAndSetFMUstate``/``canSerializeFMUstate`` true;
+* the unit's power ports as ``VendorAnnotations/Tool[@name="wire_fmu"]/Ports``
+  (:func:`vendor_annotations`), which a scene's bond shorthand reads;
+* the local Real ``physics_seconds`` (the facade's timing variable) with its unit.
 
 Initial unknowns depend on every parameter (the declarations do not say
 which) and on every input, unless the unit class narrows the inputs with an
@@ -27,11 +30,21 @@ from collections.abc import Iterable, Mapping
 from xml.etree import ElementTree as ET
 
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.ports import Port
 from wire_fmu.core.framework.unit import Causality, Unit, Variable, output
 from wire_fmu.export.facade import PHYSICS_SECONDS
 from wire_fmu.export.units import UNITS
 
-__all__ = ["CAPABILITIES", "check_units", "patch_model_description"]
+__all__ = [
+    "CAPABILITIES",
+    "PORTS_TOOL",
+    "check_units",
+    "patch_model_description",
+    "vendor_annotations",
+]
+
+PORTS_TOOL = "wire_fmu"
+"""``Tool`` name of the vendor annotation that declares a unit's ports."""
 
 CAPABILITIES = {
     "needsExecutionTool": "true",  # a Python interpreter with numpy/scipy
@@ -152,6 +165,39 @@ def _patch_timing(node: ET.Element) -> None:
     node[0].set("unit", "s")
 
 
+def vendor_annotations(ports: Iterable[Port]) -> ET.Element:
+    """``VendorAnnotations`` declaring a unit's power ports (read by the master).
+
+    Parameters
+    ----------
+    ports : iterable of Port
+        The unit's ports.
+
+    Returns
+    -------
+    xml.etree.ElementTree.Element
+        ``<VendorAnnotations><Tool name="wire_fmu"><Ports><Port .../>...``, one ``Port``
+        element per port with the attributes ``name``, ``kind``, ``side``, ``effort``,
+        ``flow``, ``description`` and (when the port has one) ``position``.
+    """
+    annotations = ET.Element("VendorAnnotations")
+    tool = ET.SubElement(annotations, "Tool", name=PORTS_TOOL)
+    section = ET.SubElement(tool, "Ports")
+    for port in ports:
+        attrs = {
+            "name": port.name,
+            "kind": port.kind,
+            "side": port.side.value,
+            "effort": port.effort,
+            "flow": port.flow,
+        }
+        if port.position:
+            attrs["position"] = port.position
+        attrs["description"] = port.description
+        ET.SubElement(section, "Port", attrs)
+    return annotations
+
+
 def _insert_before(root: ET.Element, element: ET.Element, successors: tuple[str, ...]) -> None:
     for position, child in enumerate(root):
         if child.tag in successors:
@@ -201,6 +247,10 @@ def patch_model_description(xml: bytes, unit_class: type[Unit], generation_tool:
     successors = ("TypeDefinitions", "LogCategories", "DefaultExperiment", "ModelVariables")
     used = (*unit_class.variables(), _TIMING_UNIT)
     _insert_before(root, _unit_definitions(used), successors)
+    for old in root.findall("VendorAnnotations"):
+        root.remove(old)
+    if unit_class.PORTS:
+        _insert_before(root, vendor_annotations(unit_class.PORTS), ("ModelVariables",))
     index_of = {v.name: i + 1 for i, v in enumerate(unit_class.variables())}
     root.append(_model_structure(unit_class, index_of))
     ET.indent(root, space="  ")

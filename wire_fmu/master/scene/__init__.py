@@ -40,6 +40,10 @@ Format::
     flow = "cylinder.rod.velocity -> rope.mover_a.velocity"
     position = "cylinder.rod.position -> rope.mover_a.position"
 
+    [[bonds]]                 # the same, as the two ports it joins (links and kind from the
+    name = "rod"              # ports the FMUs declare; see wire_fmu.master.scene.bonds)
+    ports = "cylinder.rod <-> rope.mover_a"
+
     [[connections]]           # plain signals
     from = "a.x"
     to = "b.y"

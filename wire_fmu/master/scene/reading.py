@@ -8,10 +8,10 @@ from pathlib import Path
 from typing import Any
 
 from ..files import UnreadableFileError, read_regular
+from .bonds import PortsOf, parse_bonds
 from .checks import is_plain_name, unknown_unit_problems
-from .data import Scene, SceneError
+from .data import Scene, SceneError, UnitSpec
 from .sections import (
-    _parse_bonds,
     _parse_connections,
     _parse_drivers,
     _parse_events,
@@ -100,7 +100,8 @@ def read_scene_data(
         problems.append(f"'description' must be text, got {type(description).__name__}")
         description = ""
     units = _parse_units(data.get("units", {}), problems)
-    bonds = _parse_bonds(data.get("bonds", []), problems, set(units))
+    ports_of = _port_reader(units, Path(base_dir))
+    bonds = parse_bonds(data.get("bonds", []), problems, set(units), ports_of)
     connections = _parse_connections(data.get("connections", []), problems)
     drivers = _parse_drivers(data.get("drivers", []), problems)
     events = _parse_events(data.get("events", []), problems)
@@ -133,6 +134,20 @@ def read_scene_data(
         if name not in units
     ]
     return scene, problems
+
+
+def _port_reader(units: Mapping[str, UnitSpec], base_dir: Path) -> PortsOf:
+    """Reads (once per unit) the ports a unit's FMU declares, for bonds written as ports."""
+    read: dict[str, tuple] = {}
+
+    def ports_of(unit: str) -> tuple:
+        from ..ports import unit_ports  # opens (and builds) FMUs: only when a bond needs it
+
+        if unit not in read:
+            read[unit] = unit_ports(units[unit].fmu, base_dir)
+        return read[unit]
+
+    return ports_of
 
 
 def _scene_name(name: Any, problems: list[str]) -> str:

@@ -10,9 +10,7 @@ from typing import Any
 
 from .checks import MAX_TIME, _check_run, _finite, is_scalar
 from .data import (
-    BOND_KINDS,
     EXTRAPOLATIONS,
-    Bond,
     Connection,
     DriverSpec,
     EventSpec,
@@ -97,50 +95,6 @@ def _parse_link(text: Any, where: str, problems: list[str]) -> tuple[VarRef, Var
         problems.append(f"{where}: both sides must be 'unit.variable', got {text!r}")
         return None
     return source, target
-
-
-def _parse_bonds(data: Any, problems: list[str], units: set[str]) -> tuple[Bond, ...]:
-    bonds = []
-    names: set[str] = set()
-    for i, spec in enumerate(_as_list(data, "bonds", problems)):
-        if not isinstance(spec, Mapping):
-            problems.append(f"bond {i}: must be a table")
-            continue
-        name = _text(spec.get("name", f"bond{i}"), f"bond {i}", "name", problems, f"bond{i}")
-        where = f"bond {name!r}"
-        if name in names:
-            problems.append(f"{where}: defined twice")
-        names.add(name)
-        kind = spec.get("kind")
-        if kind not in BOND_KINDS:
-            problems.append(f"{where}: 'kind' must be one of {sorted(BOND_KINDS)}, got {kind!r}")
-        extrapolation = spec.get("extrapolation")
-        if extrapolation is not None and extrapolation not in EXTRAPOLATIONS:
-            problems.append(f"{where}: 'extrapolation' must be one of {EXTRAPOLATIONS}")
-        links = {}
-        for role in ("effort", "flow", "position"):
-            if role not in spec:
-                if role != "position":
-                    problems.append(f"{where}: '{role}' is required")
-                continue
-            link = _parse_link(spec[role], f"{where} {role}", problems)
-            if link:
-                links[role] = Connection(*link, role=role, bond=name, extrapolation=extrapolation)
-        unknown = set(spec) - {"name", "kind", "effort", "flow", "position", "extrapolation"}
-        if unknown:
-            problems.append(f"{where}: unknown keys {sorted(unknown)}")
-        if "effort" in links and "flow" in links:
-            e, f = links["effort"], links["flow"]
-            named = {e.source.unit, e.target.unit, f.source.unit, f.target.unit}
-            crossed = e.source.unit != f.target.unit or e.target.unit != f.source.unit
-            if named <= units and crossed:
-                problems.append(
-                    f"{where}: the effort must go from the unit the flow goes to "
-                    f"(effort {e.source.unit} -> {e.target.unit}, flow "
-                    f"{f.source.unit} -> {f.target.unit})"
-                )
-            bonds.append(Bond(name, str(kind), e, f, links.get("position")))
-    return tuple(bonds)
 
 
 def _parse_connections(data: Any, problems: list[str]) -> tuple[Connection, ...]:

@@ -1,0 +1,227 @@
+"""Bonds written as two ports: ``"cylinder.rod <-> rope.mover_a"``.
+
+Our FMUs declare their power ports in the model description, as
+``VendorAnnotations/Tool[@name="wire_fmu"]/Ports/Port`` elements (written by
+:mod:`wire_fmu.export.model_description`): a port's kind, which side of the
+bond the unit computes (``effort``: it outputs the effort and takes the flow
+and position; ``flow``: the reverse) and the names of its effort, flow and
+position variables. A scene bond written as two ports is turned here into
+the three links of the long form: the effort from the effort side to the
+flow side, the flow and (when both ports have one) the position back.
+
+The declarations are read from the FMU file itself, so any FMU that carries
+them can be bonded by port; for others the long form is the way.
+"""
+
+from __future__ import annotations
+
+import re
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from wire_fmu.master.archive import check_member_size
+from wire_fmu.master.catalog import DEFAULT_FMU_DIR, resolve_fmu
+
+__all__ = [
+    "MAX_MODEL_DESCRIPTION_BYTES",
+    "PORT_BOND_PATTERN",
+    "PortDeclaration",
+    "PortLinks",
+    "parse_port_pair",
+    "port_links",
+    "read_ports",
+    "unit_ports",
+]
+
+PORTS_TOOL = "wire_fmu"
+"""``Tool`` name of the vendor annotation that declares ports."""
+MAX_MODEL_DESCRIPTION_BYTES = 64 * 2**20
+"""The largest ``modelDescription.xml`` read for its ports."""
+PORT_BOND_PATTERN = re.compile(
+    r"^\s*(?P<a_unit>[A-Za-z_]\w*)\.(?P<a_port>[A-Za-z_]\w*)\s*<->"
+    r"\s*(?P<b_unit>[A-Za-z_]\w*)\.(?P<b_port>[A-Za-z_]\w*)\s*$"
+)
+"""``unit.port <-> unit.port``, unit and port names being identifiers."""
+_SIDES = ("effort", "flow")
+
+
+@dataclass(frozen=True)
+class PortDeclaration:
+    """A port as an FMU declares it (the attributes of one ``Port`` element).
+
+    Parameters
+    ----------
+    name, kind, side : str
+        The port's name, its kind (``translational``, ``rope``, ``rotational``) and the side
+        the unit computes (``effort`` or ``flow``).
+    effort, flow : str
+        Names of the unit's effort and flow variables at the port.
+    position : str or None
+        Name of its position variable, if it has one.
+    description : str
+        What the port is.
+    """
+
+    name: str
+    kind: str
+    side: str
+    effort: str
+    flow: str
+    position: str | None = None
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class PortLinks:
+    """The long form of a port bond: links as ``("unit.variable", "unit.variable")`` pairs.
+
+    Parameters
+    ----------
+    kind : str
+        The bond's kind (that of both ports).
+    effort, flow : tuple of str
+        Source and target of the effort link (effort side to flow side) and of the flow link
+        (back).
+    position : tuple of str or None
+        Source and target of the position link, when both ports have a position.
+    """
+
+    kind: str
+    effort: tuple[str, str]
+    flow: tuple[str, str]
+    position: tuple[str, str] | None
+
+
+def parse_port_pair(text: object) -> tuple[tuple[str, str], tuple[str, str]] | None:
+    """``((unit, port), (unit, port))`` of ``"unit.port <-> unit.port"``, else None.
+
+    Parameters
+    ----------
+    text : object
+        What the scene wrote.
+    """
+    match = PORT_BOND_PATTERN.match(text) if isinstance(text, str) else None
+    if match is None:
+        return None
+    return (match["a_unit"], match["a_port"]), (match["b_unit"], match["b_port"])
+
+
+def read_ports(path: Path) -> dict[str, PortDeclaration]:
+    """The ports an FMU file declares, by name (empty when it declares none).
+
+    Parameters
+    ----------
+    path : Path
+        The FMU file.
+
+    Raises
+    ------
+    ValueError
+        If the FMU cannot be read or its port declarations are malformed (saying why).
+    """
+    too_big = check_member_size(path, "modelDescription.xml", MAX_MODEL_DESCRIPTION_BYTES)
+    if too_big:
+        raise ValueError(too_big)
+    try:
+        with zipfile.ZipFile(path) as archive:
+            root = ET.fromstring(archive.read("modelDescription.xml"))
+    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as exc:
+        raise ValueError(f"cannot read the model description of {path}: {exc}") from exc
+    ports: dict[str, PortDeclaration] = {}
+    for element in root.findall(f"VendorAnnotations/Tool[@name='{PORTS_TOOL}']/Ports/Port"):
+        port = _declaration(element.attrib)
+        if port.name in ports:
+            raise ValueError(f"port {port.name!r} is declared twice")
+        ports[port.name] = port
+    return ports
+
+
+def _declaration(attrs: dict[str, str]) -> PortDeclaration:
+    missing = [k for k in ("name", "kind", "side", "effort", "flow") if not attrs.get(k)]
+    if missing:
+        raise ValueError(f"a port declaration lacks {missing}: {attrs}")
+    if attrs["side"] not in _SIDES:
+        raise ValueError(f"port {attrs['name']!r}: side {attrs['side']!r} is not one of {_SIDES}")
+    return PortDeclaration(
+        attrs["name"],
+        attrs["kind"],
+        attrs["side"],
+        attrs["effort"],
+        attrs["flow"],
+        attrs.get("position") or None,
+        attrs.get("description", ""),
+    )
+
+
+def unit_ports(
+    fmu: str, base_dir: Path, fmu_dir: Path = DEFAULT_FMU_DIR
+) -> tuple[dict[str, PortDeclaration] | None, str | None]:
+    """The ports of the FMU a scene's unit names: ``(ports, None)`` or ``(None, problem)``.
+
+    Parameters
+    ----------
+    fmu : str
+        The unit's ``fmu`` entry (one of ours, built if needed, or a path to an FMU file).
+    base_dir : Path
+        Folder relative FMU paths are taken from (the scene's).
+    fmu_dir : Path
+        Where our FMUs are built.
+    """
+    path, problem = resolve_fmu(fmu, base_dir, fmu_dir)
+    if problem:
+        return None, problem
+    try:
+        return read_ports(path), None
+    except ValueError as exc:
+        return None, str(exc)
+
+
+def port_links(
+    a: tuple[str, PortDeclaration], b: tuple[str, PortDeclaration]
+) -> tuple[PortLinks | None, list[str]]:
+    """The links of a bond between two ports, or the problems that prevent it.
+
+    Parameters
+    ----------
+    a, b : tuple of (str, PortDeclaration)
+        Each port's unit name and declaration, in the order the scene wrote them.
+
+    Returns
+    -------
+    PortLinks or None
+        The long form (None when there are problems).
+    list of str
+        Why the two ports cannot be bonded: different kinds, not one effort side and one
+        flow side, or a position the effort side takes and the flow side does not give.
+    """
+    (a_unit, a_port), (b_unit, b_port) = a, b
+    named = f"{a_unit}.{a_port.name} ({a_port.kind}, {a_port.side} side) and "
+    named += f"{b_unit}.{b_port.name} ({b_port.kind}, {b_port.side} side)"
+    problems = []
+    if a_port.kind != b_port.kind:
+        problems.append(f"ports {named} are of different kinds")
+    if a_port.side == b_port.side:
+        problems.append(
+            f"ports {named} both compute the {a_port.side}: a bond joins an effort side "
+            "to a flow side"
+        )
+    if problems:
+        return None, problems
+    (e_unit, e_port), (f_unit, f_port) = (a, b) if a_port.side == "effort" else (b, a)
+    if e_port.position and not f_port.position:
+        return None, [
+            f"port {e_unit}.{e_port.name} takes a position ({e_port.position}) that port "
+            f"{f_unit}.{f_port.name} does not give: write the bond's links out (effort, flow, "
+            "position) with the position from another output"
+        ]
+    position = None
+    if e_port.position:
+        position = (f"{f_unit}.{f_port.position}", f"{e_unit}.{e_port.position}")
+    return PortLinks(
+        a_port.kind,
+        (f"{e_unit}.{e_port.effort}", f"{f_unit}.{f_port.effort}"),
+        (f"{f_unit}.{f_port.flow}", f"{e_unit}.{e_port.flow}"),
+        position,
+    ), []
