@@ -17,7 +17,8 @@ import pytest
 from wire_fmu.core.components.sheave_geometry import Circle, PathNode, path_geometry
 from wire_fmu.core.errors import ConfigurationError, GeometryError
 from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
-from wire_fmu.tools.draw import draw_reeving, reeving_drawing
+from wire_fmu.tools.draw import draw_reeving
+from wire_fmu.tools.draw_geometry import reeving_drawing
 
 from .test_block_train_fmu import tensioner_like
 

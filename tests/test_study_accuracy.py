@@ -18,22 +18,12 @@ import numpy as np
 import pytest
 
 from wire_fmu.master.scene import SceneError, VarRef, load_scene, parse_scene
-from wire_fmu.study.accuracy import (
-    RunRow,
-    SolverChoice,
-    StudyError,
-    accuracy_markdown,
-    equal_error,
-    observed_orders,
-    output_error,
-    reference_run,
-    run_accuracy_study,
-    scene_solver,
-    study_scene,
-    study_settings,
-    theoretical_order,
-    with_stop_time,
-)
+from wire_fmu.study.accuracy import reference_run, run_accuracy_study
+from wire_fmu.study.accuracy_report import accuracy_markdown
+from wire_fmu.study.measures import RunRow, output_error
+from wire_fmu.study.orders import equal_error, observed_orders, theoretical_order
+from wire_fmu.study.plan import StudyError, study_scene, study_settings, with_stop_time
+from wire_fmu.study.solvers import SolverChoice, scene_solver
 
 from .block_train_helpers import (
     FALL_EA,

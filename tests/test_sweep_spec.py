@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 from wire_fmu.master.scene import SceneError, VarRef, parse_scene
+from wire_fmu.sweep.axes import Axis, Sampling
 from wire_fmu.sweep.cases import apply_case, case_id, check_targets, expand
-from wire_fmu.sweep.spec import Axis, Figure, Sampling, SweepSpecError, parse_sweep_spec
+from wire_fmu.sweep.figures import Figure
+from wire_fmu.sweep.spec import SweepSpecError, parse_sweep_spec
 
 
 def spec_data(**more):

@@ -31,32 +31,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import TextIO
+from typing import Any
 
 from wire_fmu.core.framework.effects import EffectCatalogue
-from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 from wire_fmu.master.run import with_run_settings
 from wire_fmu.master.scene import Scene
 from wire_fmu.master.validate import validate_scene
 from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
-from .accuracy import (
-    PhysicsTimer,
-    StudyError,
-    StudyProgress,
-    StudySettings,
-    TimedRun,
-    core_classes,
-    dumps,
-    fastest_run,
-    load_study_scene,
-    one_line,
-    output_error,
-    pinned,
-    study_settings,
-    with_stop_time,
-    write_csv,
-)
+from .measures import one_line, output_error
+from .plan import StudyError, StudyOptions, StudySettings
+from .tables import dumps, write_csv
+from .timing import PhysicsTimer, StudyProgress, TimedRun, core_classes, fastest_run, pinned
 
 __all__ = [
     "EFFECT_CATALOGUES",
@@ -251,18 +237,7 @@ def _effect_row(
     )
 
 
-def run_effects_study(
-    scene: Scene | str | Path,
-    output_dir: Path,
-    *,
-    quick: bool = False,
-    settings: StudySettings | None = None,
-    repeats: int | None = None,
-    stop_time: float | None = None,
-    fmu_dir: Path = DEFAULT_FMU_DIR,
-    progress: bool = True,
-    stream: TextIO | None = None,
-) -> EffectsStudy:
+def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: Any) -> EffectsStudy:
     """Run the effects study of ``scene`` and write its files into ``output_dir``.
 
     Parameters
@@ -271,15 +246,13 @@ def run_effects_study(
         A parsed scene, a shipped scene's name or a scene file.
     output_dir : Path
         Folder for ``effects.csv``, ``effects.md`` and ``effects.png``.
-    quick : bool
-        Short stop time and one run per case (see
-        :func:`~wire_fmu.study.accuracy.study_settings`).
-    settings : StudySettings, optional
-        Key outputs and stop time of one's own.
-    repeats : int, optional
-        Runs per case, the fastest counts (default 1 quick, 3 full).
-    stop_time : float, optional
-        Simulated seconds per run instead of the study's.
+    **options
+        How the study runs, the fields of
+        :class:`~wire_fmu.study.plan.StudyOptions`: ``quick`` (short stop
+        time and one run per case), ``settings`` (key outputs and stop time
+        of one's own), ``repeats`` (runs per case, the fastest counts;
+        default 1 quick, 3 full), ``stop_time``, ``fmu_dir``, ``progress``,
+        ``stream``.
 
     Raises
     ------
@@ -287,12 +260,12 @@ def run_effects_study(
         If the run with every effect does not finish.
     """
     started = time.perf_counter()
-    scene = load_study_scene(scene)
-    settings = with_stop_time(settings or study_settings(scene, quick=quick), stop_time)
-    repeats = repeats or (QUICK_REPEATS if settings.quick else FULL_REPEATS)
+    opts = StudyOptions(**options)
+    scene, settings = opts.prepare(scene)
+    repeats = opts.repeats or (QUICK_REPEATS if settings.quick else FULL_REPEATS)
     base = effects_scene(scene, settings)
     cases = effect_cases(base)
-    report = StudyProgress(len(cases) + 1, stream, progress)
+    report = StudyProgress(len(cases) + 1, opts.stream, opts.progress)
     report.note(
         f"effects of {scene.name!r}: {len(cases)} effects, {repeats} run(s) each of "
         f"{base.run.stop_time:g} s at H = {base.run.step:g} s"
@@ -303,7 +276,7 @@ def run_effects_study(
         tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp,
         PhysicsTimer(core_classes(base)) as timer,
     ):
-        structure = pinned(validate_scene(base, fmu_dir), Path(tmp))
+        structure = pinned(validate_scene(base, opts.fmu_dir), Path(tmp))
         baseline, spread = fastest_run(base, structure, Path(tmp) / "run", timer, repeats)
         report.advance(
             f"all effects: {baseline.status}, {baseline.timing.per_simulated_second:.3g} s/s"

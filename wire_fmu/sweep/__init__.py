@@ -9,10 +9,14 @@ Modules
 -------
 :mod:`~wire_fmu.sweep.spec`
     the SWEEP_SPEC file: axes (grid, random sample), key figures.
+:mod:`~wire_fmu.sweep.axes`, :mod:`~wire_fmu.sweep.figures`
+    a spec's axes and sampling, its key figures, and their parsing.
 :mod:`~wire_fmu.sweep.cases`
     expanding a spec into cases with stable ids, applying one to a scene.
 :mod:`~wire_fmu.sweep.runner`
     running the cases on dask.distributed (or serially), resuming.
+:mod:`~wire_fmu.sweep.worker`, :mod:`~wire_fmu.sweep.cluster`
+    what a worker runs for one case; the Dask client and its workers.
 :mod:`~wire_fmu.sweep.results`
     the output folder: Parquet records and summary, time series, plots.
 

@@ -35,7 +35,8 @@ from wire_fmu.master.scene import (
 )
 from wire_fmu.master.validate import Structure
 
-from .spec import Figure, SweepSpec, SweepSpecError
+from .figures import Figure
+from .spec import SweepSpec, SweepSpecError
 
 __all__ = ["Case", "case_id", "expand", "check_targets", "apply_case", "with_figures_recorded"]
 

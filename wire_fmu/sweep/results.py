@@ -44,8 +44,9 @@ import pyarrow.parquet as pq
 
 from wire_fmu.master.plots import read_results
 
+from .axes import Axis
 from .cases import Case
-from .spec import Axis, SweepError, SweepSpec
+from .spec import SweepError, SweepSpec
 
 __all__ = [
     "CaseOutcome",

@@ -34,6 +34,9 @@ Nothing is lost:
 * an interrupted sweep keeps every finished case; the next invocation with
   the same output folder runs only the cases without a record (and the
   ``lost`` ones; with ``rerun_failed`` also ``failed`` and ``stopped``).
+
+Modules: :mod:`~wire_fmu.sweep.worker` (what a worker runs),
+:mod:`~wire_fmu.sweep.cluster` (Dask), this one (the sweep).
 """
 
 from __future__ import annotations
@@ -43,14 +46,10 @@ import dataclasses
 import hashlib
 import json
 import logging
-import os
 import sys
-import tempfile
 import time
 import zipfile
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import CancelledError
-from contextlib import contextmanager
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
@@ -60,163 +59,21 @@ from wire_fmu._fingerprint import fingerprint, package_dir
 from wire_fmu.core.errors import WireFmuError
 from wire_fmu.export.guard import BUILD_INFO_FILE
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
-from wire_fmu.master.run import find_scene, run_scene
+from wire_fmu.master.run import find_scene
 from wire_fmu.master.scene import Scene, load_scene
-from wire_fmu.master.simulation import SimulationStoppedError
-from wire_fmu.master.slave import StepRefusedError, UnitFailedError
 from wire_fmu.master.validate import Structure, check_structure, resolve_units
 
 from .cases import Case, apply_case, check_targets, expand, with_figures_recorded
+from .cluster import _check_workers, _client, _run_on_dask
 from .results import DONE_STATUSES, CaseOutcome, ResultStore, plot_summary
-from .spec import Figure, SweepError, SweepSpec, SweepSpecError, load_sweep_spec
+from .spec import SweepSpec, SweepSpecError, load_sweep_spec
+from .worker import CaseTask, _describe, _execute_here
 
-__all__ = ["run_sweep", "SweepResult", "CaseTask", "execute_case", "scene_key"]
+__all__ = ["run_sweep", "SweepResult", "ProgressWriter", "scene_key"]
 
 logger = logging.getLogger(__name__)
 
-CASE_ERRORS = (WireFmuError, SimulationStoppedError, UnitFailedError, StepRefusedError)
-"""Errors that belong to a case (its values, its scene): recorded, never retried."""
 CaseCallback = Callable[[dict[str, Any]], None]
-
-
-# -- what a worker runs ------------------------------------------------------------------------
-@dataclass(frozen=True)
-class CaseTask:
-    """One case, ready to run anywhere.
-
-    Attributes
-    ----------
-    case : Case
-        Its id and values.
-    scene : Scene
-        The scene with the case applied; each unit's ``fmu`` is the path of
-        the FMU file on the client.
-    figures : tuple of Figure
-        Key figures to compute from the recorded time series.
-    """
-
-    case: Case
-    scene: Scene
-    figures: tuple[Figure, ...]
-
-
-def _describe(exc: BaseException) -> str:
-    return f"{type(exc).__name__}: {exc}"
-
-
-def _folder_files(folder: Path) -> dict[str, bytes]:
-    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
-
-
-def _figures(figures: Sequence[Figure], csv_path: Path) -> dict[str, float | None]:
-    from wire_fmu.master.plots import read_results
-
-    if not csv_path.exists():
-        return {f.name: None for f in figures}
-    columns = read_results(csv_path)
-    return {f.name: f.evaluate(columns) for f in figures}
-
-
-def _on_local_fmus(scene: Scene, local: Mapping[str, Path]) -> Scene:
-    units = {
-        name: dataclasses.replace(u, fmu=str(local.get(u.fmu, u.fmu)))
-        for name, u in scene.units.items()
-    }
-    return dataclasses.replace(scene, units=units)
-
-
-def execute_case(
-    task: CaseTask, local_fmus: Mapping[str, Path] | None = None, worker: str = "local"
-) -> CaseOutcome:
-    """Run one case in a temporary folder; its outcome with the folder's files.
-
-    Parameters
-    ----------
-    task : CaseTask
-        The case.
-    local_fmus : mapping, optional
-        Client FMU path -> the same FMU's path here (when they differ).
-    worker : str
-        Who runs it, for the record.
-
-    Returns
-    -------
-    CaseOutcome
-        ``finished``, ``stopped`` (a unit stopped the run) or ``failed``
-        (one of :data:`CASE_ERRORS`); other exceptions propagate.
-    """
-    scene = _on_local_fmus(task.scene, local_fmus or {})
-    cid = task.case.case_id
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix=f"wire_fmu_case_{cid}_") as tmp:
-        folder = Path(tmp)
-        try:
-            outcome = run_scene(scene, folder, plots=False)
-        except CASE_ERRORS as exc:
-            logger.info("case %s failed: %s", cid, exc)
-            return CaseOutcome(
-                cid,
-                "failed",
-                _describe(exc),
-                time.perf_counter() - start,
-                files=_folder_files(folder),
-                worker=worker,
-            )
-        result = outcome.result
-        if result.status == "interrupted":  # Ctrl-C ends the sweep, the case is not done
-            raise KeyboardInterrupt
-        status = result.status if result.status in ("finished", "stopped") else "failed"
-        return CaseOutcome(
-            cid,
-            status,
-            result.message or None if status != "finished" else None,
-            time.perf_counter() - start,
-            result.end_time,
-            _figures(task.figures, outcome.csv_path),
-            _folder_files(folder),
-            worker,
-        )
-
-
-def _execute_here(task: CaseTask) -> CaseOutcome:
-    """Run a case in this process; an unexpected exception is recorded, not raised."""
-    start = time.perf_counter()
-    try:
-        return execute_case(task)
-    except Exception as exc:  # noqa: BLE001 - recorded with its message, the sweep goes on
-        logger.exception("case %s raised", task.case.case_id)
-        return CaseOutcome(
-            task.case.case_id, "failed", _describe(exc), time.perf_counter() - start, worker="local"
-        )
-
-
-def _worker_fmu(directory: Path, digest: str, name: str, blob: bytes) -> Path:
-    """The FMU file in a worker's folder, written once (atomically) per content."""
-    path = directory / digest / name
-    if not path.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{name}.{os.getpid()}.tmp")
-        tmp.write_bytes(blob)
-        os.replace(tmp, path)
-    return path
-
-
-def _dask_case(task: CaseTask, fmus: Mapping[str, tuple[str, bytes]]) -> CaseOutcome:
-    """Task run by a Dask worker: materialise the FMUs, run the case."""
-    from distributed import get_worker
-
-    worker = get_worker()
-    folder = Path(worker.local_directory) / "wire_fmu_fmus"
-    local = {
-        client_path: _worker_fmu(folder, digest, Path(client_path).name, blob)
-        for client_path, (digest, blob) in fmus.items()
-    }
-    return execute_case(task, local, worker.address)
-
-
-def _worker_core() -> tuple[str, str]:
-    """Version and core fingerprint of the ``wire_fmu`` a worker imports."""
-    return wire_fmu.__version__, fingerprint(package_dir())
 
 
 # -- progress ------------------------------------------------------------------------------
@@ -565,165 +422,3 @@ def _execute(
             writer.restart_clock()
         _run_on_dask(client, tasks, sink, sink.written, retries=retries, max_attempts=max_attempts)
     return startup
-
-
-# -- Dask ----------------------------------------------------------------------------------------
-@contextmanager
-def _client(workers: int, scheduler: str | None) -> Iterator[Any]:
-    """A Dask client: to ``scheduler``, or to a new local cluster of ``workers`` processes."""
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        with Client(scheduler) as client:
-            yield client
-        return
-    if workers < 1:
-        raise ValueError(f"workers must be >= 1 for a local cluster (0: serial), got {workers}")
-    with (
-        LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
-        ) as cluster,
-        Client(cluster) as client,
-    ):
-        yield client
-
-
-def _check_workers(client: Any) -> None:
-    """Refuse workers whose wire_fmu differs from this one (the FMUs would refuse them).
-
-    Raises
-    ------
-    SweepError
-        Naming the workers and what they have.
-    """
-    if not client.scheduler_info().get("workers"):
-        logger.warning("the scheduler has no worker yet; waiting for one to join")
-        client.wait_for_workers(1)
-    expected = _worker_core()
-    try:
-        found = client.run(_worker_core)
-    except Exception as exc:  # noqa: BLE001 - any failure here means the workers cannot run us
-        raise SweepError(
-            f"the Dask workers cannot run wire_fmu ({_describe(exc)}); install "
-            f"wire_fmu {expected[0]} on every worker"
-        ) from exc
-    wrong = {addr: core for addr, core in found.items() if tuple(core) != expected}
-    if wrong:
-        lines = ", ".join(f"{a}: {v} core {f[:12]}" for a, (v, f) in wrong.items())
-        raise SweepError(
-            f"workers with another wire_fmu than this client ({expected[0]} core "
-            f"{expected[1][:12]}): {lines}; install the same version on every "
-            "worker (the FMUs are built from this one)"
-        )
-
-
-class _Shipment:
-    """The FMU files of a sweep, scattered to every worker; scattered again if lost."""
-
-    def __init__(self, client: Any, paths: Sequence[str]) -> None:
-        self.client = client
-        self.blobs = {p: Path(p).read_bytes() for p in sorted(set(paths))}
-        self.digests = {p: hashlib.sha256(b).hexdigest()[:16] for p, b in self.blobs.items()}
-        self.futures: dict[str, Any] = {}
-        self.refresh()
-
-    def refresh(self) -> None:
-        """Scatter every file not (or no longer) held by the cluster."""
-        for path, blob in self.blobs.items():
-            if path not in self.futures or self.futures[path].status != "finished":
-                self.futures[path] = self.client.scatter(blob, broadcast=True, hash=False)
-
-    def argument(self) -> dict[str, tuple[str, Any]]:
-        """What a task gets: client path -> (digest, bytes future)."""
-        return {p: (self.digests[p], self.futures[p]) for p in self.blobs}
-
-
-def _lost(task: CaseTask, attempt: int, exc: BaseException) -> CaseOutcome:
-    return CaseOutcome(
-        task.case.case_id,
-        "lost",
-        f"worker lost {attempt} times; last: {_describe(exc)}",
-        worker="",
-        attempts=attempt,
-    )
-
-
-class _DaskRun:
-    """Cases submitted to a Dask cluster, each outcome handed on as it completes."""
-
-    def __init__(
-        self, client: Any, tasks: Sequence[CaseTask], *, retries: int, max_attempts: int
-    ) -> None:
-        self.client = client
-        self.retries = retries
-        self.max_attempts = max_attempts
-        self.shipment = _Shipment(client, [u.fmu for t in tasks for u in t.scene.units.values()])
-        self.pending: dict[str, tuple[CaseTask, int]] = {}
-        self.submitted = 0
-
-    def submit(self, task: CaseTask, attempt: int) -> Any:
-        """Submit one case (``attempt`` counts from 1)."""
-        self.submitted += 1
-        future = self.client.submit(
-            _dask_case,
-            task,
-            self.shipment.argument(),
-            retries=self.retries,
-            pure=False,
-            key=f"wire-fmu-case-{task.case.case_id}-{attempt}-{self.submitted}",
-        )
-        self.pending[future.key] = (task, attempt)
-        return future
-
-    def run(self, tasks: Sequence[CaseTask], sink: Callable[[CaseOutcome], None]) -> None:
-        """Submit ``tasks``; outcomes go to ``sink`` in the order they complete."""
-        from distributed import as_completed
-
-        queue = as_completed([self.submit(t, 1) for t in tasks])
-        for future in queue:
-            task, attempt = self.pending.pop(future.key)
-            outcome = self.collect(future, task, attempt)
-            if outcome is None:
-                queue.add(self.submit(task, attempt + 1))
-                continue
-            future.release()
-            sink(outcome)
-
-    def collect(self, future: Any, task: CaseTask, attempt: int) -> CaseOutcome | None:
-        """The outcome of a completed future; None when the case was lost and goes again."""
-        from distributed.scheduler import KilledWorker
-
-        try:
-            outcome = future.result()
-        except (KilledWorker, CancelledError) as exc:
-            if attempt < self.max_attempts:
-                logger.warning(
-                    "case %s: worker lost (%s); submitting it again",
-                    task.case.case_id,
-                    _describe(exc),
-                )
-                self.shipment.refresh()
-                return None
-            return _lost(task, attempt, exc)
-        except Exception as exc:  # noqa: BLE001 - the task's own error, after Dask's retries
-            return CaseOutcome(task.case.case_id, "failed", _describe(exc), attempts=attempt)
-        outcome.attempts = attempt
-        return outcome
-
-
-def _run_on_dask(
-    client: Any,
-    tasks: Sequence[CaseTask],
-    sink: Callable[[CaseOutcome], None],
-    written: set[str],
-    *,
-    retries: int,
-    max_attempts: int,
-) -> None:
-    """Run ``tasks`` on the cluster; then once more any that left no record (never expected)."""
-    run = _DaskRun(client, tasks, retries=retries, max_attempts=max_attempts)
-    run.run(tasks, sink)
-    missing = [t for t in tasks if t.case.case_id not in written]
-    if missing:
-        logger.warning("%d cases left no record; running them again", len(missing))
-        run.run(missing, sink)

@@ -1,0 +1,401 @@
+"""The plan of a study: its settings from a scene's ``[study]`` table, and its grid.
+
+:func:`study_settings` reads the plan (key outputs, stop time, macro
+steps, output grid) a scene asks for, :func:`build_grid` lists the
+configurations of the accuracy study (:mod:`wire_fmu.study.accuracy`),
+:func:`study_scene` and :func:`configured_scene` set a scene up for the
+study and for one configuration; :class:`StudyOptions` are how a study
+runs, whatever it varies (shared with :mod:`wire_fmu.study.effects`).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, TextIO
+
+from wire_fmu.core.errors import WireFmuError
+from wire_fmu.master.catalog import DEFAULT_FMU_DIR
+from wire_fmu.master.run import find_scene, with_run_settings
+from wire_fmu.master.scene import (
+    ALGORITHMS,
+    EXTRAPOLATIONS,
+    Scene,
+    SceneError,
+    VarRef,
+    load_scene,
+)
+from wire_fmu.master.validate import Structure
+
+from .solvers import DEFAULT_SOLVERS, SolverChoice, scene_solver
+
+__all__ = [
+    "StudyError",
+    "STUDY_KEYS",
+    "DEFAULT_STOP_TIME",
+    "QUICK_STOP_TIME",
+    "GRIDS",
+    "StudySettings",
+    "study_settings",
+    "with_stop_time",
+    "Configuration",
+    "family_label",
+    "solver_choices",
+    "build_grid",
+    "study_scene",
+    "configured_scene",
+    "load_study_scene",
+    "StudyOptions",
+]
+
+STUDY_KEYS = ("key_outputs", "stop_time", "steps", "output_interval")
+"""Keys of a scene's optional ``[study]`` table."""
+
+DEFAULT_STOP_TIME = 10.0
+"""Study stop time, s, unless ``[study] stop_time`` says otherwise (capped by the scene's)."""
+
+QUICK_STOP_TIME = 1.0
+"""Stop time of the quick mode, s (capped by the study's)."""
+
+
+class StudyError(WireFmuError):
+    """A study cannot be made (no reference, no key outputs, ...)."""
+
+
+GRIDS = ("slices", "product")
+"""``slices``: every coupling with the scene's own solvers, and every solver with the
+scene's own coupling; ``product``: every coupling with every solver."""
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """Everything a study varies and keeps (a frozen plan, no behaviour).
+
+    Attributes
+    ----------
+    key_outputs : tuple of VarRef
+        Outputs the error is measured on.
+    stop_time : float
+        Simulated time of every run, s (a multiple of ``output_interval``).
+    steps : tuple of float
+        Macro steps, largest first; the largest is a multiple of every other.
+    output_interval : float
+        Spacing of the comparison grid, s (a multiple of every step).
+    algorithms, extrapolations : tuple of str
+        Coupling schemes of the grid.
+    solvers : tuple of SolverChoice
+        Internal solvers of the grid, besides the scene's own.
+    grid : str
+        One of :data:`GRIDS`: how couplings and solvers are combined.
+    reference_rtol : float
+        Tolerance of the monolithic reference (Radau), rtol = atol.
+    monolithic_rtols : tuple of float
+        Looser tolerances at which the monolithic model is run too, for its
+        own work-precision curve (empty: none).
+    run_budget : float
+        Wall seconds one run may take: a family stops refining its macro
+        step once the next run would likely take longer.
+    solver_floors : bool
+        Also solve the monolithic model with each unit solver choice: its
+        error is that solver's own error on the scene with no coupling, the
+        floor below which a family's order is not measured.
+    repeats : int
+        Runs per configuration; the fastest one's time counts.
+    quick : bool
+        Whether this is the reduced plan for CI.
+    """
+
+    key_outputs: tuple[VarRef, ...]
+    stop_time: float
+    steps: tuple[float, ...]
+    output_interval: float
+    algorithms: tuple[str, ...] = ALGORITHMS
+    extrapolations: tuple[str, ...] = EXTRAPOLATIONS
+    solvers: tuple[SolverChoice, ...] = DEFAULT_SOLVERS
+    grid: str = "slices"
+    reference_rtol: float = 1e-10
+    monolithic_rtols: tuple[float, ...] = (1e-4, 1e-6, 1e-8)
+    run_budget: float = 60.0
+    solver_floors: bool = True
+    repeats: int = 1
+    quick: bool = False
+
+
+def _multiple(big: float, small: float) -> bool:
+    ratio = big / small
+    return abs(ratio - round(ratio)) < 1e-6 * max(1.0, ratio) and round(ratio) >= 1
+
+
+def _study_table(scene: Scene) -> Mapping[str, Any]:
+    table = getattr(scene, "study", None) or {}
+    unknown = sorted(set(table) - set(STUDY_KEYS))
+    if unknown:
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            [f"unknown keys {unknown}; known: {', '.join(STUDY_KEYS)}"],
+        )
+    return table
+
+
+def _key_outputs(scene: Scene, table: Mapping[str, Any]) -> tuple[VarRef, ...]:
+    raw = table.get("key_outputs")
+    if raw is None:
+        refs = [r for plot in scene.plots for r in plot.variables]
+        refs = refs or list(scene.outputs or ())
+        if not refs:
+            raise SceneError(
+                f"scene {scene.name!r}",
+                [
+                    'no key outputs: give [study] key_outputs = ["unit.variable", ...] or '
+                    "[[plots]] variables"
+                ],
+            )
+        return tuple(dict.fromkeys(refs))
+    if not isinstance(raw, list) or not raw:
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            ["key_outputs must be a non-empty list of 'unit.variable'"],
+        )
+    refs = [VarRef.parse(text) for text in raw]
+    bad = [text for text, ref in zip(raw, refs, strict=True) if ref is None]
+    if bad:
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            [f"key_outputs: {text!r} is not 'unit.variable'" for text in bad],
+        )
+    return tuple(dict.fromkeys(refs))
+
+
+def _steps(scene: Scene, table: Mapping[str, Any], quick: bool) -> tuple[float, ...]:
+    raw = table.get("steps")
+    if raw is None:
+        exponents = (1, 0, -1) if quick else (2, 1, 0, -1, -2)
+        return tuple(scene.run.step * 2.0**k for k in exponents)
+    if (
+        not isinstance(raw, list)
+        or not raw
+        or not all(isinstance(h, int | float) and not isinstance(h, bool) and h > 0 for h in raw)
+    ):
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            ["steps must be a non-empty list of positive macro steps (s)"],
+        )
+    steps = tuple(sorted((float(h) for h in raw), reverse=True))
+    if quick and len(steps) > 3:
+        middle = len(steps) // 2
+        steps = steps[middle - 1 : middle + 2]
+    return steps
+
+
+def _output_interval(scene: Scene, table: Mapping[str, Any], steps: Sequence[float]) -> float:
+    interval = float(table.get("output_interval", steps[0]))
+    problems = [
+        f"output_interval {interval:g} s is not a multiple of the macro step {h:g} s"
+        for h in steps
+        if not _multiple(interval, h)
+    ]
+    if problems:
+        raise SceneError(
+            f"scene {scene.name!r} [study]",
+            problems
+            + ["every run is compared on one grid of step ends: choose steps that divide it"],
+        )
+    return interval
+
+
+def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
+    """The study plan for ``scene``: its ``[study]`` table, else defaults.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its optional ``[study]`` table may give ``key_outputs``,
+        ``stop_time``, ``steps`` and ``output_interval``.
+    quick : bool
+        The reduced plan for CI: three macro steps, constant and linear
+        extrapolation, the scene's own solvers only, at most
+        :data:`QUICK_STOP_TIME` seconds, no monolithic curve.
+
+    Raises
+    ------
+    SceneError
+        Listing the problems of the ``[study]`` table.
+    """
+    table = _study_table(scene)
+    keys = _key_outputs(scene, table)
+    steps = _steps(scene, table, quick)
+    interval = _output_interval(scene, table, steps)
+    stop = float(table.get("stop_time", min(scene.run.stop_time, DEFAULT_STOP_TIME)))
+    if quick:
+        stop = min(stop, QUICK_STOP_TIME)
+    stop = max(1, math.floor(stop / interval + 1e-9)) * interval
+    settings = StudySettings(keys, stop, steps, interval)
+    if quick:
+        settings = replace(
+            settings,
+            extrapolations=("constant", "linear"),
+            solvers=(),
+            monolithic_rtols=(),
+            run_budget=20.0,
+            quick=True,
+        )
+    return settings
+
+
+def with_stop_time(settings: StudySettings, stop_time: float | None) -> StudySettings:
+    """``settings`` with another stop time (a multiple of the output interval); None: as is."""
+    if stop_time is None:
+        return settings
+    if not (math.isfinite(stop_time) and stop_time > 0):
+        raise ValueError(f"stop_time must be a positive number of seconds, got {stop_time!r}")
+    interval = settings.output_interval
+    return replace(settings, stop_time=max(1, math.floor(stop_time / interval + 1e-9)) * interval)
+
+
+# ----------------------------------------------------------------------- the grid
+@dataclass(frozen=True)
+class Configuration:
+    """One run of the grid."""
+
+    algorithm: str
+    extrapolation: str
+    step: float
+    solver: SolverChoice
+
+    @property
+    def family(self) -> str:
+        """The family label: everything but the macro step."""
+        return family_label(self.algorithm, self.extrapolation, self.solver.label)
+
+
+def family_label(algorithm: str, extrapolation: str, solver: str) -> str:
+    """``"gauss_seidel / linear / ros2 h=1e-3"``."""
+    return f"{algorithm} / {extrapolation} / {solver}"
+
+
+def solver_choices(scene: Scene, settings: StudySettings) -> list[SolverChoice]:
+    """The scene's own solvers, then every choice of the plan that differs and applies."""
+    own = scene_solver(scene)
+    out = [own]
+    for choice in settings.solvers:
+        if choice.applies_to(scene) and (
+            choice.only is not None or choice.complete != own.complete
+        ):
+            out.append(choice)
+    return out
+
+
+def build_grid(scene: Scene, settings: StudySettings) -> list[Configuration]:
+    """Every configuration, family by family, each from its largest step down.
+
+    ``slices`` (the default): every algorithm and extrapolation with the
+    scene's own solvers, then every other solver with the scene's own
+    algorithm and extrapolation; ``product``: every combination.
+    """
+    solvers = solver_choices(scene, settings)
+    couplings = [(a, e) for a in settings.algorithms for e in settings.extrapolations]
+    if settings.grid == "product":
+        return [
+            Configuration(a, e, h, s) for s in solvers for a, e in couplings for h in settings.steps
+        ]
+    own = [Configuration(a, e, h, solvers[0]) for a, e in couplings for h in settings.steps]
+    run = scene.run
+    return own + [
+        Configuration(run.algorithm, run.extrapolation, h, s)
+        for s in solvers[1:]
+        for h in settings.steps
+    ]
+
+
+def _solver_parameters(
+    scene: Scene, structure: Structure | None, solver: SolverChoice
+) -> dict[str, Any]:
+    units = {}
+    for name, spec in scene.units.items():
+        params = copy.deepcopy(spec.parameters)
+        chosen = solver.for_model(spec.fmu)
+        if structure is None or structure.variable(VarRef(name, "solver")) is not None:
+            params.update(chosen)
+        units[name] = replace(spec, parameters=params)
+    return units
+
+
+def study_scene(scene: Scene, settings: StudySettings) -> Scene:
+    """The scene as every run of the study sees it: stop time, grid, key outputs recorded."""
+    scene = with_run_settings(
+        scene,
+        stop_time=settings.stop_time,
+        output_interval=settings.output_interval,
+        adaptive=False,
+    )
+    return replace(scene, outputs=settings.key_outputs)
+
+
+def configured_scene(
+    scene: Scene, config: Configuration, structure: Structure | None = None
+) -> Scene:
+    """A copy of a study scene set up for ``config`` (parameters deep-copied)."""
+    scene = with_run_settings(
+        scene, step=config.step, algorithm=config.algorithm, extrapolation=config.extrapolation
+    )
+    return replace(scene, units=_solver_parameters(scene, structure, config.solver))
+
+
+def load_study_scene(scene: Scene | str | Path) -> Scene:
+    """A parsed scene from a scene, a shipped name or a file."""
+    return scene if isinstance(scene, Scene) else load_scene(find_scene(scene))
+
+
+@dataclass(frozen=True)
+class StudyOptions:
+    """How a study runs, whatever it varies (the accuracy and the effects study).
+
+    Parameters
+    ----------
+    quick : bool
+        The reduced plan for CI (see :func:`study_settings`): short stop
+        time, few configurations, one run per case.
+    settings : StudySettings, optional
+        A plan of one's own (key outputs, stop time, ...) instead of
+        :func:`study_settings`'s.
+    repeats : int, optional
+        Runs per configuration or case, the fastest counts; None: the
+        study's default.
+    stop_time : float, optional
+        Simulated time per run instead of the plan's, s (rounded down to a
+        multiple of the output interval).
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+    progress : bool
+        A line per run on ``stream``.
+    stream : text stream, optional
+        For the progress lines (stderr by default).
+    """
+
+    quick: bool = False
+    settings: StudySettings | None = None
+    repeats: int | None = None
+    stop_time: float | None = None
+    fmu_dir: Path = DEFAULT_FMU_DIR
+    progress: bool = True
+    stream: TextIO | None = None
+
+    def prepare(self, scene: Scene | str | Path) -> tuple[Scene, StudySettings]:
+        """The parsed scene and the study's plan for it (its own or this one's settings).
+
+        Parameters
+        ----------
+        scene : Scene, str or Path
+            A parsed scene, a shipped scene's name or a scene file.
+
+        Raises
+        ------
+        SceneError
+            The scene or its ``[study]`` table has problems.
+        """
+        scene = load_study_scene(scene)
+        settings = self.settings or study_settings(scene, quick=self.quick)
+        return scene, with_stop_time(settings, self.stop_time)
