@@ -29,8 +29,9 @@ from wire_fmu.export.builder import build_fmu
 from wire_fmu.master.catalog import OUR_FMUS, ROOT
 from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results
+from wire_fmu.master.run_result import RunResult
 from wire_fmu.master.scene import Scene, parse_scene
-from wire_fmu.master.simulation import RunResult, Simulation
+from wire_fmu.master.simulation import Simulation
 from wire_fmu.master.validate import validate_scene
 from wire_fmu.study.monolithic import MonolithicResult, run_monolithic
 

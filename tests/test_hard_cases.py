@@ -31,8 +31,9 @@ from wire_fmu.core.units.hydraulics.model import damping_ratio_for_restitution
 from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results
 from wire_fmu.master.run import find_scene, run_scene, with_run_settings
+from wire_fmu.master.run_result import RunResult
 from wire_fmu.master.scene import SceneError, load_scene
-from wire_fmu.master.simulation import RunResult, Simulation
+from wire_fmu.master.simulation import Simulation
 from wire_fmu.master.validate import validate_scene
 
 from .hard_case_helpers import (

@@ -47,6 +47,10 @@ from __future__ import annotations
 import math
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .scene import RunSettings
 
 __all__ = ["DEFAULT_SHARE", "BondEnergy", "EnergyGuard"]
 
@@ -159,3 +163,13 @@ def _describe(name: str, bond: BondEnergy) -> str:
         share = 100 * bond.error / bond.carried
         return text + f", {share:.3g} % of the {bond.carried:.3g} J it carried"
     return text + f" while it carried {bond.carried:.3g} J"
+
+
+def _remedies(s: RunSettings) -> list[str]:
+    """What the energy guard's message suggests, given the run settings."""
+    remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
+    if s.iterations == 1:
+        remedies.append("iterations > 1")
+    if not s.adaptive:
+        remedies.append("adaptive = true")
+    return remedies

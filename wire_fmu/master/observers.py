@@ -22,12 +22,20 @@ import math
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
-    from .simulation import RunResult, Simulation
+    from .run_result import RunResult
+    from .simulation import Simulation
 
-__all__ = ["CsvRecorder", "Progress", "summary_rows", "BOND_CHANNELS", "LEDGER_CHANNEL"]
+__all__ = [
+    "Observer",
+    "CsvRecorder",
+    "Progress",
+    "summary_rows",
+    "BOND_CHANNELS",
+    "LEDGER_CHANNEL",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -37,6 +45,19 @@ power it transmitted (W)."""
 
 LEDGER_CHANNEL = "energy.units_balance"
 """Sum of the units' ``energy_balance`` outputs, J (each unit's own ledger)."""
+
+
+class Observer(Protocol):
+    """Reads the simulation; never changes it."""
+
+    def on_start(self, sim: Simulation) -> None:
+        """Called after initialisation, at the start time."""
+
+    def on_step(self, sim: Simulation) -> None:
+        """Called after every accepted macro step."""
+
+    def on_end(self, sim: Simulation, result: RunResult) -> None:
+        """Called once at the end, also after a failure or an interruption."""
 
 
 class CsvRecorder:

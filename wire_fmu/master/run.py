@@ -15,8 +15,9 @@ from pathlib import Path
 
 from .catalog import DEFAULT_FMU_DIR
 from .observers import CsvRecorder, Progress
+from .run_result import RunResult
 from .scene import Scene, SceneError, read_scene
-from .simulation import RunResult, Simulation
+from .simulation import Simulation
 from .validate import validate_scene
 
 __all__ = [
@@ -156,7 +157,7 @@ def run_scene(
     fmu_dir : Path
         Where our FMUs are built and cached.
     observers : sequence
-        More observers (see :class:`~wire_fmu.master.simulation.Observer`).
+        More observers (see :class:`~wire_fmu.master.observers.Observer`).
     **run_overrides
         Replace run settings of the scene, e.g. ``stop_time=5.0`` for a quick run.
     """

@@ -21,62 +21,37 @@ observers (which read: recorder, progress, energy monitor). One macro step:
    passes a share of what the bond carried: with any settings, a macro step
    too large for the dynamics across a bond is never a silent blow-up.
 
-Energy residual of a bond over a step (SPEC section 15): the flow side got
-``e_held * dx`` (``dx`` its displacement: exact from a position link, else
-``h * mean(flow)``) while the effort side gave ``mean(effort) * f_held * h``
-and, with a position link, ``e1 * (dx - f_held * h)`` more when its position
-input is set to the source's new value at the next step (the jump its own
-integration of ``f_held`` missed). Their difference is energy the coupling
-created (positive) or destroyed.
+The energy residual of a bond over a step is computed in
+:mod:`~wire_fmu.master.bond_energy`; macro step sizes (nanosecond times, the
+step after a rejection, the adaptive controller) in
+:mod:`~wire_fmu.master.step_size`.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import signal
-import threading
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field
-from typing import Any, Protocol
 
 from .algorithms import make_algorithm, step_order
-from .energy_guard import EnergyGuard
+from .bond_energy import bond_step_energy
+from .energy_guard import EnergyGuard, _remedies
 from .extrapolation import History, held_value
+from .interrupts import _InterruptRequestedError, _Interrupts
 from .manipulators import DriverSet, ScheduledEvents
-from .scene import Bond, Connection, RunSettings, Scene
+from .run_result import RunResult, SimulationStoppedError
+from .scene import Connection, Scene
 from .slave import Slave, StepRefusedError, UnitFailedError
+from .step_size import _PI, _ns, new_h
 from .validate import Structure, unit_start_values
 
-__all__ = ["Simulation", "Observer", "RunResult", "SimulationStoppedError"]
+__all__ = ["Simulation"]
 
 logger = logging.getLogger(__name__)
 
 MODE_OUTPUT = "mode_changes"
-STATUSES = ("finished", "stopped", "failed", "interrupted")
-"""How a run ends: ``finished`` at the stop time; ``stopped`` by the physics or the
-numerics with a message (a unit refused a step, the energy guard, a diverging
-iteration); ``failed``, a unit answered with an error (also in initialisation) or
-something unexpected happened; ``interrupted`` by Ctrl-C (SIGINT) or SIGTERM."""
-_PI = {"safety": 0.99, "k_p": 0.2, "k_i": 0.15, "shrink": 0.2, "grow": 1.5}
-
-
-class SimulationStoppedError(RuntimeError):
-    """A unit stopped the run; the message says which, when and why."""
-
-
-class Observer(Protocol):
-    """Reads the simulation; never changes it."""
-
-    def on_start(self, sim: Simulation) -> None:
-        """Called after initialisation, at the start time."""
-
-    def on_step(self, sim: Simulation) -> None:
-        """Called after every accepted macro step."""
-
-    def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Called once at the end, also after a failure or an interruption."""
 
 
 @dataclass
@@ -99,22 +74,6 @@ class _Attempt:
     message: str = ""
 
 
-@dataclass
-class RunResult:
-    """Outcome of :meth:`Simulation.run`."""
-
-    status: str  # one of STATUSES
-    message: str = ""
-    end_time: float = 0.0
-    wall_time: float = 0.0
-    steps: int = 0
-    rejected: int = 0
-    iterations: int = 0
-    bond_residual: dict[str, float] = field(default_factory=dict)
-    bond_carried: dict[str, float] = field(default_factory=dict)
-    bond_error: dict[str, float] = field(default_factory=dict)
-
-
 class Simulation:
     """A scene ready to run.
 
@@ -124,7 +83,7 @@ class Simulation:
         The parsed scene.
     structure : Structure
         Its units' FMU paths and model descriptions (from validation).
-    observers : sequence of Observer
+    observers : sequence of :class:`~wire_fmu.master.observers.Observer`
         Recorders, progress displays, monitors.
     """
 
@@ -224,14 +183,36 @@ class Simulation:
 
     # -- what algorithms call ------------------------------------------------------
     def read_sources(self, unit: str) -> dict[str, float]:
-        """Current values of ``unit``'s outputs that feed connections."""
+        """Current values of ``unit``'s outputs that feed connections.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        dict of str to float
+            Each output's value by its ``"unit.variable"`` name, in its unit.
+        """
         keys = self.source_keys.get(unit, [])
         return dict(
             zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
         )
 
     def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
-        """Held values of every connected, driven or overridden input of ``unit``."""
+        """Held values of every connected, driven or overridden input of ``unit``.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        t, h : float
+            Start and length of the macro step, s.
+        fresh : dict or None
+            Source outputs (``"unit.variable"``) at ``t + h`` from the previous
+            sweep of an iterated step; None extrapolates from the past.
+        """
         refs, values = [], []
         for link in self.links_into.get(unit, ()):
             history = self.histories[link.key]
@@ -252,7 +233,15 @@ class Simulation:
             slave.set_many(driven)
 
     def step_unit(self, unit: str, t: float, h: float) -> None:
-        """Step one unit (errors propagate as StepRefusedError / UnitFailedError)."""
+        """Step one unit (errors propagate as StepRefusedError / UnitFailedError).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        t, h : float
+            Start and length of the macro step, s.
+        """
         self.slaves[unit].do_step(t, h)
 
     def _fire_events(self, t: float) -> list[str]:
@@ -313,26 +302,26 @@ class Simulation:
         return new, sweeps
 
     def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
-        """Energy each bond's coupling created over the step just taken, J."""
+        """Energy each bond's coupling created over the step just taken, J.
+
+        Parameters
+        ----------
+        new : dict of str to float
+            Source outputs (``"unit.variable"``) at the end of the step.
+        h : float
+            The step just taken, s.
+
+        Returns
+        -------
+        dict of str to float
+            The energy residual by bond name, J (positive: created).
+        """
         out = {}
         for bond in self.scene.bonds:
-            out[bond.name] = self._bond_residual(bond, new, h)
+            out[bond.name], self.bond_power[bond.name] = bond_step_energy(
+                bond, self.histories, self.held, new, h
+            )
         return out
-
-    def _bond_residual(self, bond: Bond, new: dict[str, float], h: float) -> float:
-        e_key, f_key = str(bond.effort.source), str(bond.flow.source)
-        e0, e1 = self.histories[e_key].latest, new[e_key]
-        f_held = self.held.get(str(bond.flow.target), self.histories[f_key].latest)
-        e_held = self.held.get(str(bond.effort.target), e0)
-        if bond.position is None:  # the flow side's displacement, by the trapezoidal rule
-            moved, jump = 0.5 * (self.histories[f_key].latest + new[f_key]) * h, 0.0
-        else:  # exactly; the effort side's position input will jump by what it missed
-            p_key = str(bond.position.source)
-            moved = new[p_key] - self.histories[p_key].latest
-            jump = moved - f_held * h
-        self.bond_power[bond.name] = e_held * moved / h
-        # received by the flow side - given by the effort side over the step and the jump
-        return e_held * moved - 0.5 * (e0 + e1) * f_held * h - e1 * jump
 
     def _attempt(self, t: float, h: float) -> _Attempt:
         """Take one macro step, rolling back when it is refused or rejected."""
@@ -422,9 +411,10 @@ class Simulation:
     def run(self) -> RunResult:
         """Initialise and run to the stop time; observers see every accepted step.
 
-        Never raises: the result's ``status`` (one of :data:`STATUSES`) and
-        ``message`` say how the run ended, and every observer's ``on_end`` is
-        called whatever happened. Ctrl-C (and SIGTERM) end the run after the
+        Never raises: the result's ``status`` (one of
+        :data:`~wire_fmu.master.run_result.STATUSES`) and ``message`` say how
+        the run ended, and every observer's ``on_end`` is called whatever
+        happened. Ctrl-C (and SIGTERM) end the run after the
         macro step under way, with status ``interrupted``; a second Ctrl-C
         interrupts at once.
         """
@@ -513,57 +503,3 @@ class Simulation:
             if blow_up:
                 raise SimulationStoppedError(blow_up)
             h = self._next_step(h, attempt.residuals)
-
-
-class _InterruptRequestedError(Exception):
-    """Ctrl-C or SIGTERM was asked for between two macro steps."""
-
-
-class _Interrupts:
-    """While a run goes: SIGINT and SIGTERM end it between macro steps.
-
-    A signal then only sets :attr:`requested`, so it never lands inside a
-    unit's own code (all our FMUs share this interpreter); the run loop ends
-    the run cleanly after the step under way. A second SIGINT raises
-    KeyboardInterrupt at once. Outside the main thread nothing is installed.
-    """
-
-    def __init__(self) -> None:
-        self.requested = False
-        self._previous: dict[int, Any] = {}
-
-    def _handle(self, signum: int, frame: Any) -> None:
-        if self.requested and signum == signal.SIGINT:
-            raise KeyboardInterrupt
-        self.requested = True
-        logger.warning("interrupted: the run ends after this step (Ctrl-C again to stop now)")
-
-    def __enter__(self) -> _Interrupts:
-        if threading.current_thread() is threading.main_thread():
-            for signum in (signal.SIGINT, signal.SIGTERM):
-                self._previous[signum] = signal.signal(signum, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for signum, handler in self._previous.items():
-            signal.signal(signum, handler)
-
-
-def _remedies(s: RunSettings) -> list[str]:
-    """What the energy guard's message suggests, given the run settings."""
-    remedies = ["a smaller step" if not s.adaptive else "a smaller energy_tolerance"]
-    if s.iterations == 1:
-        remedies.append("iterations > 1")
-    if not s.adaptive:
-        remedies.append("adaptive = true")
-    return remedies
-
-
-def _ns(seconds: float) -> int:
-    """Seconds as integer nanoseconds."""
-    return int(round(seconds * 1e9))
-
-
-def new_h(h: float, error: float) -> float:
-    """A shorter step after a rejection, from the error ratio (> 1)."""
-    return h * max(_PI["shrink"], min(0.9, 0.9 * error**-0.5))

@@ -1,0 +1,33 @@
+"""How a run ended: :class:`RunResult`, its statuses, and the error that stops a run."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = ["RunResult", "SimulationStoppedError", "STATUSES"]
+
+STATUSES = ("finished", "stopped", "failed", "interrupted")
+"""How a run ends: ``finished`` at the stop time; ``stopped`` by the physics or the
+numerics with a message (a unit refused a step, the energy guard, a diverging
+iteration); ``failed``, a unit answered with an error (also in initialisation) or
+something unexpected happened; ``interrupted`` by Ctrl-C (SIGINT) or SIGTERM."""
+
+
+class SimulationStoppedError(RuntimeError):
+    """A unit stopped the run; the message says which, when and why."""
+
+
+@dataclass
+class RunResult:
+    """Outcome of :meth:`Simulation.run`."""
+
+    status: str  # one of STATUSES
+    message: str = ""
+    end_time: float = 0.0
+    wall_time: float = 0.0
+    steps: int = 0
+    rejected: int = 0
+    iterations: int = 0
+    bond_residual: dict[str, float] = field(default_factory=dict)
+    bond_carried: dict[str, float] = field(default_factory=dict)
+    bond_error: dict[str, float] = field(default_factory=dict)
