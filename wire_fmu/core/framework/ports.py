@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
-__all__ = ["PORT_KINDS", "Port", "PortSide"]
+__all__ = ["PORT_KINDS", "Port", "PortSide", "port"]
 
 PORT_KINDS = {
     # kind: (effort unit, flow unit, position unit)
@@ -95,3 +95,30 @@ class Port:
             elif units.get(name) != unit:
                 problems.append(f"port {self.name!r}: {name!r} must be in {unit}")
         return problems
+
+
+def port(
+    name: str,
+    kind: str,
+    side: PortSide,
+    effort: str,
+    flow: str,
+    position: str | None = None,
+    description: str = "",
+) -> Port:
+    """A :class:`Port` whose variable names without a dot are taken under the port's name.
+
+    ``port("rod", "translational", PortSide.flow, "force", "velocity", "displacement")``
+    declares ``rod.force``, ``rod.velocity`` and ``rod.displacement``; a name with a dot
+    (``"shaft.speed"``) is taken as it is.
+
+    Parameters
+    ----------
+    name, kind, side, effort, flow, position, description
+        As for :class:`Port`; ``effort``, ``flow`` and ``position`` may be short names.
+    """
+
+    def full(variable: str | None) -> str | None:
+        return variable if variable is None or "." in variable else f"{name}.{variable}"
+
+    return Port(name, kind, side, full(effort), full(flow), full(position), description)

@@ -49,33 +49,24 @@ from wire_fmu.core.components.sheave_geometry import (
     planar_path_lengths,
 )
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
 
 __all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
 
-from wire_fmu.core.framework.effects import Effect, EffectCatalogue
-
+_INERTIA = ("sheave_inertia",)
+_EFFECTS = (  # name, the model without it, with it, the effects it needs
+    ("rope_damping", "Hooke rope (eq. 3)", "Kelvin-Voigt rope (eq. 5)", ()),
+    ("sheave_inertia", "massless sheaves, merged springs", "sheave inertia (eq. 11)", ()),
+    ("bearing_friction", "frictionless bearings", "dry bearing friction with stick", _INERTIA),
+    ("rope_slip", "rope grips the groove", "capstan slip (eq. 9-12)", _INERTIA),
+    ("moving_geometry", "fixed line directions", "tangent points recomputed (eq. 16-31)", ()),
+    ("spatial_geometry", "planar reeving", "3-D reeving with fleet angles", ()),
+)
 BLOCK_TRAIN_EFFECTS = EffectCatalogue(
     "block train",
-    (
-        Effect("rope_damping", "Hooke rope (eq. 3)", "Kelvin-Voigt rope (eq. 5)"),
-        Effect("sheave_inertia", "massless sheaves, merged springs", "sheave inertia (eq. 11)"),
-        Effect(
-            "bearing_friction",
-            "frictionless bearings",
-            "dry bearing friction with stick",
-            requires=("sheave_inertia",),
-        ),
-        Effect(
-            "rope_slip",
-            "rope grips the groove",
-            "capstan slip (eq. 9-12)",
-            requires=("sheave_inertia",),
-        ),
-        Effect("moving_geometry", "fixed line directions", "tangent points recomputed (eq. 16-31)"),
-        Effect("spatial_geometry", "planar reeving", "3-D reeving with fleet angles"),
-    ),
+    tuple(Effect(name, off, on, requires=needs) for name, off, on, needs in _EFFECTS),
 )
 
 

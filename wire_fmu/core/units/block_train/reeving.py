@@ -49,7 +49,7 @@ followed along the path, goes round the sheave about its axis.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -383,20 +383,30 @@ def _parse_floor(data: Any, where: str, p: _Problems) -> Floor | None:
     )
 
 
-def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, SheaveSpec]:
-    sheaves: dict[str, SheaveSpec] = {}
+def _parse_on_bodies(
+    data: Mapping, what: str, bodies: dict[str, Body], p: _Problems, build: Callable
+) -> dict:
+    """Parts named in ``data`` (sheaves, anchors), each on a body; ``build(name, body,
+    spec, where)`` makes one from its table."""
+    parts: dict = {}
     if not isinstance(data, Mapping):
-        p.add("sheaves", "must be a mapping of name -> sheave")
-        return sheaves
+        p.add(f"{what}s", f"must be a mapping of name -> {what}")
+        return parts
     for name, spec in data.items():
-        where = f"sheave {name!r}"
+        where = f"{what} {name!r}"
         if not isinstance(spec, Mapping):
             p.add(where, "must be a mapping")
             continue
         body = spec.get("body", "ground")
         if body not in bodies:
             p.add(where, f"'body' {body!r} is not a body; bodies: {', '.join(bodies)}")
-        sheaves[name] = SheaveSpec(
+        parts[name] = build(name, body, spec, where)
+    return parts
+
+
+def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, SheaveSpec]:
+    def sheave(name: str, body: str, spec: Mapping, where: str) -> SheaveSpec:
+        return SheaveSpec(
             name,
             body,
             p.vector(spec, "centre", where),
@@ -407,7 +417,8 @@ def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict
             _efficiency(spec, where, p),
             p.number(spec, "groove_friction", where, 0.1, nonnegative=True),
         )
-    return sheaves
+
+    return _parse_on_bodies(data, "sheave", bodies, p, sheave)
 
 
 def _efficiency(spec: Mapping, where: str, p: _Problems) -> float:
@@ -416,20 +427,10 @@ def _efficiency(spec: Mapping, where: str, p: _Problems) -> float:
 
 
 def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, AnchorSpec]:
-    anchors: dict[str, AnchorSpec] = {}
-    if not isinstance(data, Mapping):
-        p.add("anchors", "must be a mapping of name -> anchor")
-        return anchors
-    for name, spec in data.items():
-        where = f"anchor {name!r}"
-        if not isinstance(spec, Mapping):
-            p.add(where, "must be a mapping")
-            continue
-        body = spec.get("body", "ground")
-        if body not in bodies:
-            p.add(where, f"'body' {body!r} is not a body; bodies: {', '.join(bodies)}")
-        anchors[name] = AnchorSpec(name, body, p.vector(spec, "point", where))
-    return anchors
+    def anchor(name: str, body: str, spec: Mapping, where: str) -> AnchorSpec:
+        return AnchorSpec(name, body, p.vector(spec, "point", where))
+
+    return _parse_on_bodies(data, "anchor", bodies, p, anchor)
 
 
 def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[PathElement, ...]:

@@ -30,7 +30,7 @@ import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, fastest_mode
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
@@ -96,15 +96,15 @@ def _variables():
         ),
     )
     inputs = []
-    for port in LINE_PORTS:
+    for line in LINE_PORTS:
         inputs += [
-            input_(f"{port}.payout", 0.0, "m", f"Rope paid in through {port} since the start"),
-            input_(f"{port}.payout_rate", 0.0, "m/s", f"Rate of rope paid in through {port}"),
+            input_(f"{line}.payout", 0.0, "m", f"Rope paid in through {line} since the start"),
+            input_(f"{line}.payout_rate", 0.0, "m/s", f"Rate of rope paid in through {line}"),
         ]
-    for port in MOVER_PORTS:
+    for mover in MOVER_PORTS:
         inputs += [
-            input_(f"{port}.position", 0.0, "m", f"Displacement of driven body {port}"),
-            input_(f"{port}.velocity", 0.0, "m/s", f"Velocity of driven body {port}"),
+            input_(f"{mover}.position", 0.0, "m", f"Displacement of driven body {mover}"),
+            input_(f"{mover}.velocity", 0.0, "m/s", f"Velocity of driven body {mover}"),
         ]
     inputs.append(
         input_("break_segment", 0, "", "Break this rope segment (1-based) now; 0: none", type=int)
@@ -162,28 +162,15 @@ class BlockTrainUnit(Unit):
     NAME = "BlockTrain"
     DESCRIPTION = "Rope reeved over sheaves and anchors (block train), wire_fmu"
     VARIABLES = _variables()
-    PORTS = tuple(
-        Port(
-            f"line_{e}",
-            "rope",
-            PortSide.effort,
-            f"line_{e}.tension",
-            f"line_{e}.payout_rate",
-            f"line_{e}.payout",
-            f"rope line end {e}",
-        )
-        for e in "ab"
-    ) + tuple(
-        Port(
-            f"mover_{e}",
-            "translational",
-            PortSide.effort,
-            f"mover_{e}.force",
-            f"mover_{e}.velocity",
-            f"mover_{e}.position",
-            f"driven body port {e}",
-        )
-        for e in "ab"
+    PORTS = (
+        *(
+            port(f"line_{e}", "rope", PortSide.effort, "tension", "payout_rate", "payout")
+            for e in "ab"
+        ),
+        *(
+            port(f"mover_{e}", "translational", PortSide.effort, "force", "velocity", "position")
+            for e in "ab"
+        ),
     )
 
     def __init__(self, instance_name: str = "block_train") -> None:

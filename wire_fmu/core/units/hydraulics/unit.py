@@ -97,7 +97,7 @@ import numpy as np
 
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
 from wire_fmu.core.errors import ConfigurationError, ModelError
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import OdeView, Unit, input_, output, parameter
 from wire_fmu.core.units.hydraulics.model import (
@@ -121,123 +121,76 @@ DEFAULT_ROD_FORCE = -4.0 * 356.0e3
 _FEEDTHROUGH = ("rod.force",)
 
 
+def _size(name: str, start: float, unit: str, description: str, **limits: float):
+    """A fixed physical parameter; not negative unless ``limits`` say otherwise."""
+    return parameter(name, start, unit, description, **({"min": 0.0} | limits))
+
+
+def _cylinder_parameters():
+    side = (
+        "Oil-filled side: 'bore' (gas pushes the rod out) or 'annulus' (gas pulls it in); "
+        "the other side is vented"
+    )
+    gravity = "Gravity along the extension direction (-9.81: vertical, rod extends up)"
+    return (
+        parameter("pressurised_side", "bore", "", side, type=str),
+        _size("bore_diameter", 0.356, "m", "Piston (bore) diameter"),
+        _size("rod_diameter", 0.229, "m", "Rod diameter"),
+        _size("stroke", 3.81, "m", "Stroke"),
+        _size("moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries"),
+        _size("chamber_dead_volume", 0.01, "m3", "Oil in the chamber at zero working length"),
+        parameter("gravity_along_rod", -9.81, "m/s2", gravity),
+        _size("ambient_pressure", 101325.0, "Pa", "Absolute pressure on the vented side and rod"),
+    )
+
+
+def _accumulator_parameters():
+    exponent = "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)"
+    return (
+        _size("accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)"),
+        _size("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels"),
+        _size("accumulator_dead_volume", 0.01, "m3", "Gas left in a full accumulator"),
+        _size("precharge_pressure", 13.5e6, "Pa", "Absolute gas pressure with no oil in it"),
+        _size("polytropic_exponent", 1.4, "1", exponent, min=1.0, max=2.0),
+    )
+
+
+def _oil_parameters():
+    minor = "Sum of minor-loss coefficients (valves, bends, entry, exit)"
+    volume = "Oil volume whose compressibility is modelled (0: chamber at the start plus line)"
+    cavitation = "Absolute chamber pressure at which the step is refused (cavitation)"
+    return (
+        _size("line_length", 15.0, "m", "Length of the oil line"),
+        _size("line_diameter", 0.1524, "m", "Inner diameter of the oil line"),
+        _size("oil_density", 870.0, "kg/m3", "Oil density"),
+        _size("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity"),
+        _size("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent"),
+        _size("line_loss_coefficient", 5.0, "1", minor),
+        _size("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus"),
+        _size("oil_volume", 0.0, "m3", volume),
+        _size("cavitation_pressure", 1.0e4, "Pa", cavitation),
+    )
+
+
+def _seal_and_stop_parameters():
+    return (
+        _size("seal_static_friction", 25.0e3, "N", "Seal breakaway force"),
+        _size("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force"),
+        _size("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient"),
+        _size("seal_stribeck_velocity", 0.01, "m/s", "Stribeck velocity (0: no Stribeck decay)"),
+        _size("cushion_length", 0.15, "m", "Length of the cushion zone at each end"),
+        _size("cushion_coefficient", 1.0e5, "N.s2/m2", "Cushion force coefficient c in F = c v^2"),
+        _size("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness"),
+        _size("stop_restitution", 0.3, "1", "Coefficient of restitution at an end stop", max=1.0),
+    )
+
+
 def _physical_parameters():
     return (
-        parameter(
-            "pressurised_side",
-            "bore",
-            "",
-            "Oil-filled side: 'bore' (gas pushes the rod "
-            "out) or 'annulus' (gas pulls it in); the other side is vented",
-            type=str,
-        ),
-        parameter("bore_diameter", 0.356, "m", "Piston (bore) diameter", min=0.0),
-        parameter("rod_diameter", 0.229, "m", "Rod diameter", min=0.0),
-        parameter("stroke", 3.81, "m", "Stroke", min=0.0),
-        parameter(
-            "moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries", min=0.0
-        ),
-        parameter(
-            "chamber_dead_volume",
-            0.01,
-            "m3",
-            "Oil in the pressurised chamber at zero working length",
-            min=0.0,
-        ),
-        parameter(
-            "gravity_along_rod",
-            -9.81,
-            "m/s2",
-            "Gravity along the extension direction (-9.81: vertical, rod extends up)",
-        ),
-        parameter(
-            "ambient_pressure",
-            101325.0,
-            "Pa",
-            "Absolute pressure on the vented side and the rod's outer end",
-            min=0.0,
-        ),
-        parameter(
-            "accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)", min=0.0
-        ),
-        parameter("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels", min=0.0),
-        parameter(
-            "accumulator_dead_volume",
-            0.01,
-            "m3",
-            "Gas left in the accumulator when it is full of oil",
-            min=0.0,
-        ),
-        parameter(
-            "precharge_pressure",
-            13.5e6,
-            "Pa",
-            "Absolute gas pressure with no oil in the accumulator",
-            min=0.0,
-        ),
-        parameter(
-            "polytropic_exponent",
-            1.4,
-            "1",
-            "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)",
-            min=1.0,
-            max=2.0,
-        ),
-        parameter("line_length", 15.0, "m", "Length of the oil line", min=0.0),
-        parameter("line_diameter", 0.1524, "m", "Inner diameter of the oil line", min=0.0),
-        parameter("oil_density", 870.0, "kg/m3", "Oil density", min=0.0),
-        parameter("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity", min=0.0),
-        parameter("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent", min=0.0),
-        parameter(
-            "line_loss_coefficient",
-            5.0,
-            "1",
-            "Sum of minor-loss coefficients (valves, bends, entry, exit)",
-            min=0.0,
-        ),
-        parameter("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus", min=0.0),
-        parameter(
-            "oil_volume",
-            0.0,
-            "m3",
-            "Oil volume whose compressibility is modelled "
-            "(0: chamber at the initial position plus line)",
-            min=0.0,
-        ),
-        parameter(
-            "cavitation_pressure",
-            1.0e4,
-            "Pa",
-            "Absolute chamber pressure at which the step is refused (cavitation)",
-            min=0.0,
-        ),
-        parameter("seal_static_friction", 25.0e3, "N", "Seal breakaway force", min=0.0),
-        parameter("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force", min=0.0),
-        parameter("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient", min=0.0),
-        parameter(
-            "seal_stribeck_velocity",
-            0.01,
-            "m/s",
-            "Stribeck velocity (0: no Stribeck decay)",
-            min=0.0,
-        ),
-        parameter("cushion_length", 0.15, "m", "Length of the cushion zone at each end", min=0.0),
-        parameter(
-            "cushion_coefficient",
-            1.0e5,
-            "N.s2/m2",
-            "Cushion force coefficient c in F = c v^2",
-            min=0.0,
-        ),
-        parameter("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness", min=0.0),
-        parameter(
-            "stop_restitution",
-            0.3,
-            "1",
-            "Coefficient of restitution at an end stop",
-            min=0.0,
-            max=1.0,
-        ),
+        *_cylinder_parameters(),
+        *_accumulator_parameters(),
+        *_oil_parameters(),
+        *_seal_and_stop_parameters(),
     )
 
 
@@ -330,15 +283,7 @@ class HydraulicsUnit(Unit):
     DESCRIPTION = "Hydraulic cylinder with gas accumulator (hydro-pneumatic spring), wire_fmu"
     VARIABLES = _variables()
     PORTS = (
-        Port(
-            "rod",
-            "translational",
-            PortSide.flow,
-            "rod.force",
-            "rod.velocity",
-            "rod.displacement",
-            "the cylinder rod (position: extension since the start)",
-        ),
+        port("rod", "translational", PortSide.flow, "force", "velocity", "displacement", "the rod"),
     )
 
     def __init__(self, instance_name: str = "hydraulics") -> None:

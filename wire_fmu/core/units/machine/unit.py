@@ -45,7 +45,7 @@ from wire_fmu.core.framework.energy_integrator import (
     make_energy_solver,
 )
 from wire_fmu.core.framework.hybrid import make_solver
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
@@ -166,15 +166,7 @@ class MachineDriveUnit(Unit):
     DESCRIPTION = "Machine unit in steady motion, paper 004's energy-form integrator, wire_fmu"
     VARIABLES = _parameters() + _inputs() + _outputs()
     PORTS = (
-        Port(
-            "load",
-            "rotational",
-            PortSide.flow,
-            "load.torque",
-            "shaft.speed",
-            "shaft.angle",
-            "the driven shaft",
-        ),
+        port("load", "rotational", PortSide.flow, "torque", "shaft.speed", "shaft.angle", "shaft"),
     )
 
     def __init__(self, instance_name: str = "machine") -> None:

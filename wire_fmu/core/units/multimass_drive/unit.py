@@ -52,7 +52,7 @@ from wire_fmu.core.components.drive_tree import DriveTree, default_multimass_dri
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
@@ -326,33 +326,9 @@ class DriveUnit(Unit):
     DESCRIPTION = "Multi-mass elastic drive with delta-star reduction (paper 002), wire_fmu"
     VARIABLES = _parameters() + _inputs() + _outputs()
     PORTS = (
-        Port(
-            "motor",
-            "rotational",
-            PortSide.flow,
-            "motor.torque",
-            "motor.speed",
-            "motor.angle",
-            "the first motor's shaft",
-        ),
-        Port(
-            "motor2",
-            "rotational",
-            PortSide.flow,
-            "motor2.torque",
-            "motor2.speed",
-            None,
-            "the second motor's shaft",
-        ),
-        Port(
-            "load",
-            "rotational",
-            PortSide.flow,
-            "load.torque",
-            "load.speed",
-            "load.angle",
-            "the load's shaft",
-        ),
+        port("motor", "rotational", PortSide.flow, "torque", "speed", "angle", "first motor"),
+        port("motor2", "rotational", PortSide.flow, "torque", "speed", None, "second motor"),
+        port("load", "rotational", PortSide.flow, "torque", "speed", "angle", "the load's shaft"),
     )
 
     def __init__(self, instance_name: str = "drive") -> None:
