@@ -317,19 +317,23 @@ class JackInputs:
 
 @dataclass(frozen=True)
 class JackReport:
-    """Outputs of the jack at one instant (SI units)."""
+    """Outputs of the jack at one instant (SI units).
+
+    Fields are named after the unit's outputs, dots as underscores
+    (:mod:`~wire_fmu.core.framework.report_outputs`).
+    """
 
     handle_angle: float
     handle_speed: float
     handle_torque: float
-    travel: float
-    height: float
+    screw_travel: float
+    load_height: float
     load_velocity: float
     screw_displacement: float
     rod_angle: float
-    axial_force: float
-    lead_torque: float
-    friction_torque: float
+    screw_axial_force: float
+    thread_lead_torque: float
+    thread_friction_torque: float
     thread_state: int
     stored_energy: float
     dissipated_energy: float
@@ -618,14 +622,14 @@ class ScissorJackModel:
             handle_angle=psi,
             handle_speed=omega,
             handle_torque=f.handle_torque,
-            travel=travel,
-            height=self.height(psi),
+            screw_travel=travel,
+            load_height=self.height(psi),
             load_velocity=self.h * slope * omega,
             screw_displacement=0.5 * travel,
             rod_angle=self.config.geometry.rod_angle(travel),
-            axial_force=f.axial_force,
-            lead_torque=self.h * f.axial_force,
-            friction_torque=f.friction_torque,
+            screw_axial_force=f.axial_force,
+            thread_lead_torque=self.h * f.axial_force,
+            thread_friction_torque=f.friction_torque,
             thread_state=self.thread_state(x),
             stored_energy=self.stored_energy(x),
             dissipated_energy=float(x[2]),

@@ -28,7 +28,6 @@ section 2; present: dry friction ``r_mean mu |F|`` with the model
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -38,6 +37,7 @@ from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
+from wire_fmu.core.framework.report_outputs import ReportOutputs
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     HeldInputsUnit,
@@ -230,6 +230,13 @@ def _outputs():
     )
 
 
+_REPORTED = ReportOutputs.of(
+    _outputs(),
+    finite=("load.height", "handle.speed", "handle.torque", "screw.axial_force", "stored_energy"),
+)
+"""The outputs copied from the model's report, and those that must be finite."""
+
+
 class ScissorJackUnit(HeldInputsUnit):
     """Scissor jack with screw-nut drive and thread friction (SPEC section 10, paper 003)."""
 
@@ -335,30 +342,13 @@ class ScissorJackUnit(HeldInputsUnit):
 
     def _update_outputs(self, x: np.ndarray | None = None) -> None:
         model = self._require_model()
-        r = model.report(x)
-        out = self.values
-        out["handle.angle"] = r.handle_angle
-        out["handle.speed"] = r.handle_speed
-        out["handle.torque"] = r.handle_torque
-        out["load.height"] = r.height
-        out["load.velocity"] = r.load_velocity
-        out["rod_angle"] = r.rod_angle
-        out["screw.travel"] = r.travel
-        out["screw.displacement"] = r.screw_displacement
-        out["screw.axial_force"] = r.axial_force
-        out["thread.lead_torque"] = r.lead_torque
-        out["thread.friction_torque"] = r.friction_torque
-        out["thread.state"] = int(r.thread_state)
-        out["stored_energy"] = r.stored_energy
-        out["dissipated_energy"] = r.dissipated_energy
-        out["external_work"] = r.external_work
-        out["energy_balance"] = (
-            r.stored_energy - self.initial_energy + r.dissipated_energy - r.external_work
+        _REPORTED.publish(
+            self.values,
+            model.report(x),
+            self.initial_energy,
+            model.mode_changes,
+            self.instance_name,
         )
-        out["mode_changes"] = int(model.mode_changes)
-        reals = (r.height, r.handle_speed, r.handle_torque, r.axial_force, r.stored_energy)
-        if not all(math.isfinite(value) for value in reals):
-            raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
 
 def _stability_problems(config: JackConfig, max_step: float) -> list[str]:

@@ -248,14 +248,18 @@ class WinchConfig:
 
 @dataclass(frozen=True)
 class WinchReport:
-    """Every output quantity of a winch at one instant (units as in the FMU)."""
+    """Every output quantity of a winch at one instant (units as in the FMU).
 
-    payout: float
-    payout_rate: float
+    Fields are named after the unit's outputs, dots as underscores
+    (:mod:`~wire_fmu.core.framework.report_outputs`).
+    """
+
+    rope_payout: float
+    rope_payout_rate: float
     drum_speed: float
     drum_angle: float
-    layer: int
-    radius: float
+    drum_layer: int
+    drum_radius: float
     motor_speed: float
     motor_torque: float
     brake_torque: float
@@ -628,12 +632,12 @@ class WinchModel(_WinchBase):
         radius = self.drum.layer_radius(k)
         motor_speed = self.motor_ratio * float(x[n])
         return WinchReport(
-            payout=self.drum.payout(self.phi, k),
-            payout_rate=radius * w,
+            rope_payout=self.drum.payout(self.phi, k),
+            rope_payout_rate=radius * w,
             drum_speed=w,
             drum_angle=self.phi,
-            layer=k + 1,
-            radius=radius,
+            drum_layer=k + 1,
+            drum_radius=radius,
             motor_speed=motor_speed,
             motor_torque=self.motor_torque(motor_speed),
             brake_torque=float(link[0]) + 0.0 if self.engaged else 0.0,
@@ -821,12 +825,12 @@ class KinetostaticWinch(_WinchBase):
         radius = self.drum.layer_radius(self.layer)
         brake, motor = self._brake_and_motor(omega)
         return WinchReport(
-            payout=self.drum.payout(phi, self.layer),
-            payout_rate=radius * omega,
+            rope_payout=self.drum.payout(phi, self.layer),
+            rope_payout_rate=radius * omega,
             drum_speed=omega,
             drum_angle=phi,
-            layer=self.layer + 1,
-            radius=radius,
+            drum_layer=self.layer + 1,
+            drum_radius=radius,
             motor_speed=self.motor_ratio * omega,
             motor_torque=motor / self.motor_ratio,
             brake_torque=brake + 0.0,

@@ -52,6 +52,7 @@ from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.report_outputs import ReportOutputs
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     HeldInputsUnit,
@@ -69,7 +70,6 @@ from wire_fmu.core.units.winch.model import (
     WinchConfig,
     WinchInputs,
     WinchModel,
-    WinchReport,
     build_winch,
     fastest_rate,
 )
@@ -251,6 +251,20 @@ def _outputs():
     )
 
 
+_REPORTED = ReportOutputs.of(
+    _outputs(),
+    finite=(
+        "rope.payout",
+        "rope.payout_rate",
+        "drum.speed",
+        "motor.torque",
+        "brake.torque",
+        "stored_energy",
+    ),
+)
+"""The outputs copied from the model's report, and those that must be finite."""
+
+
 class WinchUnit(HeldInputsUnit):
     """Winch (drawworks) with band brake, motor and drive train (SPEC sections 7-9)."""
 
@@ -416,39 +430,10 @@ class WinchUnit(HeldInputsUnit):
         ]
 
     def _update_outputs(self) -> None:
-        report: WinchReport = self._require_model().report()
-        out = self.values
-        out["rope.payout"] = report.payout
-        out["rope.payout_rate"] = report.payout_rate
-        out["drum.speed"] = report.drum_speed
-        out["drum.angle"] = report.drum_angle
-        out["drum.layer"] = report.layer
-        out["drum.radius"] = report.radius
-        out["motor.speed"] = report.motor_speed
-        out["motor.torque"] = report.motor_torque
-        out["brake.torque"] = report.brake_torque
-        out["brake.capacity"] = report.brake_capacity
-        out["brake.state"] = report.brake_state
-        out["stored_energy"] = report.stored_energy
-        out["dissipated_energy"] = report.dissipated_energy
-        out["external_work"] = report.external_work
-        out["energy_balance"] = (
-            report.stored_energy
-            - self.initial_energy
-            + report.dissipated_energy
-            - report.external_work
+        model = self._require_model()
+        _REPORTED.publish(
+            self.values, model.report(), self.initial_energy, model.mode_changes, self.instance_name
         )
-        out["mode_changes"] = int(self._require_model().mode_changes)
-        reals = (
-            report.payout,
-            report.payout_rate,
-            report.drum_speed,
-            report.motor_torque,
-            report.brake_torque,
-            report.stored_energy,
-        )
-        if not all(math.isfinite(x) for x in reals):
-            raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
 
 def _energy_solver_problems(method: str, effects: frozenset[str], chain: DriveChain) -> list[str]:
