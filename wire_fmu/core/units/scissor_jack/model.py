@@ -317,11 +317,7 @@ class JackInputs:
 
 @dataclass(frozen=True)
 class JackReport:
-    """Outputs of the jack at one instant (SI units).
-
-    Fields are named after the unit's outputs, dots as underscores
-    (:mod:`~wire_fmu.core.framework.report_outputs`).
-    """
+    """Outputs of the jack at one instant (SI units), each named as its output (``_`` for ``.``)."""
 
     handle_angle: float
     handle_speed: float

@@ -250,8 +250,7 @@ class WinchConfig:
 class WinchReport:
     """Every output quantity of a winch at one instant (units as in the FMU).
 
-    Fields are named after the unit's outputs, dots as underscores
-    (:mod:`~wire_fmu.core.framework.report_outputs`).
+    Each field feeds the unit's output of the same name, dots written as underscores.
     """
 
     rope_payout: float
