@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,8 +12,12 @@ from wire_fmu.core.units.block_train.reevings import drilling_block_train
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 
 from .block_train_helpers import make_unit
+from .facade_checks import (
+    assert_maps_every_declared_variable,
+    load_facade_class,
+    started_facade,
+)
 
-ROOT = Path(__file__).resolve().parents[1]
 INPUTS = [
     v.name for v in BlockTrainUnit.VARIABLES if v.causality is Causality.input and v.type is float
 ]
@@ -91,33 +93,16 @@ def test_evaluating_outputs_leaves_the_state_alone():
     assert json.dumps(unit.get_state()) == state
 
 
-def load_facade_class():
-    spec = importlib.util.spec_from_file_location(
-        "block_train_facade", ROOT / "models" / "block_train.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.BlockTrain
-
-
 def test_facade_maps_every_declared_variable():
-    facade = load_facade_class()(instance_name="bt", resources=None)
-    registered = {v.name: v for v in facade.vars.values()}
-    assert list(registered) == [v.name for v in BlockTrainUnit.VARIABLES]
-    for var in BlockTrainUnit.VARIABLES:
-        assert registered[var.name].causality.name == var.causality.value
-    assert facade.modelName == "BlockTrain"
+    facade = load_facade_class("block_train", "BlockTrain")(instance_name="bt", resources=None)
+    assert_maps_every_declared_variable(facade, BlockTrainUnit, "BlockTrain")
 
 
 def test_facade_steps_like_the_core():
     """Same inputs, same numbers: the facade adds nothing to the physics."""
-    facade = load_facade_class()(instance_name="bt", resources=None)
-    unit = make_unit(drilling_block_train(4), "rope_damping,sheave_inertia,bearing_friction")
-    refs = {v.name: v.value_reference for v in facade.vars.values()}
-    facade.set_string([refs["effects"]], ["rope_damping,sheave_inertia,bearing_friction"])
-    facade.setup_experiment(0.0, None, None)
-    facade.enter_initialization_mode()
-    facade.exit_initialization_mode()
+    effects = "rope_damping,sheave_inertia,bearing_friction"
+    facade, refs = started_facade(load_facade_class("block_train", "BlockTrain"), "bt", effects)
+    unit = make_unit(drilling_block_train(4), effects)
     for i in range(20):
         for target in (facade, None):
             if target is None:

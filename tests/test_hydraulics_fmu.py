@@ -3,10 +3,8 @@ without building an FMU."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-from pathlib import Path
 
 import pytest
 
@@ -15,9 +13,13 @@ from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 from wire_fmu.export.model_description import check_units
 
+from .facade_checks import (
+    assert_maps_every_declared_variable,
+    load_facade_class,
+    started_facade,
+)
 from .hydraulics_helpers import ALL_EFFECTS, make_free_rod, make_unit, run
 
-ROOT = Path(__file__).resolve().parents[1]
 OUTPUTS = [v for v in HydraulicsUnit.VARIABLES if v.causality is Causality.output]
 F0 = -4 * 356.0e3
 
@@ -166,32 +168,14 @@ def test_state_round_trip_is_bit_identical_on_an_end_stop():
     assert not unit.values["end_stop.contact"]  # it bounced off
 
 
-def load_facade_class():
-    spec = importlib.util.spec_from_file_location(
-        "hydraulics_facade", ROOT / "models" / "hydraulics.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.Hydraulics
-
-
 def test_facade_maps_every_declared_variable():
-    facade = load_facade_class()(instance_name="hyd", resources=None)
-    registered = {v.name: v for v in facade.vars.values()}
-    assert list(registered) == [v.name for v in HydraulicsUnit.VARIABLES]
-    for var in HydraulicsUnit.VARIABLES:
-        assert registered[var.name].causality.name == var.causality.value
-    assert facade.modelName == "Hydraulics"
+    facade = load_facade_class("hydraulics", "Hydraulics")(instance_name="hyd", resources=None)
+    assert_maps_every_declared_variable(facade, HydraulicsUnit, "Hydraulics")
 
 
 def test_facade_steps_like_the_core():
     """Same inputs, same numbers: the facade adds nothing to the physics."""
-    facade = load_facade_class()(instance_name="hyd", resources=None)
-    refs = {v.name: v.value_reference for v in facade.vars.values()}
-    facade.set_string([refs["effects"]], [ALL_EFFECTS])
-    facade.setup_experiment(0.0, None, None)
-    facade.enter_initialization_mode()
-    facade.exit_initialization_mode()
+    facade, refs = started_facade(load_facade_class("hydraulics", "Hydraulics"), "hyd", ALL_EFFECTS)
     unit = make_unit(ALL_EFFECTS)
     for i in range(30):
         force = F0 * (1 + 0.05 * math.sin(0.3 * i))

@@ -3,9 +3,7 @@ without building an FMU."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +13,13 @@ from wire_fmu.core.framework.unit import Causality
 from wire_fmu.core.units.winch.unit import WinchUnit
 from wire_fmu.export.model_description import check_units
 
+from .facade_checks import (
+    assert_maps_every_declared_variable,
+    load_facade_class,
+    started_facade,
+)
 from .winch_helpers import make_unit, run
 
-ROOT = Path(__file__).resolve().parents[1]
 INPUTS = [v.name for v in WinchUnit.VARIABLES if v.causality is Causality.input]
 OUTPUTS = [v for v in WinchUnit.VARIABLES if v.causality is Causality.output]
 ALL = "drum_inertia,band_brake,motor_characteristic,elastic_drive_train,rope_layers"
@@ -217,31 +219,15 @@ def test_non_finite_input_refuses_the_step():
     assert not result.success and "rope.tension" in result.message
 
 
-def load_facade_class():
-    spec = importlib.util.spec_from_file_location("winch_facade", ROOT / "models" / "winch.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.Winch
-
-
 def test_facade_maps_every_declared_variable():
-    facade = load_facade_class()(instance_name="w", resources=None)
-    registered = {v.name: v for v in facade.vars.values()}
-    assert list(registered) == [v.name for v in WinchUnit.VARIABLES]
-    for var in WinchUnit.VARIABLES:
-        assert registered[var.name].causality.name == var.causality.value
-    assert facade.modelName == "Winch"
+    facade = load_facade_class("winch", "Winch")(instance_name="w", resources=None)
+    assert_maps_every_declared_variable(facade, WinchUnit, "Winch")
 
 
 def test_facade_steps_like_the_core():
     """Same inputs, same numbers: the facade adds nothing to the physics."""
-    facade = load_facade_class()(instance_name="w", resources=None)
+    facade, refs = started_facade(load_facade_class("winch", "Winch"), "w", ALL)
     unit = make_unit(ALL)
-    refs = {v.name: v.value_reference for v in facade.vars.values()}
-    facade.set_string([refs["effects"]], [ALL])
-    facade.setup_experiment(0.0, None, None)
-    facade.enter_initialization_mode()
-    facade.exit_initialization_mode()
     names = ["rope.tension", "brake.lever_force", "motor.command"]
     for i in range(20):
         values = [1.2e5, 800.0 if i > 10 else 0.0, -400.0]
