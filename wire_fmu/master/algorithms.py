@@ -42,6 +42,19 @@ class CouplingAlgorithm(ABC):
 
         ``fresh`` (iteration) maps source outputs to their values at ``t + h``
         from the previous sweep; without it values are extrapolated.
+
+        Parameters
+        ----------
+        sim : Simulation
+            The simulation whose units are stepped (through its
+            ``set_inputs``, ``step_unit`` and ``read_sources``).
+        t : float
+            Start of the macro step, s.
+        h : float
+            Macro step, s.
+        fresh : dict of str to float, optional
+            Source outputs (``"unit.variable"``) at ``t + h`` from the previous
+            sweep, in their units.
         """
 
 
@@ -51,7 +64,7 @@ class Jacobi(CouplingAlgorithm):
     name = "jacobi"
 
     def sweep(self, sim, t, h, fresh=None):
-        """See :meth:`CouplingAlgorithm.sweep`."""
+        """Parameters and contract as in :meth:`CouplingAlgorithm.sweep`."""
         for unit in self.order:
             sim.set_inputs(unit, t, h, fresh)
         for unit in self.order:
@@ -64,7 +77,7 @@ class GaussSeidel(CouplingAlgorithm):
     name = "gauss_seidel"
 
     def sweep(self, sim, t, h, fresh=None):
-        """See :meth:`CouplingAlgorithm.sweep`."""
+        """Parameters and contract as in :meth:`CouplingAlgorithm.sweep`."""
         new = dict(fresh or {})
         for unit in self.order:
             sim.set_inputs(unit, t, h, new)
@@ -118,7 +131,19 @@ ALGORITHMS = {"jacobi": Jacobi, "gauss_seidel": GaussSeidel}
 
 
 def make_algorithm(name: str, order: Sequence[str]) -> CouplingAlgorithm:
-    """The algorithm called ``name`` (raises ValueError naming the known ones)."""
+    """The algorithm called ``name`` (raises ValueError naming the known ones).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`ALGORITHMS`: ``"jacobi"`` or ``"gauss_seidel"``.
+    order : sequence of str
+        The units in the order they step (see :func:`step_order`).
+
+    Returns
+    -------
+    CouplingAlgorithm
+    """
     try:
         return ALGORITHMS[name](order)
     except KeyError:

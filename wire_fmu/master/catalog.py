@@ -29,7 +29,13 @@ OUR_FMUS = MappingProxyType({u.name: u.facade for u in UNIT_TYPES})
 
 
 def is_ours(fmu: str) -> bool:
-    """Whether a scene's ``fmu`` names one of our units."""
+    """Whether a scene's ``fmu`` names one of our units.
+
+    Parameters
+    ----------
+    fmu : str
+        A unit's ``fmu`` entry: a model name or a path.
+    """
     return fmu in OUR_FMUS
 
 
@@ -38,7 +44,22 @@ def resolve_fmu(
 ) -> tuple[Path | None, str | None]:
     """The FMU file for a scene's ``fmu`` entry, building ours if needed.
 
-    Returns ``(path, None)`` or ``(None, problem)``.
+    Parameters
+    ----------
+    fmu : str
+        A unit's ``fmu`` entry: one of :data:`OUR_FMUS` or a path to a
+        ``.fmu`` file.
+    base_dir : Path
+        Folder of the scene file; a relative path is found there.
+    fmu_dir : Path
+        Folder our FMUs are built into and reused from.
+
+    Returns
+    -------
+    path : Path or None
+        The FMU file; None if there is a problem.
+    problem : str or None
+        What is wrong with the entry; None if ``path`` is given.
     """
     if is_ours(fmu):
         script = BY_NAME[fmu].facade_path
@@ -75,7 +96,22 @@ def _recorded_fingerprint(path: Path) -> str | None:
 
 
 def ensure_built(name: str, script: Path, fmu_dir: Path) -> Path:
-    """Path of our FMU ``name``, (re)built from ``script`` if missing or stale."""
+    """Path of our FMU ``name``, (re)built from ``script`` if missing or stale.
+
+    Parameters
+    ----------
+    name : str
+        Model name, one of :data:`OUR_FMUS`.
+    script : Path
+        Its facade script.
+    fmu_dir : Path
+        Folder the FMU is built into (created if missing).
+
+    Returns
+    -------
+    Path
+        ``fmu_dir / "<name>.fmu"``, built with the core this process imported.
+    """
     from wire_fmu.export.builder import build_fmu
 
     path = fmu_dir / f"{name}.fmu"

@@ -119,6 +119,17 @@ class EnergyGuard:
         their units (a break, slack to taut, stick to slip): an effort that jumps
         inside a step cannot be held right, so its residual counts in ``created``
         but not in ``error``.
+
+        Parameters
+        ----------
+        residuals : mapping of str to float
+            Energy each bond's coupling created over the step, by bond name, J.
+        powers : mapping of str to float
+            Power each bond transmitted over the step, by bond name, W.
+        h : float
+            The macro step, s.
+        across_events : collection of str
+            Names of the bonds whose step crossed a mode event.
         """
         for name, residual in residuals.items():
             bond = self.bonds[name]
@@ -128,7 +139,13 @@ class EnergyGuard:
                 bond.error += abs(residual)
 
     def limit(self, name: str) -> float:
-        """Energy error at which bond ``name`` stops the run now, J."""
+        """Energy error at which bond ``name`` stops the run now, J.
+
+        Parameters
+        ----------
+        name : str
+            The bond's name.
+        """
         return max(self.share * self.bonds[name].carried, self.floor)
 
     def blow_up(self, t: float, h: float) -> str | None:

@@ -37,7 +37,15 @@ class History:
         self.points: deque[tuple[float, float]] = deque(maxlen=size)
 
     def push(self, t: float, value: float) -> None:
-        """Record the value at an accepted step end."""
+        """Record the value at an accepted step end.
+
+        Parameters
+        ----------
+        t : float
+            Time of the step end, s; a time not after the newest replaces it.
+        value : float
+            The output's value there, in its unit.
+        """
         if self.points and t <= self.points[-1][0]:
             self.points[-1] = (t, value)
         else:

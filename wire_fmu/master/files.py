@@ -30,7 +30,13 @@ class UnreadableFileError(ValueError):
 
 
 def file_kind(mode: int) -> str:
-    """What a file of ``st_mode`` ``mode`` is, in words ("a directory", ...)."""
+    """What a file of ``st_mode`` ``mode`` is, in words ("a directory", ...).
+
+    Parameters
+    ----------
+    mode : int
+        ``st_mode`` from :func:`os.stat`.
+    """
     for test, kind in _KINDS:
         if test(mode):
             return kind
@@ -39,6 +45,16 @@ def file_kind(mode: int) -> str:
 
 def open_regular(path: Path | str) -> BinaryIO:
     """``path`` opened for reading in binary mode, if it is a regular file.
+
+    Parameters
+    ----------
+    path : Path or str
+        The file.
+
+    Returns
+    -------
+    BinaryIO
+        The open file; the caller closes it.
 
     Raises
     ------
@@ -63,6 +79,13 @@ def open_regular(path: Path | str) -> BinaryIO:
 
 def read_regular(path: Path | str, limit: int) -> bytes:
     """All bytes of a regular file of at most ``limit`` bytes.
+
+    Parameters
+    ----------
+    path : Path or str
+        The file.
+    limit : int
+        Largest size read, bytes.
 
     Raises
     ------

@@ -49,7 +49,24 @@ class DriverSet:
             self._by_unit[d.target.unit].append(_Driven(driver, d.target, d.rate_target))
 
     def values(self, unit: str, t: float, h: float | None) -> dict[str, float]:
-        """Input values of ``unit`` for the step ``[t, t + h]`` (``h`` None: at ``t``)."""
+        """Input values of ``unit`` for the step ``[t, t + h]`` (``h`` None: at ``t``).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        t : float
+            Start of the step, s.
+        h : float or None
+            The step, s; None (or 0) gives the values and rates at ``t``.
+
+        Returns
+        -------
+        dict of str to float
+            Value of each driven input by variable name, in its unit: a
+            driver's value at the step's midpoint, or, with a rate input, the
+            value at ``t`` and the step's mean rate.
+        """
         out = {}
         for d in self._by_unit.get(unit, ()):
             if d.rate is None:
@@ -75,7 +92,13 @@ class ScheduledEvents:
         return self._pending[0].time if self._pending else None
 
     def fire_due(self, t: float) -> list[str]:
-        """Apply every event due at or before ``t``; return their labels."""
+        """Apply every event due at or before ``t``; return their labels.
+
+        Parameters
+        ----------
+        t : float
+            Time reached, s.
+        """
         fired = []
         while self._pending and self._pending[0].time <= t + 1e-12:
             event = self._pending.pop(0)
@@ -85,5 +108,16 @@ class ScheduledEvents:
         return fired
 
     def values(self, unit: str) -> dict[str, Any]:
-        """Input values the events so far impose on ``unit``."""
+        """Input values the events so far impose on ``unit``.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        dict of str to object
+            Value by variable name (a number, a boolean or text).
+        """
         return {ref.variable: v for ref, v in self._active.items() if ref.unit == unit}

@@ -51,13 +51,33 @@ class Observer(Protocol):
     """Reads the simulation; never changes it."""
 
     def on_start(self, sim: Simulation) -> None:
-        """Called after initialisation, at the start time."""
+        """Called after initialisation, at the start time.
+
+        Parameters
+        ----------
+        sim : Simulation
+            The simulation, initialised; read it, never change it.
+        """
 
     def on_step(self, sim: Simulation) -> None:
-        """Called after every accepted macro step."""
+        """Called after every accepted macro step.
+
+        Parameters
+        ----------
+        sim : Simulation
+            The simulation at the end of the step (``sim.time``, s).
+        """
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Called once at the end, also after a failure or an interruption."""
+        """Called once at the end, also after a failure or an interruption.
+
+        Parameters
+        ----------
+        sim : Simulation
+            The simulation where it ended.
+        result : RunResult
+            How it ended.
+        """
 
 
 class CsvRecorder:
@@ -84,7 +104,10 @@ class CsvRecorder:
 
     # -- observer protocol -----------------------------------------------------
     def on_start(self, sim: Simulation) -> None:
-        """Open the file, write the header and the initial row."""
+        """Open the file, write the header and the initial row.
+
+        Parameters as in :meth:`Observer.on_start`.
+        """
         self.directory.mkdir(parents=True, exist_ok=True)
         self._plan = self._recorded(sim)
         self.columns = ["time"] + [f"{u}.{n}" for u, names in self._plan.items() for n in names]
@@ -101,12 +124,18 @@ class CsvRecorder:
         self._row(sim)
 
     def on_step(self, sim: Simulation) -> None:
-        """Record when the next output time is reached."""
+        """Record when the next output time is reached.
+
+        Parameters as in :meth:`Observer.on_step`.
+        """
         if self.interval is None or sim.time >= self._next - 1e-9 * max(1.0, self._next):
             self._row(sim)
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Close the file and write the summary into the metadata (also after a failure)."""
+        """Close the file and write the summary into the metadata (also after a failure).
+
+        Parameters as in :meth:`Observer.on_end`.
+        """
         if self._file is not None:
             self._file.close()
             self._file = None
@@ -221,18 +250,27 @@ class Progress:
         self._start = 0.0
 
     def on_start(self, sim: Simulation) -> None:
-        """Start the clock."""
+        """Start the clock.
+
+        Parameters as in :meth:`Observer.on_start`.
+        """
         self._start = time.perf_counter()
 
     def on_step(self, sim: Simulation) -> None:
-        """Redraw at most every ``every`` seconds."""
+        """Redraw at most every ``every`` seconds.
+
+        Parameters as in :meth:`Observer.on_step`.
+        """
         now = time.perf_counter()
         if now - self._last >= self.every:
             self._last = now
             self._draw(sim, now)
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Final state of the bar."""
+        """Final state of the bar.
+
+        Parameters as in :meth:`Observer.on_end`.
+        """
         self._draw(sim, time.perf_counter())
         self.stream.write("\n")
         self.stream.flush()
@@ -251,7 +289,21 @@ class Progress:
 
 
 def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
-    """Key figures of a finished run, for a summary table."""
+    """Key figures of a finished run, for a summary table.
+
+    Parameters
+    ----------
+    sim : Simulation
+        The simulation that ran.
+    result : RunResult
+        How it ended.
+
+    Returns
+    -------
+    list of (str, str)
+        Label and text of each figure: status, times, steps, each bond's energy
+        residual, each unit's FMI calls.
+    """
     rows = [
         ("status", result.status),
         ("simulated", f"{result.end_time:.6g} s"),

@@ -18,7 +18,19 @@ logger = logging.getLogger(__name__)
 
 
 def read_results(csv_path: Path) -> dict[str, np.ndarray]:
-    """Columns of a results file as float arrays, by name (a text cell reads as NaN)."""
+    """Columns of a results file as float arrays, by name (a text cell reads as NaN).
+
+    Parameters
+    ----------
+    csv_path : Path
+        A ``timeseries.csv`` written by :class:`~wire_fmu.master.observers.CsvRecorder`.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Each column by its header (``"time"`` in s, ``"unit.variable"`` in the
+        variable's unit), shape (rows,).
+    """
     with Path(csv_path).open(newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], rows[1:]
@@ -70,7 +82,22 @@ def _file_names(titles: list[str], taken: set[str]) -> list[str]:
 
 
 def plot_scene(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
-    """One PNG per scene plot, plus the energy channels; returns the files."""
+    """One PNG per scene plot, plus the energy channels; returns the files.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene that ran (its ``plots``).
+    csv_path : Path
+        Its results file.
+    directory : Path
+        Folder the PNG files are written into.
+
+    Returns
+    -------
+    list of Path
+        The PNG files written.
+    """
     columns = read_results(csv_path)
     time = columns["time"]
     written = []

@@ -45,6 +45,11 @@ def shipped_scenes() -> dict[str, Path]:
 def find_scene(name_or_path: str | Path) -> Path:
     """The scene file for a shipped name or a path.
 
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A shipped scene's name (see :func:`shipped_scenes`) or a scene file.
+
     Raises
     ------
     SceneError
@@ -65,7 +70,18 @@ def find_scene(name_or_path: str | Path) -> Path:
 
 
 def load_scene_file(path: Path) -> Scene:
-    """A scene file (TOML) or an SSP package (``.ssp``, see :mod:`wire_fmu.interop.ssp_read`)."""
+    """A scene file (TOML) or an SSP package (``.ssp``, see :mod:`wire_fmu.interop.ssp_read`).
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+
+    Raises
+    ------
+    SceneError
+        Listing every problem of the scene's data.
+    """
     scene, problems = read_scene_file(path)
     if problems:
         raise SceneError(f"scene {scene.name!r}" if scene else str(path), problems)
@@ -73,7 +89,20 @@ def load_scene_file(path: Path) -> Scene:
 
 
 def read_scene_file(path: Path) -> tuple[Scene | None, list[str]]:
-    """A scene file or an SSP package and its problems (see :func:`~.scene.read_scene`)."""
+    """A scene file or an SSP package and its problems (see :func:`~.scene.read_scene`).
+
+    Parameters
+    ----------
+    path : Path
+        A scene file (TOML) or an SSP package (``.ssp``).
+
+    Returns
+    -------
+    scene : Scene or None
+        The scene (None if it cannot be read at all).
+    problems : list of str
+        Every problem of its data; empty if none.
+    """
     if Path(path).suffix.lower() == ".ssp":
         from wire_fmu.interop.ssp_read import read_ssp
 
@@ -92,6 +121,20 @@ def check_scene(
     The scene's data, its structure against the units' model descriptions,
     each unit's own check of its parameters and (``dry_run``) the
     initialisation of every unit as a run does it.
+
+    Parameters
+    ----------
+    scene : str, Path or Scene
+        A shipped scene's name, a scene file or SSP package, or a parsed scene.
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+    dry_run : bool
+        Also instantiate and initialise every unit as a run does.
+
+    Returns
+    -------
+    Scene
+        The scene, checked.
 
     Raises
     ------
@@ -121,7 +164,21 @@ class Outcome:
 
 
 def with_run_settings(scene: Scene, **changes) -> Scene:
-    """A copy of ``scene`` with some run settings replaced (checked like the file's)."""
+    """A copy of ``scene`` with some run settings replaced (checked like the file's).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    **changes
+        Run settings by name (see :class:`~.scene.RunSettings`), e.g.
+        ``stop_time=5.0`` (s); a None value keeps the scene's setting.
+
+    Raises
+    ------
+    SceneError
+        Listing every problem of the new settings.
+    """
     from .scene.checks import _check_run
 
     settings = replace(scene.run, **{k: v for k, v in changes.items() if v is not None})
@@ -160,6 +217,11 @@ def run_scene(
         More observers (see :class:`~wire_fmu.master.observers.Observer`).
     **run_overrides
         Replace run settings of the scene, e.g. ``stop_time=5.0`` for a quick run.
+
+    Returns
+    -------
+    Outcome
+        The scene run, its result, the results folder and files, the simulation.
     """
     if not isinstance(scene, Scene):
         scene = load_scene_file(find_scene(scene))
@@ -180,6 +242,16 @@ def run_scene(
 
 def make_results_folder(directory: Path) -> Path:
     """Create ``directory`` (and its parents) for results, or say why it cannot be.
+
+    Parameters
+    ----------
+    directory : Path
+        The results folder.
+
+    Returns
+    -------
+    Path
+        ``directory``.
 
     Raises
     ------

@@ -139,7 +139,13 @@ class Slave:
         return out
 
     def vr(self, name: str) -> int:
-        """Value reference of ``name``."""
+        """Value reference of ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A variable of the FMU's model description.
+        """
         return self.variables[name].valueReference
 
     # -- life cycle ------------------------------------------------------------
@@ -196,7 +202,17 @@ class Slave:
             self._unzipdir = None
 
     def initialize(self, start_time: float, values: dict[str, Any], inputs_first=None) -> None:
-        """Set ``values`` (parameters, start inputs), then enter initialisation mode."""
+        """Set ``values`` (parameters, start inputs), then enter initialisation mode.
+
+        Parameters
+        ----------
+        start_time : float
+            Start of the experiment, s.
+        values : dict of str to object
+            Start values by variable name, each checked against its type.
+        inputs_first : optional
+            Unused (no caller passes it).
+        """
         self._call("setupExperiment", startTime=start_time)
         self.set_many(values)
         self._call("enterInitializationMode")
@@ -235,7 +251,20 @@ class Slave:
 
     # -- values ------------------------------------------------------------------
     def set_many(self, values: dict[str, Any]) -> None:
-        """Set variables by name, grouped by type."""
+        """Set variables by name, grouped by type.
+
+        Parameters
+        ----------
+        values : dict of str to object
+            Value by variable name, in the variable's unit: a number, a
+            boolean or text as the variable's type takes (checked, see
+            :func:`value_problem`; a float for a Real is passed as is).
+
+        Raises
+        ------
+        UnitFailedError
+            For an unknown variable, a value its type cannot take, or an FMI error.
+        """
         groups: dict[str, tuple[list[int], list[Any]]] = defaultdict(lambda: ([], []))
         for name, value in values.items():
             var = self.variables.get(name)
@@ -256,16 +285,46 @@ class Slave:
             self._call(f"set{kind}", refs, vals)
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
-        """Fast path: set Reals by value reference."""
+        """Fast path: set Reals by value reference.
+
+        Parameters
+        ----------
+        refs : sequence of int
+            Value references (see :meth:`vr`).
+        values : sequence of float
+            A value for each, in the variable's unit.
+        """
         if refs:
             self._call("setReal", list(refs), list(values))
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:
-        """Fast path: get Reals by value reference."""
+        """Fast path: get Reals by value reference.
+
+        Parameters
+        ----------
+        refs : sequence of int
+            Value references (see :meth:`vr`).
+
+        Returns
+        -------
+        list of float
+            A value for each, in the variable's unit.
+        """
         return self._call("getReal", list(refs)) if refs else []
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
-        """Values of variables by name."""
+        """Values of variables by name.
+
+        Parameters
+        ----------
+        names : iterable of str
+            Variables of the FMU.
+
+        Returns
+        -------
+        dict of str to object
+            Each value by name, of the variable's type and in its unit.
+        """
         out = {}
         by_type: dict[str, list[str]] = defaultdict(list)
         for name in names:
@@ -278,6 +337,13 @@ class Slave:
     # -- stepping and state ---------------------------------------------------------
     def do_step(self, t: float, h: float) -> None:
         """One communication step.
+
+        Parameters
+        ----------
+        t : float
+            Current communication point, s.
+        h : float
+            Communication step size, s.
 
         Raises
         ------
@@ -308,11 +374,23 @@ class Slave:
         return self._call("getFMUstate")
 
     def set_state(self, state: object) -> None:
-        """Restore a saved FMU state."""
+        """Restore a saved FMU state.
+
+        Parameters
+        ----------
+        state : object
+            A state from :meth:`get_state`, not yet freed.
+        """
         self._call("setFMUstate", state)
 
     def free_state(self, state: object) -> None:
-        """Free a saved FMU state."""
+        """Free a saved FMU state.
+
+        Parameters
+        ----------
+        state : object
+            A state from :meth:`get_state`; not used again.
+        """
         self._call("freeFMUstate", state)
 
     def _call(self, fn: str, *args, **kwargs):
@@ -348,6 +426,18 @@ def value_problem(variable, value) -> str | None:
 
     No value is converted silently: a Real takes a finite number, an Integer
     a whole number within 32 bits, a Boolean true or false, a String text.
+
+    Parameters
+    ----------
+    variable : fmpy.model_description.ScalarVariable
+        The variable (its ``type`` and ``causality``).
+    value : object
+        The value to set.
+
+    Returns
+    -------
+    str or None
+        The problem, e.g. ``"expected a finite number (Real)"``; None if none.
     """
     kind = variable.type
     if kind == "Real":

@@ -45,7 +45,13 @@ class Structure:
     descriptions: dict[str, object]
 
     def variable(self, ref: VarRef):
-        """The model variable ``ref`` names, or None."""
+        """The model variable ``ref`` names, or None.
+
+        Parameters
+        ----------
+        ref : VarRef
+            ``unit.variable``.
+        """
         md = self.descriptions.get(ref.unit)
         if md is None:
             return None
@@ -55,7 +61,18 @@ class Structure:
         return None
 
     def dependencies(self, unit: str) -> dict[str, list[str]]:
-        """Each output's direct-feedthrough inputs (all inputs when undeclared)."""
+        """Each output's direct-feedthrough inputs (all inputs when undeclared).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        dict of str to list of str
+            The inputs each output depends on directly, by output name.
+        """
         md = self.descriptions[unit]
         inputs = [v.name for v in md.modelVariables if v.causality == "input"]
         out = {}
@@ -66,7 +83,22 @@ class Structure:
 
 
 def resolve_units(scene: Scene, fmu_dir: Path = DEFAULT_FMU_DIR) -> tuple[Structure, list[str]]:
-    """Find (and build) every unit's FMU and read its model description."""
+    """Find (and build) every unit's FMU and read its model description.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+
+    Returns
+    -------
+    structure : Structure
+        The units found, by name (those with a problem left out).
+    problems : list of str
+        Each unit whose FMU cannot be found, built or read, and why.
+    """
     problems, paths, descriptions = [], {}, {}
     for name, spec in scene.units.items():
         path, problem = resolve_fmu(spec.fmu, scene.base_dir, fmu_dir)
@@ -167,7 +199,20 @@ def _bond_problems(scene: Scene, structure: Structure) -> list[str]:
 
 
 def feedthrough_loops(scene: Scene, structure: Structure) -> list[list[str]]:
-    """Cycles of the signal graph through direct feedthrough (algebraic loops)."""
+    """Cycles of the signal graph through direct feedthrough (algebraic loops).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its connections).
+    structure : Structure
+        Its units' model descriptions (their outputs' dependencies).
+
+    Returns
+    -------
+    list of list of str
+        Each loop as the ``"unit.variable"`` names along it.
+    """
     graph: dict[str, list[str]] = defaultdict(list)
     for c in scene.all_connections:
         graph[str(c.source)].append(str(c.target))
@@ -266,7 +311,15 @@ def _short(value) -> str:
 
 
 def check_structure(scene: Scene, structure: Structure) -> list[str]:
-    """Every structural problem of ``scene`` (empty when sound)."""
+    """Every structural problem of ``scene`` (empty when sound).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    structure : Structure
+        Its units' model descriptions.
+    """
     problems = unknown_unit_problems(scene)  # also for scenes not read from a file (sweeps)
     problems += _connection_problems(scene, structure) + _bond_problems(scene, structure)
     for loop in feedthrough_loops(scene, structure):
@@ -281,7 +334,20 @@ def check_structure(scene: Scene, structure: Structure) -> list[str]:
 
 
 def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
-    """Instantiate each unit with its parameters and enter initialisation mode."""
+    """Instantiate each unit with its parameters and enter initialisation mode.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    structure : Structure
+        Its units' FMU files.
+
+    Returns
+    -------
+    list of str
+        What each unit that failed said, naming the unit.
+    """
     from .slave import Slave, UnitFailedError
 
     problems = []
@@ -300,14 +366,37 @@ def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
 
 
 def unit_messages(name: str, slave, exc: Exception) -> list[str]:
-    """What a unit said when it failed, each message once, naming the unit."""
+    """What a unit said when it failed, each message once, naming the unit.
+
+    Parameters
+    ----------
+    name : str
+        Instance name of the unit in the scene.
+    slave : Slave
+        The unit (its logged messages).
+    exc : Exception
+        The error it failed with (its text, when the unit said nothing).
+    """
     said = list(dict.fromkeys(slave.messages.kept)) or [str(exc)]
     return [m if m.startswith(f"unit {name!r}") else f"unit {name!r}: {m}" for m in said]
 
 
 def dry_initialization(scene: Scene, structure: Structure) -> list[str]:
     """Initialise every unit exactly as a run does (connected start values, drivers, events at
-    the start time), then free them: what a run would refuse before its first step."""
+    the start time), then free them: what a run would refuse before its first step.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene, without structural problems.
+    structure : Structure
+        Its units' FMU files and model descriptions.
+
+    Returns
+    -------
+    list of str
+        What the unit that failed said; empty if all initialised.
+    """
     from .simulation import Simulation
     from .slave import StepRefusedError, UnitFailedError
 
@@ -325,7 +414,20 @@ def dry_initialization(scene: Scene, structure: Structure) -> list[str]:
 
 
 def unit_start_values(spec, slave) -> dict:
-    """Parameters (and the effects list of ours) as FMI values for ``slave``."""
+    """Parameters (and the effects list of ours) as FMI values for ``slave``.
+
+    Parameters
+    ----------
+    spec : UnitSpec
+        The unit in the scene.
+    slave : Slave
+        The unit's FMU (whether it has an ``effects`` parameter).
+
+    Returns
+    -------
+    dict of str to object
+        Start value by variable name.
+    """
     values = spec.parameter_values()
     if spec.effects or is_ours(spec.fmu):
         if "effects" in slave.variables:
@@ -357,6 +459,11 @@ def validate_scene(
         (:func:`dry_initialization`); ``wire-fmu check`` does.
     problems : sequence of str
         Problems already found in the scene's data, reported with the rest.
+
+    Returns
+    -------
+    Structure
+        The units' FMU files and model descriptions.
     """
     found = list(problems)
     structure, unresolved = resolve_units(scene, fmu_dir)

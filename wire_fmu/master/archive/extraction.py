@@ -86,7 +86,13 @@ def _remove(folder: Path) -> None:
 
 
 def remove_extracted(folder: Path | str | None) -> None:
-    """Remove a folder made by :func:`extract_temporary` (nothing if None or gone)."""
+    """Remove a folder made by :func:`extract_temporary` (nothing if None or gone).
+
+    Parameters
+    ----------
+    folder : Path or str or None
+        The folder :func:`extract_temporary` returned.
+    """
     if folder is not None:
         _remove(Path(folder))
 

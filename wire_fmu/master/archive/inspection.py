@@ -60,6 +60,18 @@ def _digest(handle: IO[bytes]) -> str:
 def archive_digest(path: Path, *, what: str = "archive") -> str:
     """SHA-256 (hex) of the archive file ``path``, read in chunks.
 
+    Parameters
+    ----------
+    path : Path
+        The archive.
+    what : str
+        What the archive is, for messages: "FMU", "package".
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+
     Raises
     ------
     ArchiveError
@@ -196,6 +208,23 @@ def check_member_size(path: Path, member: str, max_bytes: int, *, what: str = "a
     of an FMU): its declared size must not exceed ``max_bytes``. A member
     that is missing or an archive that cannot be opened is not reported
     here (the reader says what is wrong).
+
+    Parameters
+    ----------
+    path : Path
+        The archive.
+    member : str
+        The member's name in the archive, e.g. ``"modelDescription.xml"``.
+    max_bytes : int
+        Largest uncompressed size allowed, bytes.
+    what : str
+        What the archive is, for messages: "FMU", "package".
+
+    Returns
+    -------
+    str
+        The problem, e.g. ``"its modelDescription.xml expands to 300 MiB, more
+        than the 256 MiB allowed"``; empty if none.
     """
     try:
         with _open_regular(Path(path), f"{what} {path}") as handle, zipfile.ZipFile(handle) as z:

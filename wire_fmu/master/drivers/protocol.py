@@ -20,11 +20,35 @@ class Driver(Protocol):
     """
 
     def value(self, t: float) -> float:
-        """Signal at time ``t`` (s), in the driven input's unit."""
+        """Signal at time ``t`` (s), in the driven input's unit.
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+
+        Returns
+        -------
+        float or ndarray
+            The signal, in the driven input's unit: a float for a float time,
+            an array of the same shape for an array of times.
+        """
         ...
 
     def rate(self, t: float) -> float:
-        """Time derivative of :meth:`value` at ``t``, input unit per s."""
+        """Time derivative of :meth:`value` at ``t``, input unit per s.
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+
+        Returns
+        -------
+        float or ndarray
+            The rate, the driven input's unit per s: a float for a float time,
+            an array of the same shape for an array of times.
+        """
         ...
 
 

@@ -134,13 +134,19 @@ class SeaStateDriver:
         return out.reshape(tau.shape)
 
     def value(self, t: float) -> float:
-        """Heave at ``t`` (s), m."""
+        """Heave at ``t`` (s), m.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
+        """
         weight, _ = _fade(t, self.start_time, self.ramp_time)
         wave = self._sum(t, np.cos, self.amplitudes)
         return _out(self.heave_rao * weight * wave, t)
 
     def rate(self, t: float) -> float:
-        """Heave velocity at ``t`` (s), m/s."""
+        """Heave velocity at ``t`` (s), m/s.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.rate`.
+        """
         weight, weight_rate = _fade(t, self.start_time, self.ramp_time)
         wave_rate = -self._sum(t, np.sin, self.amplitudes * self.angular_frequencies)
         rate = weight * wave_rate

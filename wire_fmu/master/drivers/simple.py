@@ -25,11 +25,17 @@ class ConstantDriver:
     constant: float
 
     def value(self, t: float) -> float:
-        """The constant (input unit)."""
+        """The constant (input unit).
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
+        """
         return _out(np.full(np.shape(t), self.constant), t)
 
     def rate(self, t: float) -> float:
-        """Zero (input unit per s)."""
+        """Zero (input unit per s).
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.rate`.
+        """
         return _out(np.zeros(np.shape(t)), t)
 
 
@@ -68,11 +74,17 @@ class PiecewiseLinearDriver:
         object.__setattr__(self, "slopes", slopes)
 
     def value(self, t: float) -> float:
-        """Interpolated value at ``t`` (s), input unit."""
+        """Interpolated value at ``t`` (s), input unit.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
+        """
         return _out(np.interp(t, self.times, self.values), t)
 
     def rate(self, t: float) -> float:
-        """Slope of the segment starting at or before ``t``; 0 outside, input unit per s."""
+        """Slope of the segment starting at or before ``t``; 0 outside, input unit per s.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.rate`.
+        """
         slopes = self.slopes
         k = np.searchsorted(self.times, t, side="right") - 1
         inside = (k >= 0) & (k < len(slopes))
@@ -112,12 +124,18 @@ class SineDriver:
         return weight, weight_rate, self.amplitude * np.sin(arg), arg
 
     def value(self, t: float) -> float:
-        """Signal at ``t`` (s), input unit."""
+        """Signal at ``t`` (s), input unit.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
+        """
         weight, _, wave, _ = self._parts(t)
         return _out(self.offset + weight * wave, t)
 
     def rate(self, t: float) -> float:
-        """Time derivative at ``t``, input unit per s."""
+        """Time derivative at ``t``, input unit per s.
+
+        Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.rate`.
+        """
         weight, weight_rate, wave, arg = self._parts(t)
         wave_rate = self.amplitude * self.angular_frequency * np.cos(arg)
         return _out(weight_rate * wave + weight * wave_rate, t)

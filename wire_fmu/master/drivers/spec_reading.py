@@ -56,11 +56,23 @@ class _Reader:
         self.problems: list[str] = []
 
     def add(self, text: str) -> None:
-        """Record a problem, prefixed with where it is."""
+        """Record a problem, prefixed with where it is.
+
+        Parameters
+        ----------
+        text : str
+            The problem, e.g. ``"'period' must be > 0 s, got -1"``.
+        """
         self.problems.append(f"{self.where}: {text}")
 
     def has(self, key: str) -> bool:
-        """Whether the table sets ``key``."""
+        """Whether the table sets ``key``.
+
+        Parameters
+        ----------
+        key : str
+            A key of the driver table.
+        """
         return key in self.spec
 
     def number(
@@ -72,7 +84,21 @@ class _Reader:
         minimum: float | None = None,
         positive: bool = False,
     ) -> float:
-        """A finite number (NaN after a problem); ``default`` None means required."""
+        """A finite number (NaN after a problem); ``default`` None means required.
+
+        Parameters
+        ----------
+        key : str
+            A key of the driver table.
+        default : float, optional
+            Value when the key is absent; None makes the key required.
+        unit : str
+            Unit of the number, for problems (``"s"``, ``"m"``, ``"Hz"``).
+        minimum : float, optional
+            Smallest value allowed, in ``unit``.
+        positive : bool
+            Whether the value must be > 0.
+        """
         if key not in self.spec:
             if default is None:
                 self.add(f"'{key}' is required")
@@ -94,7 +120,19 @@ class _Reader:
         return value
 
     def integer(self, key: str, default: int, *, minimum: int, maximum: int | None = None) -> int:
-        """An integer in [``minimum``, ``maximum``] (``default`` after a problem)."""
+        """An integer in [``minimum``, ``maximum``] (``default`` after a problem).
+
+        Parameters
+        ----------
+        key : str
+            A key of the driver table.
+        default : int
+            Value when the key is absent or wrong.
+        minimum : int
+            Smallest value allowed.
+        maximum : int, optional
+            Largest value allowed (None: no bound).
+        """
         raw = self.spec.get(key, default)
         if not isinstance(raw, int) or isinstance(raw, bool):
             self.add(f"'{key}' must be an integer, got {_show(raw)}")
@@ -108,7 +146,17 @@ class _Reader:
         return raw
 
     def choice(self, key: str, default: str, choices: Collection[str]) -> str:
-        """One of ``choices`` (``default`` after a problem)."""
+        """One of ``choices`` (``default`` after a problem).
+
+        Parameters
+        ----------
+        key : str
+            A key of the driver table.
+        default : str
+            Value when the key is absent or wrong.
+        choices : collection of str
+            The values allowed.
+        """
         raw = self.spec.get(key, default)
         if not isinstance(raw, str) or raw not in choices:
             hint = _close_hint(raw, choices) if isinstance(raw, str) else ""
@@ -117,7 +165,15 @@ class _Reader:
         return raw
 
     def text(self, key: str, default: str | None = None) -> str:
-        """A non-empty string ('' after a problem)."""
+        """A non-empty string ('' after a problem).
+
+        Parameters
+        ----------
+        key : str
+            A key of the driver table.
+        default : str, optional
+            Value when the key is absent; None makes the key required.
+        """
         raw = self.spec.get(key, default)
         if raw is None:
             self.add(f"'{key}' is required")
@@ -128,7 +184,13 @@ class _Reader:
         return raw
 
     def unknown_keys(self, allowed: Collection[str]) -> None:
-        """Report keys the kind does not know."""
+        """Report keys the kind does not know.
+
+        Parameters
+        ----------
+        allowed : collection of str
+            The keys the driver's kind reads, ``kind`` included.
+        """
         for key in self.spec:
             if key not in allowed:
                 hint = _close_hint(str(key), allowed)
