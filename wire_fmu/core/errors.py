@@ -6,9 +6,16 @@ Bad arguments raise one of these; numerical failure inside a step is a
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
-__all__ = ["WireFmuError", "ConfigurationError", "GeometryError", "ModelError"]
+__all__ = [
+    "WireFmuError",
+    "ConfigurationError",
+    "GeometryError",
+    "ModelError",
+    "check_positive",
+]
 
 
 class WireFmuError(Exception):
@@ -44,3 +51,27 @@ class GeometryError(ConfigurationError):
 
 class ModelError(WireFmuError, RuntimeError):
     """The model reached a state it cannot continue from."""
+
+
+def check_positive(
+    name: str, value: float, out: list[str], unit: str, *, zero_ok: bool = False
+) -> None:
+    """Append a problem to ``out`` unless parameter ``name`` is finite and > 0 (>= 0).
+
+    Parameters
+    ----------
+    name : str
+        The parameter, as the user sets it.
+    value : float
+        Its value, in ``unit``.
+    out : list of str
+        Where the problem is appended.
+    unit : str
+        The parameter's unit, for the message.
+    zero_ok : bool
+        Whether 0 is allowed.
+    """
+    ok = value >= 0.0 if zero_ok else value > 0.0
+    if not (ok and math.isfinite(value)):
+        relation = ">= 0" if zero_ok else "> 0"
+        out.append(f"parameter {name!r} must be {relation} {unit}, got {value}")

@@ -130,12 +130,19 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 
+from wire_fmu.core.components.end_stops import (
+    EXTENDED,
+    RETRACTED,
+    EndStops,
+    EndStopSpec,
+    damping_ratio_for_restitution,
+    restitution_of_damping_ratio,
+)
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.gas import ISOTHERMAL, PolytropicGas, isothermal_charge_volume
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
-from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.errors import ConfigurationError, ModelError, check_positive
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 
@@ -181,9 +188,6 @@ HYDRAULICS_EFFECTS = EffectCatalogue(
     ),
 )
 
-RETRACTED, EXTENDED = 0, 1
-_END_NAMES = ("retraction", "extension")
-
 
 class HydraulicLimitError(ModelError):
     """A physical limit the unit cannot step through (the step is refused)."""
@@ -216,16 +220,11 @@ CUSHION_CHUNK_STEPS = 8
 """In a cushion the step is re-chosen (and the Jacobian refreshed) every this many steps."""
 
 _FIXED_STEP = ("rk4", "ros2")
+_NO_STOP = (0.0, (0.0, 0.0), (0.0, 0.0), 0.0, 0.0)
+"""What :meth:`EndStops.forces` gives without the effect: no force, depth, loss or energy."""
 
 
 # --------------------------------------------------------------------- specs
-def _positive(name: str, value: float, out: list[str], unit: str, *, zero_ok: bool = False):
-    ok = value >= 0.0 if zero_ok else value > 0.0
-    if not (ok and math.isfinite(value)):
-        relation = ">= 0" if zero_ok else "> 0"
-        out.append(f"parameter {name!r} must be {relation} {unit}, got {value}")
-
-
 @dataclass(frozen=True)
 class CylinderSpec:
     """Geometry and moving mass of a single-acting cylinder.
@@ -261,12 +260,12 @@ class CylinderSpec:
     def problems(self) -> list[str]:
         """Every problem with the parameters, as sentences."""
         out: list[str] = []
-        _positive("bore_diameter", self.bore_diameter, out, "m")
-        _positive("rod_diameter", self.rod_diameter, out, "m")
-        _positive("stroke", self.stroke, out, "m")
-        _positive("moving_mass", self.moving_mass, out, "kg")
-        _positive("chamber_dead_volume", self.chamber_dead_volume, out, "m3", zero_ok=True)
-        _positive("ambient_pressure", self.ambient_pressure, out, "Pa", zero_ok=True)
+        check_positive("bore_diameter", self.bore_diameter, out, "m")
+        check_positive("rod_diameter", self.rod_diameter, out, "m")
+        check_positive("stroke", self.stroke, out, "m")
+        check_positive("moving_mass", self.moving_mass, out, "kg")
+        check_positive("chamber_dead_volume", self.chamber_dead_volume, out, "m3", zero_ok=True)
+        check_positive("ambient_pressure", self.ambient_pressure, out, "Pa", zero_ok=True)
         if self.rod_diameter >= self.bore_diameter > 0.0:
             out.append(
                 f"parameter 'rod_diameter' ({self.rod_diameter} m) must be smaller than "
@@ -336,10 +335,12 @@ class AccumulatorSpec:
     def problems(self) -> list[str]:
         """Every problem with the parameters, as sentences."""
         out: list[str] = []
-        _positive("accumulator_volume", self.accumulator_volume, out, "m3")
-        _positive("gas_bank_volume", self.gas_bank_volume, out, "m3", zero_ok=True)
-        _positive("accumulator_dead_volume", self.accumulator_dead_volume, out, "m3", zero_ok=True)
-        _positive("precharge_pressure", self.precharge_pressure, out, "Pa")
+        check_positive("accumulator_volume", self.accumulator_volume, out, "m3")
+        check_positive("gas_bank_volume", self.gas_bank_volume, out, "m3", zero_ok=True)
+        check_positive(
+            "accumulator_dead_volume", self.accumulator_dead_volume, out, "m3", zero_ok=True
+        )
+        check_positive("precharge_pressure", self.precharge_pressure, out, "Pa")
         if self.accumulator_dead_volume >= self.accumulator_volume > 0.0:
             out.append(
                 "parameter 'accumulator_dead_volume' must be smaller than 'accumulator_volume'"
@@ -389,9 +390,9 @@ class OilSpec:
     def problems(self) -> list[str]:
         """Every problem with the parameters, as sentences."""
         out: list[str] = []
-        _positive("bulk_modulus", self.bulk_modulus, out, "Pa")
-        _positive("oil_volume", self.volume, out, "m3", zero_ok=True)
-        _positive("cavitation_pressure", self.cavitation_pressure, out, "Pa", zero_ok=True)
+        check_positive("bulk_modulus", self.bulk_modulus, out, "Pa")
+        check_positive("oil_volume", self.volume, out, "m3", zero_ok=True)
+        check_positive("cavitation_pressure", self.cavitation_pressure, out, "Pa", zero_ok=True)
         return out
 
 
@@ -420,10 +421,10 @@ class SealSpec:
     def problems(self) -> list[str]:
         """Every problem with the parameters, as sentences."""
         out: list[str] = []
-        _positive("seal_static_friction", self.static, out, "N", zero_ok=True)
-        _positive("seal_coulomb_friction", self.coulomb, out, "N", zero_ok=True)
-        _positive("seal_viscous_friction", self.viscous, out, "N.s/m", zero_ok=True)
-        _positive("seal_stribeck_velocity", self.stribeck_velocity, out, "m/s", zero_ok=True)
+        check_positive("seal_static_friction", self.static, out, "N", zero_ok=True)
+        check_positive("seal_coulomb_friction", self.coulomb, out, "N", zero_ok=True)
+        check_positive("seal_viscous_friction", self.viscous, out, "N.s/m", zero_ok=True)
+        check_positive("seal_stribeck_velocity", self.stribeck_velocity, out, "m/s", zero_ok=True)
         if self.coulomb > self.static:
             out.append(
                 f"parameter 'seal_coulomb_friction' ({self.coulomb} N) must not exceed "
@@ -437,48 +438,6 @@ class SealSpec:
             return self.coulomb
         decay = math.exp(-((velocity / self.stribeck_velocity) ** 2))
         return self.coulomb + (self.static - self.coulomb) * decay
-
-
-@dataclass(frozen=True)
-class EndStopSpec:
-    """Hydraulic cushions and stiff stops at both ends of the stroke.
-
-    Parameters
-    ----------
-    cushion_length : float
-        Length of the cushion zone at each end, m (0: no cushion).
-    cushion_coefficient : float
-        ``c`` of the cushion force ``c v^2``, N s^2/m^2.
-    stiffness : float
-        Stop stiffness, N/m.
-    restitution : float
-        Coefficient of restitution of a free rod bouncing off a stop, 1.
-    """
-
-    cushion_length: float
-    cushion_coefficient: float
-    stiffness: float
-    restitution: float
-
-    def problems(self, stroke: float) -> list[str]:
-        """Every problem with the parameters, as sentences."""
-        out: list[str] = []
-        _positive("cushion_length", self.cushion_length, out, "m", zero_ok=True)
-        _positive("cushion_coefficient", self.cushion_coefficient, out, "N.s2/m2", zero_ok=True)
-        _positive("stop_stiffness", self.stiffness, out, "N/m")
-        if not (0.0 < self.restitution <= 1.0):
-            out.append(f"parameter 'stop_restitution' must lie in (0, 1], got {self.restitution}")
-        if 2.0 * self.cushion_length >= stroke > 0.0:
-            out.append(
-                f"parameter 'cushion_length' ({self.cushion_length} m) must be less than "
-                f"half the stroke ({stroke} m)"
-            )
-        return out
-
-    def damping(self, mass: float) -> float:
-        """Stop dashpot ``2 zeta sqrt(k m)`` giving the set restitution for ``mass`` (kg), N s/m."""
-        zeta = damping_ratio_for_restitution(self.restitution)
-        return 2.0 * zeta * math.sqrt(self.stiffness * mass)
 
 
 @dataclass(frozen=True)
@@ -502,42 +461,6 @@ class HydraulicsSpec:
             + self.seal.problems()
             + self.stops.problems(self.cylinder.stroke)
         )
-
-
-# ------------------------------------------------------- restitution helpers
-def restitution_of_damping_ratio(zeta: float) -> float:
-    """Restitution of a linear spring-dashpot contact released when its force vanishes.
-
-    ``e = exp(-2 zeta arccos(zeta) / sqrt(1 - zeta^2))`` for ``zeta < 1``,
-    ``exp(-2)`` at ``zeta = 1`` and ``exp(-2 zeta arccosh(zeta) / sqrt(zeta^2 - 1))``
-    above (Schwager and Poeschel 2007).
-
-    Parameters
-    ----------
-    zeta : float
-        Damping ratio ``c / (2 sqrt(k m))`` (>= 0), 1.
-    """
-    if zeta < 1.0:
-        return math.exp(-2.0 * zeta * math.acos(zeta) / math.sqrt(1.0 - zeta * zeta))
-    if zeta == 1.0:
-        return math.exp(-2.0)
-    return math.exp(-2.0 * zeta * math.acosh(zeta) / math.sqrt(zeta * zeta - 1.0))
-
-
-def damping_ratio_for_restitution(restitution: float) -> float:
-    """Damping ratio whose force-release contact has ``restitution`` (0 < e <= 1), 1."""
-    if restitution >= 1.0:
-        return 0.0
-    upper = 1.0
-    while restitution_of_damping_ratio(upper) > restitution:
-        upper *= 4.0
-    return brentq(
-        lambda z: restitution_of_damping_ratio(z) - restitution,
-        0.0,
-        upper,
-        xtol=1e-15,
-        rtol=4 * np.finfo(float).eps,
-    )
 
 
 # ------------------------------------------------------------------ the model
@@ -604,7 +527,7 @@ class HydraulicsModel:
         self.exponent = spec.accumulator.polytropic_exponent if self.polytropic else ISOTHERMAL
         self.layout = self._build_layout()
         self._build_friction()
-        self.stop_damping = spec.stops.damping(self.mass) if self.stops_on else 0.0
+        self.stops = EndStops(spec.stops, self.cyl.stroke, self.mass) if self.stops_on else None
         self._guard_kinds = self._build_guards()
         self._directions = np.array(
             [0.0 if kind == "pad" else -1.0 for kind, _ in self._guard_kinds]
@@ -613,7 +536,6 @@ class HydraulicsModel:
         self.contact_solver = self._make_contact_solver(solver)
         self._current_resolution = "coarse"
         self._integrating = False
-        self.contact_since = -math.inf
         self.gas = PolytropicGas(
             spec.accumulator.precharge_pressure, spec.accumulator.full_volume, self.exponent
         )
@@ -621,8 +543,6 @@ class HydraulicsModel:
         self.oil_constant = 0.0
         self.state = np.zeros(self.layout.size)
         self.force = 0.0
-        self.contact = [False, False]
-        self.in_cushion = [False, False]
         self.mode_changes = 0
         self.external_work = 0.0
         self.initial_position = 0.0
@@ -664,10 +584,9 @@ class HydraulicsModel:
         five decay times, whichever is longer), s.
         """
         self.contact_transient = 0.0
-        if not self.stops_on or settings.method not in _FIXED_STEP:
+        if self.stops is None or settings.method not in _FIXED_STEP:
             return None
-        omega = math.sqrt(self.spec.stops.stiffness / self.mass)
-        zeta = damping_ratio_for_restitution(self.spec.stops.restitution)
+        omega, zeta = self.stops.contact_frequency(self.mass)
         self.contact_transient = max(
             4.0 * math.pi / omega, 5.0 / (zeta * omega) if zeta > 0.0 else math.inf
         )
@@ -679,11 +598,8 @@ class HydraulicsModel:
     def _build_guards(self) -> list[tuple[str, int]]:
         kinds = [("seal", 0)] if self.friction_on else []
         kinds += [("gas_dead", 0), ("gas_empty", 0), ("cavitation", 0)]
-        if self.stops_on:
-            for end in (RETRACTED, EXTENDED):
-                kinds += [("contact", end), ("pad", end)]
-                if self.spec.stops.cushion_length > 0.0:
-                    kinds.append(("cushion", end))
+        if self.stops is not None:
+            kinds += self.stops.guard_kinds
         else:
             kinds += [("stroke", RETRACTED), ("stroke", EXTENDED)]
         return kinds
@@ -708,7 +624,9 @@ class HydraulicsModel:
         p_g = self.gas.pressure(max(v_gas, 0.5 * dead))  # beyond the dead volume: refused
         p_c, flow, loss, stored = self._oil_side(x, vel, v_gas, p_g)
         hydraulic = self.sa * (p_c - self.cyl.ambient_pressure)
-        stop_force, depth, trial, stop_loss, stop_energy = self._stops(pos, vel)
+        stop_force, depth, trial, stop_loss, stop_energy = (
+            _NO_STOP if self.stops is None else self.stops.forces(pos, vel)
+        )
         weight = self.cyl.moving_mass * self.cyl.gravity_along_rod
         force = self.force + hydraulic + weight + stop_force - self._viscous * vel
         loss += stop_loss + self._viscous * vel * vel
@@ -756,30 +674,6 @@ class HydraulicsModel:
             flow = self.line.flow(p_g - p_c)
         drop = (self.r_l + self.r_t * abs(flow)) * flow
         return p_c, flow, drop * flow, stored
-
-    def _stops(self, pos: float, vel: float):
-        """Cushion and stop forces on the rod, depths, trial forces, loss, pad energy."""
-        if not self.stops_on:
-            return 0.0, (0.0, 0.0), (0.0, 0.0), 0.0, 0.0
-        k, c = self.spec.stops.stiffness, self.stop_damping
-        depth = (-pos, pos - self.cyl.stroke)
-        inward = (-vel, vel)  # rate of penetration at each end
-        trial = (k * depth[0] + c * inward[0], k * depth[1] + c * inward[1])
-        force = loss = energy = 0.0
-        for end, direction in ((RETRACTED, 1.0), (EXTENDED, -1.0)):
-            if self.in_cushion[end]:
-                speed = max(inward[end], 0.0)
-                cushion = self.spec.stops.cushion_coefficient * speed * speed
-                force += direction * cushion
-                loss += cushion * speed
-            if self.contact[end]:  # smooth inside the mode, whatever the sign of the depth
-                energy += 0.5 * k * depth[end] ** 2
-                force += direction * trial[end]
-                loss += c * inward[end] ** 2
-            elif depth[end] > 0.0:  # the unloaded pad relaxes behind a rod that leaves faster
-                energy += 0.5 * k * depth[end] ** 2
-                loss -= k * depth[end] * inward[end]
-        return force, depth, trial, loss, energy
 
     def _accelerate(self, point: _Point) -> tuple[float, float, float]:
         """Acceleration (m/s^2), seal friction force on the rod (N) and its loss (W)."""
@@ -843,20 +737,7 @@ class HydraulicsModel:
             return self.chamber_pressure(point, acc) - self.spec.oil.cavitation_pressure
         if kind == "stroke":
             return point.x if end == RETRACTED else self.cyl.stroke - point.x
-        if kind == "pad":  # a kink, located for accuracy: the pad is loaded or relaxed
-            return -point.depth[end]
-        if kind == "contact":
-            if self.contact[end]:
-                return point.trial[end]
-            k = self.spec.stops.stiffness
-            return max(-k * point.depth[end], -point.trial[end])
-        boundary = self._cushion_boundary(end)  # cushion zone
-        inside = point.x - boundary if end == EXTENDED else boundary - point.x
-        return inside if self.in_cushion[end] else -inside
-
-    def _cushion_boundary(self, end: int) -> float:
-        length = self.spec.stops.cushion_length
-        return length if end == RETRACTED else self.cyl.stroke - length
+        return self.stops.guard(kind, end, point.x, point.depth, point.trial)
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
         """Refuse at a limit; otherwise switch contact, cushion and seal modes."""
@@ -870,15 +751,8 @@ class HydraulicsModel:
                 continue
             if kind == "seal":
                 seal_fired.append(0)
-            elif kind == "contact":
-                self.contact[end] = not self.contact[end]
-                self.contact_since = t if self.contact[end] else self.contact_since
-                what = "reaches" if self.contact[end] else "leaves"
-                self.last_events.append(f"rod {what} the {_END_NAMES[end]} end stop")
-            elif kind == "cushion":
-                self.in_cushion[end] = not self.in_cushion[end]
-                what = "enters" if self.in_cushion[end] else "leaves"
-                self.last_events.append(f"rod {what} the {_END_NAMES[end]} cushion")
+            elif kind in ("contact", "cushion"):
+                self.last_events.append(self.stops.switch(kind, end, t))
             else:
                 raise HydraulicLimitError(self.limit_message(kind, end, x, t))
         x = self._settle_friction(x, seal_fired)
@@ -984,14 +858,8 @@ class HydraulicsModel:
         self.compliance = oil / self.spec.oil.bulk_modulus
         self.oil_constant = v0 - self.sa * position
         self.state = self._initial_state(position, velocity, p0, v0)
-        self.contact = [False, False]
-        self.contact_since = -math.inf
-        self.in_cushion = [
-            self.stops_on and position < self._cushion_boundary(RETRACTED),
-            self.stops_on and position > self._cushion_boundary(EXTENDED),
-        ]
-        if self.stops_on and self.spec.stops.cushion_length <= 0.0:
-            self.in_cushion = [False, False]
+        if self.stops is not None:
+            self.stops.start(position)
         moving = int(math.copysign(1, velocity)) if velocity != 0.0 else 0
         self.friction.set_mode([moving] * len(self.friction.links))  # a moving seal slides
         self.initial_position = float(position)
@@ -1097,31 +965,23 @@ class HydraulicsModel:
     @property
     def _refining(self) -> bool:
         """Whether event handlers may restart the integration (only inside :meth:`advance`)."""
-        return self._integrating and self.stops_on and self.settings.method in _FIXED_STEP
+        return self._integrating and self.stops is not None and self.settings.method in _FIXED_STEP
 
     def _resolution(self, t: float, x: np.ndarray) -> str:
         """``"contact"`` (impact transient), ``"cushion"`` (running into one) or ``"coarse"``."""
-        if any(self.contact) and t < self.contact_since + self.contact_transient:
+        stops = self.stops
+        if any(stops.contact) and t < stops.contact_since + self.contact_transient:
             return "contact"
-        if self._cushion_speed(x) > 0.0:
+        if stops.cushion_speed(float(x[1])) > 0.0:
             return "cushion"
         return "coarse"
-
-    def _cushion_speed(self, x: np.ndarray) -> float:
-        """Speed (m/s) at which the rod runs into a cushion it is in; 0 otherwise."""
-        speed = 0.0
-        if self.in_cushion[RETRACTED]:
-            speed = max(speed, -float(x[1]))
-        if self.in_cushion[EXTENDED]:
-            speed = max(speed, float(x[1]))
-        return speed
 
     def _piece(self, t: float, x: np.ndarray, t_end: float):
         """The solver for the next piece of integration and where the piece ends."""
         self._current_resolution = self._resolution(t, x) if self._refining else "coarse"
         if self._current_resolution == "contact" and self.contact_solver is not None:
             solver = self.contact_solver
-            settled = self.contact_since + self.contact_transient
+            settled = self.stops.contact_since + self.contact_transient
             return solver, min(
                 t_end,
                 t + CONTACT_CHUNK_STEPS * solver.settings.max_step,
@@ -1129,7 +989,7 @@ class HydraulicsModel:
             )
         if self._current_resolution == "cushion":
             c = self.spec.stops.cushion_coefficient
-            h = CUSHION_STEP_FACTOR * self.mass / (c * self._cushion_speed(x))
+            h = CUSHION_STEP_FACTOR * self.mass / (c * self.stops.cushion_speed(float(x[1])))
             if h < self.settings.max_step:
                 solver = make_solver(replace(self.settings, max_step=h))
                 return solver, min(t_end, t + CUSHION_CHUNK_STEPS * h)

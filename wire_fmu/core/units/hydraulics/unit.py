@@ -425,9 +425,7 @@ class HydraulicsUnit(Unit):
         return {
             "x": [float(c) for c in m.state],
             "force": float(m.force),
-            "contact": [bool(b) for b in m.contact],
-            "in_cushion": [bool(b) for b in m.in_cushion],
-            "contact_since": m.contact_since if math.isfinite(m.contact_since) else None,
+            "stops": None if m.stops is None else m.stops.get_state(),
             "friction_mode": m.friction.get_mode(),
             "held_position": float(m._held_position),
             "mode_changes": int(m.mode_changes),
@@ -447,10 +445,8 @@ class HydraulicsUnit(Unit):
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.force = float(state["force"])
-        m.contact = [bool(b) for b in state["contact"]]
-        m.in_cushion = [bool(b) for b in state["in_cushion"]]
-        since = state["contact_since"]
-        m.contact_since = -math.inf if since is None else float(since)
+        if m.stops is not None:
+            m.stops.set_state(state["stops"])
         m.friction.set_mode(list(state["friction_mode"]))
         m._held_position = float(state["held_position"])
         m.mode_changes = int(state["mode_changes"])
@@ -484,7 +480,7 @@ class HydraulicsUnit(Unit):
         out["seal.friction_force"] = r["friction_force"]
         out["seal.stuck"] = bool(m.friction_on and m.friction.mode[0] == 0)
         out["end_stop.force"] = r["stop_force"]
-        out["end_stop.contact"] = bool(any(m.contact))
+        out["end_stop.contact"] = m.stops is not None and any(m.stops.contact)
         out["stored_energy"] = r["stored_energy"]
         out["dissipated_energy"] = m.dissipated_energy
         out["external_work"] = float(m.external_work)
