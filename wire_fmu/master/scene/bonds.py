@@ -140,6 +140,15 @@ def _short_bond(
         return None
 
     def connection(pair: tuple[str, str], role: str) -> Connection:
+        """The bond's link of ``role``.
+
+        Parameters
+        ----------
+        pair : (str, str)
+            Source and target, ``"unit.variable"`` each.
+        role : str
+            ``"effort"``, ``"flow"`` or ``"position"``.
+        """
         source, target = (VarRef.parse(side) for side in pair)
         return Connection(source, target, role=role, bond=name, extrapolation=extrapolation)
 

@@ -18,12 +18,29 @@ _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,127}")
 
 
 def is_plain_name(name: str) -> bool:
-    """Whether ``name`` can name a folder inside another: letters, digits, ``_-.``, no ``..``."""
+    """Whether ``name`` can name a folder inside another: letters, digits, ``_-.``, no ``..``.
+
+    Parameters
+    ----------
+    name : str
+        The name (of a scene, a sweep, a case).
+    """
     return bool(_SAFE_NAME.fullmatch(name)) and ".." not in name
 
 
 def unknown_unit_problems(scene: Scene) -> list[str]:
-    """Every reference to a unit the scene does not have, naming where it is."""
+    """Every reference to a unit the scene does not have, naming where it is.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its bonds, connections, drivers, events, outputs, plots).
+
+    Returns
+    -------
+    list of str
+        One problem per reference to a unit that is not in ``scene.units``.
+    """
     units = set(scene.units)
     known = ", ".join(sorted(units)) or "none"
     refs: list[tuple[str, VarRef]] = []
@@ -49,12 +66,24 @@ def unknown_unit_problems(scene: Scene) -> list[str]:
 
 
 def valid_time(value: Any) -> bool:
-    """A time a run can count: a number of seconds from 0 to :data:`MAX_TIME`, not a boolean."""
+    """A time a run can count: a number of seconds from 0 to :data:`MAX_TIME`, not a boolean.
+
+    Parameters
+    ----------
+    value : object
+        The time, s.
+    """
     return _finite(value) and 0 <= value <= MAX_TIME
 
 
 def is_scalar(value: Any) -> bool:
-    """A finite number, a boolean or text: what one FMI variable can hold."""
+    """A finite number, a boolean or text: what one FMI variable can hold.
+
+    Parameters
+    ----------
+    value : object
+        The value.
+    """
     return isinstance(value, bool | str) or _finite(value)
 
 

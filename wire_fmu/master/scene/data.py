@@ -56,7 +56,13 @@ class VarRef:
 
     @classmethod
     def parse(cls, text: Any) -> VarRef | None:
-        """Parse ``"unit.variable.path"``; None if malformed."""
+        """Parse ``"unit.variable.path"``; None if malformed.
+
+        Parameters
+        ----------
+        text : object
+            The reference; anything but such text gives None.
+        """
         if not isinstance(text, str) or "." not in text.strip():
             return None
         unit, _, variable = text.strip().partition(".")

@@ -43,6 +43,15 @@ _TOP_KEYS = {
 def load_scene(path: Path) -> Scene:
     """Read and parse a scene file.
 
+    Parameters
+    ----------
+    path : Path
+        The scene file (TOML, at most :data:`MAX_SCENE_BYTES`).
+
+    Returns
+    -------
+    Scene
+
     Raises
     ------
     SceneError
@@ -55,7 +64,21 @@ def load_scene(path: Path) -> Scene:
 
 
 def parse_scene(data: Mapping[str, Any], *, base_dir: Path, source: Path | None = None) -> Scene:
-    """Build a :class:`Scene` from plain data; raise :class:`SceneError` with every problem."""
+    """Build a :class:`Scene` from plain data; raise :class:`SceneError` with every problem.
+
+    Parameters
+    ----------
+    data : mapping
+        What a scene file holds, as :mod:`tomllib` reads it.
+    base_dir : Path
+        Folder relative paths (FMUs, driver tables) are found in.
+    source : Path, optional
+        The file the data came from.
+
+    Returns
+    -------
+    Scene
+    """
     scene, problems = read_scene_data(data, base_dir=base_dir, source=source)
     if problems:
         raise SceneError(f"scene {scene.name!r}", problems)
@@ -68,6 +91,18 @@ def read_scene(path: Path) -> tuple[Scene | None, list[str]]:
     The scene returned with problems has each invalid item left out or at its
     default, so that the checks that need the units can still run and report
     their problems in the same list (``wire-fmu check``).
+
+    Parameters
+    ----------
+    path : Path
+        The scene file (TOML, at most :data:`MAX_SCENE_BYTES`).
+
+    Returns
+    -------
+    scene : Scene or None
+        The scene; None if the file cannot be read or is no TOML.
+    problems : list of str
+        Every problem found; empty if none.
     """
     path = Path(path)
     try:
@@ -86,7 +121,24 @@ def read_scene(path: Path) -> tuple[Scene | None, list[str]]:
 def read_scene_data(
     data: Mapping[str, Any], *, base_dir: Path, source: Path | None = None
 ) -> tuple[Scene, list[str]]:
-    """Build a :class:`Scene` from plain data and list every problem (see :func:`read_scene`)."""
+    """Build a :class:`Scene` from plain data and list every problem (see :func:`read_scene`).
+
+    Parameters
+    ----------
+    data : mapping
+        What a scene file holds, as :mod:`tomllib` reads it.
+    base_dir : Path
+        Folder relative paths (FMUs, driver tables) are found in.
+    source : Path, optional
+        The file the data came from (its stem is the default name).
+
+    Returns
+    -------
+    scene : Scene
+        The scene, each invalid item left out or at its default.
+    problems : list of str
+        Every problem found; empty if none.
+    """
     problems: list[str] = []
     if not isinstance(data, Mapping):
         data = {}
@@ -141,6 +193,13 @@ def _port_reader(units: Mapping[str, UnitSpec], base_dir: Path) -> PortsOf:
     read: dict[str, tuple] = {}
 
     def ports_of(unit: str) -> tuple:
+        """Ports of ``unit``'s FMU, or why they cannot be read (see :data:`.bonds.PortsOf`).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of a unit of the scene.
+        """
         from ..ports import unit_ports  # opens (and builds) FMUs: only when a bond needs it
 
         if unit not in read:
