@@ -14,7 +14,8 @@ import matplotlib
 import numpy as np
 import pytest
 
-from wire_fmu.core.components.sheave_geometry import Circle, PathNode, path_geometry
+from wire_fmu.core.components.sheave_geometry.circles import Circle, PathNode
+from wire_fmu.core.components.sheave_geometry.path import path_geometry
 from wire_fmu.core.errors import ConfigurationError, GeometryError
 from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
 from wire_fmu.tools.draw import draw_reeving

@@ -12,16 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from wire_fmu.core.components.sheave_geometry import (
-    Circle,
-    PathNode,
+from wire_fmu.core.components.sheave_geometry.circles import Circle, PathNode
+from wire_fmu.core.components.sheave_geometry.path import (
     check_path,
     path_geometry,
-    planar_frame,
-    planar_path_lengths,
     segment_tangent_points,
-    solve_fleet_tangent,
 )
+from wire_fmu.core.components.sheave_geometry.planar_path import planar_frame, planar_path_lengths
+from wire_fmu.core.components.sheave_geometry.spatial_tangent import solve_fleet_tangent
 from wire_fmu.core.errors import GeometryError
 
 Z = (0.0, 0.0, 1.0)

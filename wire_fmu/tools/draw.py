@@ -6,15 +6,15 @@ description into drawing primitives (:mod:`~wire_fmu.tools.draw_primitives`,
 pure data: sheave outlines, rope spans and wrapped arcs, anchors, line ends,
 body boxes, floors, in 2-D plane coordinates, m) using the core's own
 geometry (:func:`~wire_fmu.core.units.block_train.reeving.parse_reeving`,
-:func:`~wire_fmu.core.components.sheave_geometry.path_geometry`,
-:func:`~wire_fmu.core.components.sheave_geometry.planar_frame`) -- no tangent is re-derived
-there -- and a renderer (this module) draws those with matplotlib's Agg canvas on a
+:func:`~wire_fmu.core.components.sheave_geometry.path.path_geometry`,
+:func:`~wire_fmu.core.components.sheave_geometry.planar_path.planar_frame`) -- no tangent is
+re-derived there -- and a renderer (this module) draws those with matplotlib's Agg canvas on a
 :class:`~matplotlib.figure.Figure` object (no pyplot, no global rcParams).
 
 The view
 --------
 The drawing plane is the rope path's plane (from
-:func:`~wire_fmu.core.components.sheave_geometry.planar_frame`); a non-planar reeving is
+:func:`~wire_fmu.core.components.sheave_geometry.planar_path.planar_frame`); a non-planar reeving is
 projected onto its best-fit plane (least squares through the sheave centres,
 points and tangent points) and the title says so. The plane is seen from the
 side its normal's largest component points to (a reeving in the x-y plane is

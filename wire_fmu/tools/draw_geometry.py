@@ -14,13 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.components.sheave_geometry import (
-    Circle,
-    PathGeometry,
-    PathNode,
-    path_geometry,
-    planar_frame,
-)
+from wire_fmu.core.components.sheave_geometry.circles import Circle, PathNode
+from wire_fmu.core.components.sheave_geometry.path import PathGeometry, path_geometry
+from wire_fmu.core.components.sheave_geometry.planar_path import planar_frame
 from wire_fmu.core.errors import GeometryError
 from wire_fmu.core.units.block_train.reeving import Reeving, parse_reeving
 
@@ -305,7 +301,7 @@ def reeving_drawing(reeving: Mapping[str, Any]) -> ReevingDrawing:
     ------
     ConfigurationError
         From :func:`~wire_fmu.core.units.block_train.reeving.parse_reeving` (every problem of
-        the description) or :func:`~wire_fmu.core.components.sheave_geometry.path_geometry`
+        the description) or :func:`~wire_fmu.core.components.sheave_geometry.path.path_geometry`
         (a :class:`~wire_fmu.core.errors.GeometryError` with every geometric
         problem).
     """

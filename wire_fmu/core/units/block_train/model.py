@@ -41,13 +41,9 @@ import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces, slack_guard, taut_guard
-from wire_fmu.core.components.sheave_geometry import (
-    Circle,
-    PathNode,
-    path_geometry,
-    planar_frame,
-    planar_path_lengths,
-)
+from wire_fmu.core.components.sheave_geometry.circles import Circle, PathNode
+from wire_fmu.core.components.sheave_geometry.path import path_geometry
+from wire_fmu.core.components.sheave_geometry.planar_path import planar_frame, planar_path_lengths
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
