@@ -125,7 +125,13 @@ class Port:
     members: tuple[tuple[str, str], ...]
 
     def nested_name(self, element: str) -> str:
-        """Name of a port's nested effort or flow group."""
+        """Name of a port's nested effort or flow group.
+
+        Parameters
+        ----------
+        element : str
+            The nested group's element, e.g. ``"Force"`` or ``"LinearVelocity"``.
+        """
         return f"{self.name}.{element}"
 
 
@@ -150,6 +156,11 @@ def _bond_ends(bond: Bond) -> dict[str, tuple[str, str, str | None]]:
 
 def model_ports(plan: ExportPlan) -> tuple[dict[str, list[Port]], dict[tuple[str, str], Port]]:
     """Variable groups per model name, and the group of each (unit, bond role).
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The scene planned for export (its units and bonds).
 
     Returns
     -------
@@ -242,7 +253,16 @@ def _connections(root: etree._Element, plan: ExportPlan) -> None:
 def system_structure_tree(
     plan: ExportPlan, fmu_names: dict[Path, str] | None = None
 ) -> etree._Element:
-    """The ``OspSystemStructure.xml`` document of ``plan``."""
+    """The ``OspSystemStructure.xml`` document of ``plan``.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The scene planned for export.
+    fmu_names : dict of Path to str, optional
+        The file name each FMU gets beside the document (default
+        :func:`~.plan.archive_names`).
+    """
     names = fmu_names or archive_names(plan.units)
     root = _el(None, OSP_NS, "OspSystemStructure", version="0.1")
     _text(root, "StartTime", "0.0")
@@ -271,7 +291,15 @@ def _unit_definitions(root: etree._Element, model, used: set[str]) -> None:
 
 
 def model_description_tree(model, ports: list[Port]) -> etree._Element:
-    """The ``<Model>_OspModelDescription.xml`` of ``model`` with its ``ports``."""
+    """The ``<Model>_OspModelDescription.xml`` of ``model`` with its ``ports``.
+
+    Parameters
+    ----------
+    model : fmpy.model_description.ModelDescription
+        The model's description (its variables and unit definitions).
+    ports : list of Port
+        Its variable groups (see :func:`model_ports`).
+    """
     units = {v.name: v.unit for v in model.modelVariables if v.unit}
     root = _el(None, OSP_MD_NS, "OspModelDescription", version="1.0")
     used = {units[v] for p in ports for _, v in p.members if v in units}
@@ -296,6 +324,13 @@ def _xml(root: etree._Element) -> bytes:
 def write_osp(plan: ExportPlan, folder: Path) -> Path:
     """Write ``plan`` as an OSP configuration in ``folder``.
 
+    Parameters
+    ----------
+    plan : ExportPlan
+        The scene planned for export.
+    folder : Path
+        Output folder (created); the FMUs are copied into it.
+
     Returns
     -------
     Path
@@ -318,5 +353,20 @@ def write_osp(plan: ExportPlan, folder: Path) -> Path:
 
 
 def export_osp(scene: Scene, out: Path, *, fmu_dir: Path = DEFAULT_FMU_DIR) -> Path:
-    """Plan and write ``scene`` as an OSP configuration folder ``out``."""
+    """Plan and write ``scene`` as an OSP configuration folder ``out``.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene.
+    out : Path
+        Output folder (created).
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+
+    Returns
+    -------
+    Path
+        The ``OspSystemStructure.xml`` file.
+    """
     return write_osp(plan_export(scene, fmu_dir=fmu_dir), Path(out))

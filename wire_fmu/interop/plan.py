@@ -60,7 +60,16 @@ class TypedValue:
 
     @classmethod
     def of(cls, fmi_type: str, value: Any) -> TypedValue:
-        """Coerce ``value`` to ``fmi_type`` the way the master's slave does."""
+        """Coerce ``value`` to ``fmi_type`` the way the master's slave does.
+
+        Parameters
+        ----------
+        fmi_type : str
+            ``"Real"``, ``"Integer"``, ``"Enumeration"`` (kept as Integer),
+            ``"Boolean"`` or ``"String"``.
+        value : object
+            The value, in the variable's unit.
+        """
         if fmi_type == "Real":
             return cls("Real", float(value))
         if fmi_type in ("Integer", "Enumeration"):
@@ -79,7 +88,16 @@ class TypedValue:
 
     @classmethod
     def parse(cls, fmi_type: str, text: str) -> TypedValue:
-        """Inverse of :meth:`text`."""
+        """Inverse of :meth:`text`.
+
+        Parameters
+        ----------
+        fmi_type : str
+            ``"Real"``, ``"Integer"``, ``"Enumeration"`` (kept as Integer),
+            ``"Boolean"`` or ``"String"``.
+        text : str
+            The XML attribute text.
+        """
         if fmi_type == "Boolean":
             return cls("Boolean", text.strip().lower() in ("true", "1"))
         if fmi_type == "Real":
@@ -117,7 +135,13 @@ class PlannedUnit:
     generated: bool = False
 
     def variable(self, name: str) -> Any:
-        """The model variable ``name`` (KeyError naming the unit if missing)."""
+        """The model variable ``name`` (KeyError naming the unit if missing).
+
+        Parameters
+        ----------
+        name : str
+            A variable of the unit's FMU.
+        """
         for var in self.model.modelVariables:
             if var.name == name:
                 return var
@@ -153,14 +177,26 @@ class ExportPlan:
     metadata: dict[str, Any] = field(default_factory=dict)
 
     def unit(self, name: str) -> PlannedUnit:
-        """The planned unit called ``name``."""
+        """The planned unit called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Instance name of the unit (KeyError if there is none).
+        """
         for unit in self.units:
             if unit.name == name:
                 return unit
         raise KeyError(f"no unit {name!r} in the export of scene {self.scene.name!r}")
 
     def variable(self, ref: VarRef) -> Any:
-        """The model variable ``ref`` names."""
+        """The model variable ``ref`` names.
+
+        Parameters
+        ----------
+        ref : VarRef
+            ``unit.variable`` (KeyError if either is missing).
+        """
         return self.unit(ref.unit).variable(ref.variable)
 
     @property
@@ -170,13 +206,30 @@ class ExportPlan:
 
 
 def safe_name(text: str) -> str:
-    """``text`` reduced to an identifier (letters, digits, underscores)."""
+    """``text`` reduced to an identifier (letters, digits, underscores).
+
+    Parameters
+    ----------
+    text : str
+        A name, e.g. a scene's.
+    """
     name = re.sub(r"\W", "_", text)
     return name if name and not name[0].isdigit() else f"_{name}"
 
 
 def archive_names(units: tuple[PlannedUnit, ...]) -> dict[Path, str]:
-    """A file name for each distinct FMU (two units of one FMU share it)."""
+    """A file name for each distinct FMU (two units of one FMU share it).
+
+    Parameters
+    ----------
+    units : tuple of PlannedUnit
+        The units planned for export.
+
+    Returns
+    -------
+    dict of Path to str
+        The file name of each resolved FMU path, unique among them.
+    """
     names: dict[Path, str] = {}
     taken: set[str] = set()
     for unit in units:
@@ -204,6 +257,23 @@ def portable_driver_spec(spec: dict[str, Any], base_dir: Path) -> dict[str, Any]
     """A driver table that needs no file: a ``table`` becomes a ``ramp`` of its points.
 
     Both build the same :class:`~wire_fmu.master.drivers.PiecewiseLinearDriver`.
+
+    Parameters
+    ----------
+    spec : dict
+        A scene's driver table (``kind`` and its keys).
+    base_dir : Path
+        Folder of the scene file, where a relative table file is found.
+
+    Returns
+    -------
+    dict
+        ``spec`` itself (copied), or for a ``table`` the equivalent ``ramp``.
+
+    Raises
+    ------
+    ExportError
+        If the table cannot be read.
     """
     if spec.get("kind") != "table":
         return dict(spec)

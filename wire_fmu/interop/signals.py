@@ -178,7 +178,26 @@ def _check_targets(scene: Scene, entries: list[dict[str, Any]]) -> None:
 
 
 def signals_program(scene: Scene, structure: Structure) -> dict[str, Any]:
-    """The program of the scene's signals unit (see :func:`.signals_unit.make_unit_class`)."""
+    """The program of the scene's signals unit (see :func:`.signals_unit.make_unit_class`).
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene with drivers or events.
+    structure : Structure
+        Its units' model descriptions (for the targets' types, units, starts).
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``model_name``, ``description``, ``step`` (s),
+        ``start_time`` (s) and one ``signals`` entry per driven input.
+
+    Raises
+    ------
+    ExportError
+        If an input is driven and also set by events, or connected as well.
+    """
     entries = _driver_entries(scene, structure) + _event_entries(scene, structure)
     _check_targets(scene, entries)
     return {
@@ -212,6 +231,13 @@ def _copy_package_as_modules(package: Path, prefix: str, folder: Path) -> list[P
     names = {stem: base if stem == "__init__" else f"{base}_{stem}" for stem in sources}
 
     def absolute(match: re.Match) -> str:
+        """The import of a sibling, renamed to its top-level module.
+
+        Parameters
+        ----------
+        match : re.Match
+            A match of ``_RELATIVE_IMPORT``: the indentation, the sibling's name.
+        """
         return f"{match[1]}from {names[match[2]]} import "
 
     targets = []

@@ -55,7 +55,13 @@ class _Signal:
     events: tuple[tuple[float, Any], ...] = ()
 
     def initial(self, t: float) -> Any:
-        """Value during initialisation at ``t``."""
+        """Value during initialisation at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Start time, s.
+        """
         if self.mode == "events":
             return self.start
         if self.mode == "mean_rate":
@@ -63,7 +69,15 @@ class _Signal:
         return float(self.driver.value(t))
 
     def for_step(self, t: float, h: float) -> Any:
-        """Value to hold over ``[t, t + h]``."""
+        """Value to hold over ``[t, t + h]``.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            The host's macro step, s.
+        """
         if self.mode == "events":
             value = self.start
             for when, new in self.events:
@@ -108,11 +122,17 @@ class SignalsUnit(Unit):
             self.values[s.name] = s.initial(t0)
 
     def initialize(self, start_time: float) -> None:
-        """Publish the values for the first step."""
+        """Publish the values for the first step.
+
+        Parameters as in :meth:`wire_fmu.core.framework.unit.Unit.initialize`.
+        """
         self._publish(start_time)
 
     def advance(self, time: float, step: float) -> StepResult:
-        """Publish the values for the step that starts where this one ends."""
+        """Publish the values for the step that starts where this one ends.
+
+        Parameters as in :meth:`wire_fmu.core.framework.unit.Unit.advance`.
+        """
         self._publish(time + step)
         return StepResult(True)
 
@@ -126,7 +146,10 @@ class SignalsUnit(Unit):
         return {}
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Nothing to restore."""
+        """Nothing to restore.
+
+        Parameters as in :meth:`wire_fmu.core.framework.unit.Unit.set_state`.
+        """
 
 
 def _variables(program: Mapping[str, Any]) -> tuple:

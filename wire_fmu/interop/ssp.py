@@ -239,7 +239,13 @@ def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etre
 
 
 def ssv_tree(unit: PlannedUnit) -> etree._Element:
-    """The SSV 1.0 parameter set of ``unit`` (Reals with their units)."""
+    """The SSV 1.0 parameter set of ``unit`` (Reals with their units).
+
+    Parameters
+    ----------
+    unit : PlannedUnit
+        A unit planned for export (its typed start values).
+    """
     root = etree.Element(
         _q("ssv", "ParameterSet"),
         {"version": "1.0", "name": unit.name, "generationTool": f"wire_fmu {wire_fmu.__version__}"},
@@ -266,6 +272,13 @@ def _xml(root: etree._Element) -> bytes:
 
 def write_ssp(plan: ExportPlan, path: Path) -> Path:
     """Write ``plan`` as the SSP package ``path`` (a ``.ssp`` zip).
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The scene planned for export.
+    path : Path
+        The package file (its folder is created; an existing file replaced).
 
     Returns
     -------

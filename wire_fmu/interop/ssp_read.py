@@ -109,7 +109,20 @@ def extract_ssp(
 
 
 def ssp_scene_data(folder: Path) -> tuple[dict[str, Any], list[str]]:
-    """Scene data (as a scene file holds it) from an extracted package, and problems."""
+    """Scene data (as a scene file holds it) from an extracted package, and problems.
+
+    Parameters
+    ----------
+    folder : Path
+        The extracted package (see :func:`extract_ssp`).
+
+    Returns
+    -------
+    data : dict
+        Plain scene data, for :func:`~wire_fmu.master.scene.parse_scene`.
+    problems : list of str
+        Every problem found, each naming the element; empty if none.
+    """
     folder = Path(folder)
     problems: list[str] = []
     root = _read_xml(folder / SSD_NAME, SSD_NAME, problems)
