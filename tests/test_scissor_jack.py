@@ -16,13 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wire_fmu.core.components.screw_nut import (
-    BodyState,
-    RigidBody,
-    ScrewNutJoint,
-    ScrewNutSystem,
-    ScrewThread,
-)
+from wire_fmu.core.components.screw_nut.bodies import BodyState, RigidBody
+from wire_fmu.core.components.screw_nut.joint import ScrewNutJoint
+from wire_fmu.core.components.screw_nut.system import ScrewNutSystem
+from wire_fmu.core.components.screw_nut.thread import ScrewThread
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.unit import Causality
 from wire_fmu.core.units.scissor_jack.unit import ScissorJackUnit

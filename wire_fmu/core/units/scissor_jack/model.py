@@ -89,7 +89,7 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
-from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
+from wire_fmu.core.components.screw_nut.thread import REGULARISATIONS, ScrewThread
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 

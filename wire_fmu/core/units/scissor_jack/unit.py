@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.components.screw_nut import REGULARISATIONS, ScrewThread
+from wire_fmu.core.components.screw_nut.thread import REGULARISATIONS, ScrewThread
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
