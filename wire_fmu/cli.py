@@ -27,7 +27,6 @@ prints a traceback unless ``--verbose`` is given.
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import os
 import signal
@@ -36,218 +35,23 @@ import threading
 from collections.abc import Sequence
 from pathlib import Path
 
+from wire_fmu.cli_commands import (
+    EXIT_INTERRUPTED,
+    _print,
+    cmd_build,
+    cmd_check,
+    cmd_draw,
+    cmd_export,
+    cmd_run,
+    cmd_scenes,
+    cmd_study,
+    cmd_sweep,
+)
 from wire_fmu.core.errors import WireFmuError
 
 __all__ = ["main"]
 
 logger = logging.getLogger("wire_fmu")
-
-
-def _print(text: str = "") -> None:
-    sys.stdout.write(text + "\n")
-
-
-def _table(rows: Sequence[tuple[str, str]]) -> str:
-    width = max(len(k) for k, _ in rows)
-    return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)
-
-
-def cmd_scenes(args: argparse.Namespace) -> int:
-    """List shipped scenes with their descriptions."""
-    from wire_fmu.master.run import shipped_scenes
-    from wire_fmu.master.scene import load_scene
-
-    rows = []
-    for name, path in shipped_scenes().items():
-        try:
-            rows.append((name, load_scene(path).description.strip().splitlines()[0]))
-        except (WireFmuError, IndexError):
-            rows.append((name, "(cannot be read)"))
-    _print(_table(rows) if rows else "no shipped scenes")
-    return 0
-
-
-def cmd_check(args: argparse.Namespace) -> int:
-    """Validate a scene and initialise its units as a run would; exit 1 listing every problem."""
-    from wire_fmu.master.run import check_scene
-
-    scene = check_scene(args.scene, args.fmu_dir)
-    _print(
-        f"scene {scene.name!r}: no problems ({len(scene.units)} units, "
-        f"{len(scene.bonds)} bonds, {len(scene.connections)} connections)"
-    )
-    return 0
-
-
-def cmd_run(args: argparse.Namespace) -> int:
-    """Run a scene and report where the results are."""
-    from wire_fmu.master.observers import summary_rows
-    from wire_fmu.master.run import run_scene
-
-    outcome = run_scene(
-        args.scene,
-        args.output,
-        progress=not args.quiet,
-        fmu_dir=args.fmu_dir,
-        stop_time=args.stop_time,
-        step=args.step,
-    )
-    _print(f"\nscene {outcome.scene.name!r}")
-    _print(_table(summary_rows(outcome.simulation, outcome.result)))
-    if outcome.csv_path.is_file():
-        _print(f"\nresults: {outcome.csv_path.resolve()}")
-    _print(f"metadata: {(outcome.directory / 'metadata.json').resolve()}")
-    for path in outcome.plots:
-        _print(f"plot: {path.resolve()}")
-    status = outcome.result.status
-    if status != "finished":  # said once, last, where it is seen
-        _print(f"\nrun {status}: {outcome.result.message}")
-    return EXIT_INTERRUPTED if status == "interrupted" else 0 if status == "finished" else 1
-
-
-def cmd_draw(args: argparse.Namespace) -> int:
-    """Draw every block train's reeving in a scene."""
-    from wire_fmu.master.run import find_scene, make_results_folder
-    from wire_fmu.master.scene import SceneError, load_scene
-    from wire_fmu.tools.draw import draw_reeving
-
-    scene = load_scene(find_scene(args.scene))
-    out = make_results_folder(Path(args.output or Path("results") / scene.name))
-    drawn = 0
-    for name, unit in scene.units.items():
-        reeving = unit.parameters.get("reeving")
-        if reeving is None:
-            continue
-        if isinstance(reeving, str):
-            try:
-                reeving = json.loads(reeving)
-            except ValueError as exc:
-                raise SceneError(
-                    f"scene {scene.name!r}",
-                    [f"unit {name!r}: parameter 'reeving' is not JSON ({exc})"],
-                ) from None
-        try:
-            path = draw_reeving(reeving, out / f"{name}_reeving.png", title=f"{scene.name}: {name}")
-        except WireFmuError:
-            raise
-        except (ValueError, ArithmeticError) as exc:
-            raise SceneError(
-                f"scene {scene.name!r}", [f"unit {name!r}: the reeving cannot be drawn: {exc}"]
-            ) from None
-        _print(f"drawn: {path.resolve()}")
-        drawn += 1
-    if not drawn:
-        _print(f"scene {scene.name!r} has no unit with a 'reeving' parameter to draw")
-    return 0
-
-
-def cmd_build(args: argparse.Namespace) -> int:
-    """Build our FMUs into a folder."""
-    from wire_fmu.master.catalog import ensure_built
-    from wire_fmu.registry import UNIT_TYPES
-
-    for unit in UNIT_TYPES:
-        if unit.facade_path.exists():
-            path = ensure_built(unit.name, unit.facade_path, args.output or args.fmu_dir)
-            _print(f"{unit.name}: {path}")
-    return 0
-
-
-def cmd_sweep(args: argparse.Namespace) -> int:
-    """Run a parameter sweep; exit 1 unless every case finished."""
-    from wire_fmu.master.run import find_scene
-    from wire_fmu.master.scene import load_scene
-    from wire_fmu.sweep import load_sweep_spec, run_sweep
-
-    if not args.verbose:  # a local cluster's scheduler runs here and logs every event
-        import distributed  # noqa: F401 - sets its loggers' levels on import; then quieten
-
-        logging.getLogger("distributed").setLevel(logging.WARNING)
-    scene = load_scene(find_scene(args.scene))
-    spec = load_sweep_spec(args.spec)
-    out = args.output or Path("results") / "sweeps" / f"{scene.name}_{spec.name}"
-    try:
-        result = run_sweep(
-            scene,
-            spec,
-            out,
-            workers=args.workers,
-            scheduler=args.scheduler,
-            fmu_dir=args.fmu_dir,
-            progress=not args.quiet,
-            rerun_failed=args.rerun_failed,
-        )
-    except KeyboardInterrupt:
-        _print(
-            f"\ninterrupted; finished cases are kept in {Path(out).resolve()}: run the same "
-            "command again to run only the rest"
-        )
-        return EXIT_INTERRUPTED
-    counts = ", ".join(f"{n} {status}" for status, n in sorted(result.counts.items()))
-    _print(
-        f"\nsweep {spec.name!r} of scene {scene.name!r}: {len(result.rows)} cases ({counts}); "
-        f"{result.executed} run now, {result.reused} from earlier, {result.wall_time:.3g} s"
-    )
-    _print(f"summary: {result.summary_path.resolve()}")
-    _print(f"time series: {(result.directory / 'cases').resolve()}/<case_id>/timeseries.csv")
-    for path in result.plots:
-        _print(f"plot: {path.resolve()}")
-    return 0 if result.complete else 1
-
-
-def _load_any_scene(name: str):
-    """A shipped scene, a scene file or an SSP package."""
-    from wire_fmu.master.run import find_scene, load_scene_file
-
-    return load_scene_file(find_scene(name))
-
-
-def cmd_export(args: argparse.Namespace) -> int:
-    """Export a scene as an SSP package or an OSP configuration (docs/interop.md)."""
-    from wire_fmu.interop import export_osp, export_ssp
-
-    scene = _load_any_scene(args.scene)
-    out = Path(args.output or Path("results") / "export")
-    if args.format == "ssp":
-        path = export_ssp(scene, out, fmu_dir=args.fmu_dir)
-    else:
-        path = export_osp(
-            scene, out / f"{scene.name}_osp" if args.output is None else out, fmu_dir=args.fmu_dir
-        )
-    _print(f"exported scene {scene.name!r} as {args.format.upper()}: {path.resolve()}")
-    return 0
-
-
-def cmd_study(args: argparse.Namespace) -> int:
-    """Run the accuracy or the effects study of a scene and say where its files are."""
-    from wire_fmu.study import accuracy, effects
-
-    out = args.output or Path("results") / Path(args.scene).stem / args.study
-    if args.study == "accuracy":
-        study = accuracy.run_accuracy_study(
-            args.scene,
-            out,
-            quick=args.quick,
-            grid=args.grid,
-            fmu_dir=args.fmu_dir,
-            repeats=args.repeats,
-            stop_time=args.stop_time,
-        )
-        _print(accuracy.summary_text(study))
-    else:
-        study = effects.run_effects_study(
-            args.scene,
-            out,
-            quick=args.quick,
-            fmu_dir=args.fmu_dir,
-            repeats=args.repeats,
-            stop_time=args.stop_time,
-        )
-        _print(effects.summary_text(study))
-    _print(f"\nstudy took {study.elapsed:.0f} s")
-    for path in study.files.values():
-        _print(f"written: {path.resolve()}")
-    return 0
 
 
 def _positive_int(text: str) -> int:
@@ -386,10 +190,6 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-EXIT_INTERRUPTED = 130
-"""Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
-
-
 class _CtrlC:
     """Remembers a Ctrl-C for the whole command, also one that a unit's code turned into an
     FMI error on its way out (an FMU being instantiated), so the command exits 130."""
@@ -417,7 +217,19 @@ class _CtrlC:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``wire-fmu`` command."""
+    """Entry point of the ``wire-fmu`` command.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after the program name; None reads the command line
+        (and then an interrupted command ends the process with status 130).
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 1 after an error, 130 after Ctrl-C.
+    """
     args = _parser().parse_args(argv)
     logging.basicConfig(
         level=logging.DEBUG if args.verbose else logging.WARNING,
