@@ -139,9 +139,9 @@ from wire_fmu.core.components.end_stops import (
     damping_ratio_for_restitution,
     restitution_of_damping_ratio,
 )
-from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.gas import ISOTHERMAL, PolytropicGas, isothermal_charge_volume
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
+from wire_fmu.core.components.rod_seal import RodSeal, SealSpec
 from wire_fmu.core.errors import ConfigurationError, ModelError, check_positive
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
@@ -397,50 +397,6 @@ class OilSpec:
 
 
 @dataclass(frozen=True)
-class SealSpec:
-    """Rod and piston seal friction.
-
-    Parameters
-    ----------
-    static : float
-        Breakaway force (static capacity), N.
-    coulomb : float
-        Sliding (Coulomb) force at high speed, N.
-    viscous : float
-        Viscous coefficient, N s/m.
-    stribeck_velocity : float
-        Stribeck velocity, m/s; 0 switches the Stribeck decay off (the
-        sliding force is then ``coulomb``).
-    """
-
-    static: float
-    coulomb: float
-    viscous: float = 0.0
-    stribeck_velocity: float = 0.0
-
-    def problems(self) -> list[str]:
-        """Every problem with the parameters, as sentences."""
-        out: list[str] = []
-        check_positive("seal_static_friction", self.static, out, "N", zero_ok=True)
-        check_positive("seal_coulomb_friction", self.coulomb, out, "N", zero_ok=True)
-        check_positive("seal_viscous_friction", self.viscous, out, "N.s/m", zero_ok=True)
-        check_positive("seal_stribeck_velocity", self.stribeck_velocity, out, "m/s", zero_ok=True)
-        if self.coulomb > self.static:
-            out.append(
-                f"parameter 'seal_coulomb_friction' ({self.coulomb} N) must not exceed "
-                f"'seal_static_friction' ({self.static} N)"
-            )
-        return out
-
-    def sliding(self, velocity: float) -> float:
-        """Sliding friction magnitude at ``velocity`` (m/s), N (viscous part excluded)."""
-        if self.stribeck_velocity <= 0.0:
-            return self.coulomb
-        decay = math.exp(-((velocity / self.stribeck_velocity) ** 2))
-        return self.coulomb + (self.static - self.coulomb) * decay
-
-
-@dataclass(frozen=True)
 class HydraulicsSpec:
     """Everything physical about one cylinder-accumulator unit."""
 
@@ -526,7 +482,9 @@ class HydraulicsModel:
         self.mass = self.cyl.moving_mass + (self.inertance * self.area**2 if column else 0.0)
         self.exponent = spec.accumulator.polytropic_exponent if self.polytropic else ISOTHERMAL
         self.layout = self._build_layout()
-        self._build_friction()
+        self._oil_side = self._choose_oil_side()
+        self.seal = RodSeal(spec.seal, self.mass) if self.friction_on else None
+        self._viscous = self.seal.viscous if self.seal is not None else 0.0
         self.stops = EndStops(spec.stops, self.cyl.stroke, self.mass) if self.stops_on else None
         self._guard_kinds = self._build_guards()
         self._directions = np.array(
@@ -547,7 +505,6 @@ class HydraulicsModel:
         self.external_work = 0.0
         self.initial_position = 0.0
         self.last_events: list[str] = []
-        self._held_position = 0.0
 
     # ------------------------------------------------------------------ build
     def _read_effects(self, effects: frozenset[str]) -> None:
@@ -569,13 +526,6 @@ class HydraulicsModel:
                 flow, index = index, index + 1
         return _Layout(gas, p_c, flow, index, index + 1)
 
-    def _build_friction(self) -> None:
-        links = (FrictionLink("rod seals", 0, GROUND),) if self.friction_on else ()
-        self.friction = StickSlip(np.array([self.mass]), links)
-        seal = self.spec.seal
-        self._capacity = np.array([seal.static])
-        self._viscous = seal.viscous if self.friction_on else 0.0
-
     def _make_contact_solver(self, settings: SolverSettings):
         """A solver resolving the stop contact (fixed-step methods only), or None.
 
@@ -596,7 +546,7 @@ class HydraulicsModel:
         return make_solver(replace(settings, max_step=fine))
 
     def _build_guards(self) -> list[tuple[str, int]]:
-        kinds = [("seal", 0)] if self.friction_on else []
+        kinds = [("seal", 0)] if self.seal is not None else []
         kinds += [("gas_dead", 0), ("gas_empty", 0), ("cavitation", 0)]
         if self.stops is not None:
             kinds += self.stops.guard_kinds
@@ -654,17 +604,37 @@ class HydraulicsModel:
             stored,
         )
 
-    def _oil_side(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
-        """Chamber pressure, line flow, line loss and oil/line stored energy."""
-        lay = self.layout
+    def _choose_oil_side(self):
+        """The oil side's equations for the effects chosen (chosen once, at build).
+
+        Each gives, at a state, the chamber pressure (Pa), the line flow (m^3/s), the line's
+        loss (W) and the energy stored in oil and line (J).
+        """
         if not self.compressible:
-            flow = self.sa * vel
-            drop = (self.r_l + self.r_t * abs(flow)) * flow
-            return p_g - drop, flow, drop * flow, 0.0
-        if lay.chamber_pressure < 0:  # one pressure node: oil and gas in parallel
-            c_gas = v_gas / (self.exponent * p_g)
-            flow = self.sa * vel * c_gas / (c_gas + self.compliance)
-            return p_g, flow, 0.0, 0.5 * self.compliance * p_g * p_g
+            return self._rigid_column if self.losses else self._lossless_rigid_column
+        if self.layout.chamber_pressure < 0:
+            return self._one_pressure_node
+        return self._two_pressure_nodes
+
+    def _lossless_rigid_column(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
+        """Incompressible oil, lossless line: the chamber is at the gas pressure."""
+        return p_g, self.sa * vel, 0.0, 0.0
+
+    def _rigid_column(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
+        """Incompressible oil: the line's drop at the rod's flow."""
+        flow = self.sa * vel
+        drop = (self.r_l + self.r_t * abs(flow)) * flow
+        return p_g - drop, flow, drop * flow, 0.0
+
+    def _one_pressure_node(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
+        """Compressible oil with a lossless, massless line: oil and gas in parallel."""
+        c_gas = v_gas / (self.exponent * p_g)
+        flow = self.sa * vel * c_gas / (c_gas + self.compliance)
+        return p_g, flow, 0.0, 0.5 * self.compliance * p_g * p_g
+
+    def _two_pressure_nodes(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
+        """Compressible oil in the chamber, the line between it and the gas (losses, mass)."""
+        lay = self.layout
         p_c = float(x[lay.chamber_pressure])
         stored = 0.5 * self.compliance * p_c * p_c
         if lay.flow >= 0:
@@ -677,13 +647,9 @@ class HydraulicsModel:
 
     def _accelerate(self, point: _Point) -> tuple[float, float, float]:
         """Acceleration (m/s^2), seal friction force on the rod (N) and its loss (W)."""
-        if not self.friction_on:
+        if self.seal is None:
             return point.force / self.mass, 0.0, 0.0
-        caps = self._capacity
-        sliding = np.array([self.spec.seal.sliding(point.v)])
-        acc, link = self.friction.accelerations(np.array([point.force]), caps, sliding=sliding)
-        loss = self.friction.loss_power(np.array([point.v]), link)
-        return float(acc[0]), float(link[0]), float(loss)
+        return self.seal.accelerate(point.force, point.v)
 
     def chamber_pressure(self, point: _Point, acceleration: float) -> float:
         """Pressure at the cylinder port, Pa (includes ``-L dq/dt`` of an incompressible column)."""
@@ -698,7 +664,7 @@ class HydraulicsModel:
         acc, _, friction_loss = self._accelerate(point)
         lay = self.layout
         out = np.empty_like(x)
-        stuck = self.friction_on and self.friction.mode[0] == 0
+        stuck = self.seal is not None and self.seal.stuck
         out[0] = 0.0 if stuck else point.v
         out[1] = 0.0 if stuck else acc
         if lay.gas_volume >= 0:
@@ -726,9 +692,7 @@ class HydraulicsModel:
     def _guard(self, kind: str, end: int, point: _Point, acc: float, link: float) -> float:
         acc_dead = self.spec.accumulator
         if kind == "seal":
-            return float(
-                self.friction.guards(np.array([point.v]), np.array([link]), self._capacity)[0]
-            )
+            return self.seal.guard(point.v, link)
         if kind == "gas_dead":
             return point.gas_volume - acc_dead.dead_volume
         if kind == "gas_empty":
@@ -796,25 +760,20 @@ class HydraulicsModel:
 
     def project(self, x: np.ndarray) -> np.ndarray:
         """Hold a stuck rod exactly where it stuck, at rest."""
-        if self.friction_on and self.friction.mode[0] == 0:
-            x[0] = self._held_position
+        if self.seal is not None and self.seal.stuck:
+            x[0] = self.seal.held_position
             x[1] = 0.0
         return x
 
     # ------------------------------------------------------------ modes
     def _settle_friction(self, x: np.ndarray, fired: list[int]) -> np.ndarray:
         """Make the seal's mode consistent with the forces at ``x``."""
-        if not self.friction_on:
+        if self.seal is None:
             return x
-        before = self.friction.get_mode()
         point = self.evaluate(x)
-        v = self.friction.switch(np.array([x[1]]), np.array([point.force]), self._capacity, fired)
-        x[1] = v[0]
-        after = self.friction.get_mode()
-        if after != before:
-            state = "stuck" if after[0] == 0 else "sliding"
-            self.last_events.append(f"rod seals {state}")
-        self._held_position = float(x[0])
+        x[1], event = self.seal.settle(float(x[0]), float(x[1]), point.force, fired)
+        if event:
+            self.last_events.append(event)
         return x
 
     def check_limits(self, t: float, x: np.ndarray) -> None:
@@ -860,8 +819,8 @@ class HydraulicsModel:
         self.state = self._initial_state(position, velocity, p0, v0)
         if self.stops is not None:
             self.stops.start(position)
-        moving = int(math.copysign(1, velocity)) if velocity != 0.0 else 0
-        self.friction.set_mode([moving] * len(self.friction.links))  # a moving seal slides
+        if self.seal is not None:
+            self.seal.start(velocity)  # a moving seal slides
         self.initial_position = float(position)
         self.external_work = 0.0
         self.mode_changes = 0
@@ -936,10 +895,13 @@ class HydraulicsModel:
 
     def settle(self, x: np.ndarray) -> np.ndarray:
         """Seal mode consistent with the force now held (it may have jumped); the new state."""
-        before = self.friction.get_mode()
+        before = self._seal_mode()
         x = self._settle_friction(np.array(x, dtype=float), [])
-        self.mode_changes += int(self.friction.get_mode() != before)
+        self.mode_changes += int(self._seal_mode() != before)
         return self.project(x)
+
+    def _seal_mode(self) -> list[int]:
+        return [] if self.seal is None else self.seal.friction.get_mode()
 
     def _integrate(self, t: float, x: np.ndarray, t_end: float) -> tuple[np.ndarray, int]:
         """Integrate to ``t_end``; fixed-step solvers refine on a stop and in a cushion.
@@ -1009,7 +971,7 @@ class HydraulicsModel:
         """Physical quantities at the current state, for outputs."""
         point = self.evaluate(self.state, energy=True)
         acc, link, _ = self._accelerate(point)
-        if self.friction_on and self.friction.mode[0] == 0:
+        if self.seal is not None and self.seal.stuck:
             acc = 0.0
         p_c = self.chamber_pressure(point, acc)
         compliance = self.gas.compliance(point.gas_volume)

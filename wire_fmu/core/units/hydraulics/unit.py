@@ -96,6 +96,7 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
+from wire_fmu.core.components.rod_seal import SealSpec
 from wire_fmu.core.errors import ConfigurationError, ModelError
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
@@ -108,7 +109,6 @@ from wire_fmu.core.units.hydraulics.model import (
     HydraulicsModel,
     HydraulicsSpec,
     OilSpec,
-    SealSpec,
 )
 
 __all__ = ["HydraulicsUnit", "DEFAULT_ROD_FORCE"]
@@ -426,8 +426,7 @@ class HydraulicsUnit(Unit):
             "x": [float(c) for c in m.state],
             "force": float(m.force),
             "stops": None if m.stops is None else m.stops.get_state(),
-            "friction_mode": m.friction.get_mode(),
-            "held_position": float(m._held_position),
+            "seal": None if m.seal is None else m.seal.get_state(),
             "mode_changes": int(m.mode_changes),
             "external_work": float(m.external_work),
             "gas_reference": [float(m.gas.reference_pressure), float(m.gas.reference_volume)],
@@ -447,8 +446,8 @@ class HydraulicsUnit(Unit):
         m.force = float(state["force"])
         if m.stops is not None:
             m.stops.set_state(state["stops"])
-        m.friction.set_mode(list(state["friction_mode"]))
-        m._held_position = float(state["held_position"])
+        if m.seal is not None:
+            m.seal.set_state(state["seal"])
         m.mode_changes = int(state["mode_changes"])
         m.external_work = float(state["external_work"])
         p0, v0 = state["gas_reference"]
@@ -478,7 +477,7 @@ class HydraulicsUnit(Unit):
         out["accumulator.oil_volume"] = r["oil_in_accumulator"]
         out["stroke_used"] = r["position"] / m.cyl.stroke
         out["seal.friction_force"] = r["friction_force"]
-        out["seal.stuck"] = bool(m.friction_on and m.friction.mode[0] == 0)
+        out["seal.stuck"] = m.seal is not None and m.seal.stuck
         out["end_stop.force"] = r["stop_force"]
         out["end_stop.contact"] = m.stops is not None and any(m.stops.contact)
         out["stored_energy"] = r["stored_energy"]
