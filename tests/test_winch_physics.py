@@ -14,7 +14,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from wire_fmu.core.components.drive_train import DriveChain
-from wire_fmu.core.units.winch.model import BandBrake
+from wire_fmu.core.units.winch.brake import BandBrake
 
 from .winch_helpers import make_unit, one_mass, run, two_mass
 

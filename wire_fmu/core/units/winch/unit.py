@@ -50,7 +50,7 @@ from wire_fmu.core.components.drive_train import DriveChain, default_drive_train
 from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS
-from wire_fmu.core.framework.hybrid import SolverSettings
+from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
 from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.report_outputs import ReportOutputs
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
@@ -62,17 +62,11 @@ from wire_fmu.core.framework.unit import (
     output,
     parameter,
 )
-from wire_fmu.core.units.winch.model import (
-    RK4_STABILITY,
-    WINCH_EFFECTS,
-    BandBrake,
-    KinetostaticWinch,
-    WinchConfig,
-    WinchInputs,
-    WinchModel,
-    build_winch,
-    fastest_rate,
-)
+from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs
+from wire_fmu.core.units.winch.brake import BandBrake
+from wire_fmu.core.units.winch.drive import WinchModel
+from wire_fmu.core.units.winch.kinetostatic import KinetostaticWinch
+from wire_fmu.core.units.winch.model import WINCH_EFFECTS, build_winch, fastest_rate
 
 __all__ = ["WinchUnit"]
 

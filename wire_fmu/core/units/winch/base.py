@@ -1,0 +1,175 @@
+"""What both winch models share: inputs, configuration, report, drum and layer bookkeeping.
+
+Sign convention and energy: :mod:`wire_fmu.core.units.winch.model`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wire_fmu.core.components.drive_train import DriveChain
+from wire_fmu.core.components.drum import Drum
+from wire_fmu.core.errors import ModelError
+from wire_fmu.core.units.winch.brake import BandBrake
+
+__all__ = ["WinchInputs", "WinchConfig", "WinchReport"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class WinchInputs:
+    """Inputs held over one step.
+
+    Attributes
+    ----------
+    tension : float
+        Rope tension at the drum, N.
+    lever_force : float
+        Force on the brake lever, N.
+    motor_command : float
+        Motor torque (N m, at the motor shaft) or, with the motor
+        characteristic, its zero-speed torque ``a``.
+    speed_command : float
+        Drum speed the drive imposes in kinetostatic mode, rad/s.
+    """
+
+    tension: float = 0.0
+    lever_force: float = 0.0
+    motor_command: float = 0.0
+    speed_command: float = 0.0
+
+    def problems(self) -> list[str]:
+        """Names of non-finite inputs."""
+        names = ("rope.tension", "brake.lever_force", "motor.command", "drum.speed_command")
+        values = (self.tension, self.lever_force, self.motor_command, self.speed_command)
+        return [
+            f"input {n!r} is not finite ({v})"
+            for n, v in zip(names, values, strict=True)
+            if not math.isfinite(v)
+        ]
+
+
+@dataclass(frozen=True)
+class WinchConfig:
+    """Everything that defines a winch model.
+
+    Parameters
+    ----------
+    effects : frozenset of str
+        Validated by :data:`WINCH_EFFECTS`.
+    drum : Drum
+        Winding geometry (``layered`` set from the effects).
+    chain : DriveChain
+        Drive train reduced to the drum shaft, already reduced to the masses
+        the model keeps (one mass when rigid).
+    brake : BandBrake
+        Used with ``band_brake``.
+    motor_slope : float
+        ``b`` of the characteristic at the motor shaft, N m s/rad.
+    initial_speed : float
+        Drum speed at the start (inertia modes), rad/s.
+    """
+
+    effects: frozenset[str]
+    drum: Drum
+    chain: DriveChain
+    brake: BandBrake = field(default_factory=BandBrake)
+    motor_slope: float = 0.0
+    initial_speed: float = 0.0
+
+    @property
+    def has_brake(self) -> bool:
+        """Whether the band brake is modelled."""
+        return "band_brake" in self.effects
+
+
+@dataclass(frozen=True)
+class WinchReport:
+    """Every output quantity of a winch at one instant (units as in the FMU).
+
+    Each field feeds the unit's output of the same name, dots written as underscores.
+    """
+
+    rope_payout: float
+    rope_payout_rate: float
+    drum_speed: float
+    drum_angle: float
+    drum_layer: int
+    drum_radius: float
+    motor_speed: float
+    motor_torque: float
+    brake_torque: float
+    brake_capacity: float
+    brake_state: int
+    stored_energy: float
+    dissipated_energy: float
+    external_work: float
+
+
+class _WinchBase:
+    """What both winch models share: drum, brake, inputs, events, layer bookkeeping."""
+
+    def __init__(self, config: WinchConfig) -> None:
+        self.config = config
+        self.drum = config.drum
+        self.brake = config.brake
+        self.chain = config.chain
+        self.motor_ratio = config.chain.motor_ratio
+        self.layer = self.drum.initial_layer()
+        self.inputs = WinchInputs()
+        self.mode_changes = 0
+        self.last_events: list[tuple[float, str]] = []
+        self._caps = np.zeros((1, 2))
+
+    def set_inputs(self, inputs: WinchInputs) -> None:
+        """Hold ``inputs`` from now on."""
+        self.inputs = inputs
+        if self.config.has_brake:
+            self._caps = np.array([self.brake.capacities(inputs.lever_force)])
+        else:
+            self._caps = np.zeros((1, 2))
+
+    @property
+    def capacities(self) -> tuple[float, float]:
+        """Brake capacities (against paying out, against hauling in) now, N m."""
+        return float(self._caps[0, 0]), float(self._caps[0, 1])
+
+    def _event(self, t: float, text: str) -> None:
+        self.last_events.append((t, text))
+        logger.debug("winch event at t = %.9g s: %s", t, text)
+
+    def _change_layer(self, t: float, step: int) -> None:
+        """Move to the next (+1, winding in) or previous (-1, paying out) layer."""
+        new = self.layer + step
+        if new < 0:
+            raise ModelError(
+                "the rope would run off the drum: all rope on the drum has been paid out "
+                f"(rope_on_drum = {self.drum.initial_rope} m)"
+            )
+        if new >= self.drum.max_layers:
+            raise ModelError(
+                f"the drum is full: winding in beyond {self.drum.max_layers} layers "
+                "(drum_layers) would spool rope over the flanges"
+            )
+        self.layer = new
+        verb = "winds onto" if step > 0 else "pays out from"
+        self._event(t, f"rope {verb} layer {new + 1} (radius {self.drum.layer_radius(new):.6g} m)")
+
+    def held_inputs(self) -> dict[str, float]:
+        """The held inputs as plain data."""
+        i = self.inputs
+        return {
+            "tension": i.tension,
+            "lever_force": i.lever_force,
+            "motor_command": i.motor_command,
+            "speed_command": i.speed_command,
+        }
+
+    def restore_held_inputs(self, data: dict[str, float]) -> None:
+        """Restore inputs saved by :meth:`held_inputs`."""
+        self.set_inputs(WinchInputs(**{k: float(v) for k, v in data.items()}))

@@ -1,0 +1,396 @@
+"""The winch with drum inertia: a hybrid ODE of drum, drive train, motor and band brake.
+
+The equations, sign convention and energy ledger are in :mod:`wire_fmu.core.units.winch.model`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numpy as np
+
+from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.framework.energy_integrator import (
+    ENERGY_SOLVERS,
+    MachineUnit,
+    StepWork,
+    make_energy_solver,
+)
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
+from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLDING, BRAKE_SLIPPING
+
+__all__ = ["WinchModel"]
+
+
+class WinchModel(_WinchBase):
+    """Winch with drum inertia: a hybrid ODE (:mod:`wire_fmu.core.units.winch.model`).
+
+    State ``[theta_0..theta_{n-1}, omega_0..omega_{n-1}, dissipated,
+    external work]``: angles (rad) and speeds (rad/s) of the chain's masses
+    reduced to the drum shaft, mass 0 the motor rotor, mass ``n - 1`` the
+    drum (``theta_{n-1} = phi``). Modes: the brake's engagement and
+    stick/slip mode, the rope layer.
+
+    Parameters
+    ----------
+    config : WinchConfig
+        The winch.
+    solver : SolverSettings
+        Internal solver; ``"energy"``/``"energy1"`` (paper 004) only for a
+        rigid drive train (one mass).
+    """
+
+    def __init__(self, config: WinchConfig, solver: SolverSettings) -> None:
+        super().__init__(config)
+        chain = config.chain
+        self.n = chain.n
+        self.base_inertia = np.array(chain.inertias, dtype=float)
+        self.stiffness = chain.stiffness_matrix()
+        self.damping = chain.damping_matrix()
+        links = (FrictionLink("band brake", self.n - 1, GROUND),) if config.has_brake else ()
+        self.friction = StickSlip(self.base_inertia.copy(), links)
+        self.masses = self.friction.masses  # the drum's entry follows I(phi)
+        self.characteristic = "motor_characteristic" in config.effects
+        self.motor_b = config.motor_slope * self.motor_ratio**2 if self.characteristic else 0.0
+        self.engaged = False
+        self.state = np.zeros(2 * self.n + 2)
+        self._held_angle = 0.0
+        self._n_brake_guards = 2 if config.has_brake else 0
+        self._guard_dirs = -np.ones(self._n_brake_guards + 2 * int(self.drum.layered))
+        self.settings = solver
+        if solver.method in ENERGY_SOLVERS:
+            if self.n != 1:
+                raise ValueError("the energy-form solver needs a rigid drive train (one mass)")
+            self.solver = make_energy_solver(solver)
+        else:
+            self.solver = make_solver(solver)
+
+    # ---------------------------------------------------------- state views
+    @property
+    def phi(self) -> float:
+        """Drum angle, rad."""
+        return float(self.state[self.n - 1])
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Speeds of the masses reduced to the drum shaft, rad/s."""
+        return self.state[self.n : 2 * self.n]
+
+    # ---------------------------------------------------------- torques
+    def motor_torque(self, motor_speed: float) -> float:
+        """Motor torque at the motor shaft, N m, at real motor speed (rad/s)."""
+        if self.characteristic:
+            return self.inputs.motor_command - self.config.motor_slope * motor_speed
+        return self.inputs.motor_command
+
+    def _motor_reduced(self, omega0: float) -> float:
+        """Motor torque reduced to the drum shaft at reduced speed ``omega0``."""
+        return self.motor_ratio * self.inputs.motor_command - self.motor_b * omega0
+
+    def _forces(self, x: np.ndarray) -> np.ndarray:
+        """All torques except the brake's on every mass (reduced), N m; updates I(phi)."""
+        n = self.n
+        theta, omega = x[:n], x[n : 2 * n]
+        if n > 1:
+            forces = -(self.stiffness @ theta) - self.damping @ omega
+        else:
+            forces = np.array([-self.damping[0, 0] * omega[0]])
+        forces[0] += self._motor_reduced(omega[0])
+        phi, w = theta[n - 1], omega[n - 1]
+        drum, k = self.drum, self.layer
+        forces[n - 1] += (
+            self.inputs.tension * drum.layer_radius(k) - 0.5 * drum.rope_inertia_slope(k) * w * w
+        )
+        self.masses[n - 1] = self.base_inertia[n - 1] + drum.rope_inertia(phi, k)
+        return forces
+
+    def _dynamics(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Accelerations and brake torque (shape (0,) or (1,)) in the current mode."""
+        forces = self._forces(x)
+        if self.engaged:
+            return self.friction.accelerations(forces, self._caps)
+        return forces / self.masses, np.zeros(len(self.friction.links))
+
+    def drum_held(self) -> bool:
+        """Whether the brake holds the drum at rest."""
+        return self.engaged and self.friction.mode[0] == 0
+
+    # ------------------------------------------------ HybridSystem protocol
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[theta', omega', dissipated', external work']``."""
+        n = self.n
+        omega = x[n : 2 * n]
+        acc, link = self._dynamics(x)
+        out = np.empty_like(x)
+        out[:n] = omega
+        out[n : 2 * n] = acc
+        loss = float(omega @ self.damping @ omega)
+        if self.engaged:
+            loss += self.friction.loss_power(omega, link)
+            if self.friction.mode[0] == 0:
+                out[n - 1] = 0.0
+        r = self.drum.layer_radius(self.layer)
+        out[2 * n] = loss
+        out[2 * n + 1] = (
+            self._motor_reduced(omega[0]) * omega[0] + self.inputs.tension * r * omega[n - 1]
+        )
+        return out
+
+    def guard_directions(self) -> np.ndarray:
+        """All guards fire on a downward crossing."""
+        return self._guard_dirs
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """Brake stick/slip, brake engagement, then the layer's two edges.
+
+        Stick/slip: the holding margin (held) or direction * speed (sliding).
+        Engagement: ``-F`` while released, ``F`` while applied (``F`` the
+        lever force); it can only fire when the lever force varies within a
+        step, as in a monolithic model -- held inputs are settled at the
+        start of every step.
+        """
+        out = []
+        if self.config.has_brake:
+            if self.engaged:
+                _, link = self._dynamics(x)
+                out.extend(self.friction.guards(x[self.n : 2 * self.n], link, self._caps))
+                out.append(self.inputs.lever_force)
+            else:
+                out += [1.0, -self.inputs.lever_force]
+        if self.drum.layered:
+            low, high = self.drum.phi_bounds(self.layer)
+            phi = x[self.n - 1]
+            out += [phi - low, high - phi]
+        return np.array(out, dtype=float)
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """Brake stick/slip, or the rope changing layer."""
+        x = np.array(x, dtype=float)
+        n_brake = self._n_brake_guards
+        for i in fired:
+            if i >= n_brake:
+                self._change_layer_keeping_energy(t, x, +1 if i == n_brake else -1)
+        x = self._settle_modes(t, x, [0] if 0 in fired and n_brake else [])
+        self.mode_changes += 1
+        return self.project(x)
+
+    def _change_layer_keeping_energy(self, t: float, x: np.ndarray, step: int) -> None:
+        """Change layer; rescale the drum speed so its kinetic energy is continuous.
+
+        The event is located just past the edge, where the old layer's
+        inertia law has been extrapolated by at most the event tolerance;
+        the rescaling (a relative change of that order) keeps the ledger exact.
+        """
+        n, phi = self.n, x[self.n - 1]
+        before = self.base_inertia[n - 1] + self.drum.rope_inertia(phi, self.layer)
+        self._change_layer(t, step)
+        after = self.base_inertia[n - 1] + self.drum.rope_inertia(phi, self.layer)
+        x[2 * n - 1] *= math.sqrt(before / after)
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """A held drum stays exactly where it stuck, at rest."""
+        if self.drum_held():
+            x[self.n - 1] = self._held_angle
+            x[2 * self.n - 1] = 0.0
+        return x
+
+    # ------------------------------------------ RigidMachineSystem protocol
+    def machine(self, t: float, x: np.ndarray) -> MachineUnit | None:
+        """Paper 004's machine unit of the current mode (rigid chain only)."""
+        if self.drum_held():
+            return None
+        sliding = 0.0
+        if self.engaged:
+            mode = int(self.friction.mode[0])
+            sliding = mode * (self._caps[0, 0] if mode > 0 else self._caps[0, 1])
+        drum, k, base = self.drum, self.layer, float(self.base_inertia[0])
+        rope_torque = self.inputs.tension * drum.layer_radius(k)
+        beta = float(self.damping[0, 0])
+        return MachineUnit(
+            inertia=lambda phi: base + drum.rope_inertia(phi, k),
+            inertia_slope=lambda phi: drum.rope_inertia_slope(k),
+            a=self.motor_ratio * self.inputs.motor_command,
+            b=self.motor_b,
+            resistance_angle=lambda phi: -rope_torque,
+            resistance_angle_work=lambda p0, p1: -rope_torque * (p1 - p0),
+            resistance_speed=lambda w: sliding + beta * w,
+            resistance_speed_slope=lambda w: beta,
+        )
+
+    def book(self, work: StepWork) -> tuple[float, float]:
+        """Brake and dampers dissipate; motor and rope are external."""
+        return work.speed, work.driving - work.angle
+
+    # ---------------------------------------------------------- modes
+    def brake_state(self) -> int:
+        """0 released, 1 slipping, 2 holding."""
+        if not self.engaged:
+            return BRAKE_FREE
+        return BRAKE_HOLDING if self.friction.mode[0] == 0 else BRAKE_SLIPPING
+
+    def _mode_key(self) -> tuple[bool, int]:
+        return self.engaged, int(self.friction.mode[0]) if self.friction.links else 0
+
+    def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
+        """Make the brake's engagement and stick/slip mode fit the inputs at (t, x)."""
+        if not self.config.has_brake:
+            return x
+        x = np.array(x, dtype=float)
+        before = self._mode_key()
+        n = self.n
+        if min(self.capacities) <= 0.0:
+            self.engaged = False
+        else:
+            if not self.engaged:
+                self.friction.set_mode([int(np.sign(x[2 * n - 1]))])
+                self.engaged = True
+            forces = self._forces(x)
+            x[n : 2 * n] = self.friction.switch(x[n : 2 * n], forces, self._caps, fired or [])
+        if self._mode_key() != before or fired:
+            self._event(t, f"brake {_BRAKE_WORDS[self.brake_state()]}")
+            if fired is None:
+                self.mode_changes += 1
+        self._held_angle = float(x[n - 1])
+        return self.project(x)
+
+    # ---------------------------------------------------------- life cycle
+    def initialize(self, t0: float, inputs: WinchInputs) -> None:
+        """Start at the configured speed with the shafts already carrying their torques.
+
+        The shafts are twisted as in quasi-static motion: every mass has the
+        acceleration the chain would have if it were rigid (zero when the
+        brake holds), so the start causes no shaft vibration.
+        """
+        self.set_inputs(inputs)
+        self.layer = self.drum.initial_layer()
+        n = self.n
+        x = np.zeros(2 * n + 2)
+        x[n : 2 * n] = self.config.initial_speed
+        forces = self._forces(x)
+        acc = self._rigid_acceleration(float(forces.sum()), float(self.masses.sum()), x[2 * n - 1])
+        twists = np.cumsum(forces[:-1] - self.masses[:-1] * acc) / np.asarray(
+            self.chain.stiffnesses, dtype=float
+        )
+        x[: n - 1] = np.cumsum(twists[::-1])[::-1]  # angles relative to the drum's 0
+        self.engaged = False
+        self.mode_changes = 0
+        self.last_events = []
+        self.state = self._settle_modes(t0, x, [])
+        self._forces(self.state)
+
+    def _rigid_acceleration(self, torque: float, inertia: float, omega: float) -> float:
+        """Acceleration of the chain locked rigid under ``torque`` (N m) and the brake."""
+        plus, minus = self.capacities
+        if not self.config.has_brake or min(plus, minus) <= 0.0:
+            return torque / inertia
+        if omega == 0.0:
+            if -minus <= torque <= plus:  # the brake can hold
+                return 0.0
+            direction = 1.0 if torque > 0.0 else -1.0
+        else:
+            direction = 1.0 if omega > 0.0 else -1.0
+        return (torque - direction * (plus if direction > 0 else minus)) / inertia
+
+    def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
+        """Advance by ``h`` with ``inputs`` held; return the number of events."""
+        self.last_events = []
+        self.set_inputs(inputs)
+        self.state = self._settle_modes(t, self.state)
+        x, events = self.solver.advance(self, t, self.state, t + h)
+        self.state = x
+        self._forces(x)
+        return events
+
+    # ---------------------------------------------------------- outputs
+    def stored_energy(self, x: np.ndarray | None = None) -> float:
+        """Kinetic energy of every mass plus shaft strain energy, J."""
+        x = self.state if x is None else x
+        n = self.n
+        theta, omega = x[:n], x[n : 2 * n]
+        self._forces(x)
+        return 0.5 * float(self.masses @ omega**2) + 0.5 * float(theta @ self.stiffness @ theta)
+
+    def report(self) -> WinchReport:
+        """Outputs at the current state for the held inputs (state untouched)."""
+        x = self.state
+        n = self.n
+        _, link = self._dynamics(x)
+        w, k = float(x[2 * n - 1]), self.layer
+        radius = self.drum.layer_radius(k)
+        motor_speed = self.motor_ratio * float(x[n])
+        return WinchReport(
+            rope_payout=self.drum.payout(self.phi, k),
+            rope_payout_rate=radius * w,
+            drum_speed=w,
+            drum_angle=self.phi,
+            drum_layer=k + 1,
+            drum_radius=radius,
+            motor_speed=motor_speed,
+            motor_torque=self.motor_torque(motor_speed),
+            brake_torque=float(link[0]) + 0.0 if self.engaged else 0.0,
+            brake_capacity=self.capacities[0],
+            brake_state=self.brake_state(),
+            stored_energy=self.stored_energy(),
+            dissipated_energy=float(x[2 * n]),
+            external_work=float(x[2 * n + 1]),
+        )
+
+    @contextmanager
+    def trial(self, inputs: WinchInputs) -> Iterator[None]:
+        """Modes settled for other inputs, undone on exit (for feedthrough outputs)."""
+        saved = (
+            self.inputs,
+            self.engaged,
+            self.friction.get_mode(),
+            self.mode_changes,
+            list(self.last_events),
+            self._held_angle,
+            self.state.copy(),
+        )
+        try:
+            self.set_inputs(inputs)
+            self._settle_modes(0.0, self.state)
+            self.mode_changes = saved[3]  # a trial is not an event
+            yield
+        finally:
+            (
+                inputs_,
+                self.engaged,
+                mode,
+                self.mode_changes,
+                self.last_events,
+                self._held_angle,
+                self.state,
+            ) = saved
+            self.friction.set_mode(mode)
+            self.set_inputs(inputs_)
+            self._forces(self.state)
+
+    def get_state(self) -> dict:
+        """Complete model state as plain data."""
+        return {
+            "x": [float(c) for c in self.state],
+            "layer": int(self.layer),
+            "engaged": bool(self.engaged),
+            "friction_mode": self.friction.get_mode(),
+            "held_angle": float(self._held_angle),
+            "mode_changes": int(self.mode_changes),
+            "inputs": self.held_inputs(),
+            "solver": {"rhs_calls": int(self.solver.rhs_calls), "steps": int(self.solver.steps)},
+        }
+
+    def set_state(self, data: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.state = np.array(data["x"], dtype=float)
+        self.layer = int(data["layer"])
+        self.engaged = bool(data["engaged"])
+        self.friction.set_mode(list(data["friction_mode"]))
+        self._held_angle = float(data["held_angle"])
+        self.mode_changes = int(data["mode_changes"])
+        self.restore_held_inputs(data["inputs"])
+        self.solver.rhs_calls = int(data["solver"]["rhs_calls"])
+        self.solver.steps = int(data["solver"]["steps"])
+        self._forces(self.state)

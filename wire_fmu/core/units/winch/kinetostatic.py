@@ -1,0 +1,190 @@
+"""The winch without inertia (eq. 32): a speed-commanded drive, stepped exactly.
+
+Paper 000's winch (32) ``T r + M + M_f = 0`` has no inertia, so the motion
+cannot follow from the torques: the drive is *speed commanded*. The drum
+turns at ``drum.speed_command`` (rad/s) and the motor torque follows from
+(32) with the drive train's viscous losses: ``M = beta omega - T r -
+M_brake``. With the command at zero the drum is held (paper's braking
+mode): the brake takes the holding torque up to its capacity and the motor
+the rest. The drive takes up a new command at the start of a step and
+holds it over the step; the speed outputs report the speed over the step
+just finished (their left limit), so the payout outputs depend on no input
+in this mode either. Without inertia nothing is integrated: payout, work
+and losses are exact for the held inputs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numpy as np
+
+from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
+from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLDING, BRAKE_SLIPPING
+
+__all__ = ["KinetostaticWinch"]
+
+
+class KinetostaticWinch(_WinchBase):
+    """Winch without inertia (eq. 32): a speed-commanded drive, stepped exactly.
+
+    State ``[phi, omega over the last step, dissipated, external work]``.
+    The rules are in the module docstring.
+    """
+
+    def __init__(self, config: WinchConfig) -> None:
+        super().__init__(config)
+        self.beta = float(math.fsum(config.chain.dampings))
+        self.state = np.zeros(4)
+        self._brake_state = BRAKE_FREE
+        self.solver = None
+
+    def initialize(self, t0: float, inputs: WinchInputs) -> None:
+        """At rest at ``phi = 0``, turning at the speed command from the start."""
+        self.set_inputs(inputs)
+        self.layer = self.drum.initial_layer()
+        self.state = np.array([0.0, inputs.speed_command, 0.0, 0.0])
+        self._brake_state = self._brake_state_for(inputs.speed_command)
+        self.mode_changes = 0
+        self.last_events = []
+
+    def _brake_state_for(self, omega: float) -> int:
+        if not self.config.has_brake or min(self.capacities) <= 0.0:
+            return BRAKE_FREE
+        return BRAKE_SLIPPING if omega != 0.0 else BRAKE_HOLDING
+
+    def _brake_and_motor(self, omega: float) -> tuple[float, float]:
+        """(brake torque, motor torque) on the drum shaft by (32), N m."""
+        rope = self.inputs.tension * self.drum.layer_radius(self.layer)
+        plus, minus = self.capacities
+        if omega > 0.0:
+            brake = -plus
+        elif omega < 0.0:
+            brake = minus
+        else:  # held: the brake takes what it can of the holding torque -rope
+            brake = max(-rope, -plus) if rope > 0.0 else min(-rope, minus)
+        return brake, self.beta * omega - rope - brake
+
+    def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
+        """Turn at the commanded speed for ``h``; exact payout, work and losses."""
+        self.last_events = []
+        self.set_inputs(inputs)
+        omega = inputs.speed_command
+        phi0, k0 = float(self.state[0]), self.layer
+        phi1 = phi0 + omega * h
+        self._cross_layers(t, h, phi0, phi1)
+        state = self._brake_state_for(omega)
+        if state != self._brake_state:
+            self._brake_state = state
+            self.mode_changes += 1
+            self._event(t, f"brake {_BRAKE_WORDS[state]}")
+        paid = self.drum.payout(phi1, self.layer) - self.drum.payout(phi0, k0)
+        brake = self._brake_and_motor(omega)[0]
+        dissipated = -brake * (phi1 - phi0) + self.beta * omega * omega * h
+        rope_work = inputs.tension * paid
+        motor_work = dissipated - rope_work  # what (32) makes the motor do
+        self.state = np.array(
+            [phi1, omega, self.state[2] + dissipated, self.state[3] + rope_work + motor_work]
+        )
+        return len(self.last_events)
+
+    def _cross_layers(self, t: float, h: float, phi0: float, phi1: float) -> None:
+        """Change layer for every boundary between ``phi0`` and ``phi1``."""
+        speed = (phi1 - phi0) / h if h else 0.0
+        for _ in range(self.drum.max_layers + 1):
+            low, high = self.drum.phi_bounds(self.layer)
+            if phi1 < low:
+                edge, step = low, +1
+            elif phi1 > high:
+                edge, step = high, -1
+            else:
+                return
+            self._change_layer(t + (edge - phi0) / speed, step)
+            self.mode_changes += 1
+
+    def stored_energy(self) -> float:
+        """No inertia, no springs: 0 J."""
+        return 0.0
+
+    # ------------------------------ HybridSystem protocol (monolithic models)
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``[phi', 0, dissipated', external work']`` at the commanded speed."""
+        omega = self.inputs.speed_command
+        brake, motor = self._brake_and_motor(omega)
+        rope = self.inputs.tension * self.drum.layer_radius(self.layer)
+        loss = -brake * omega + self.beta * omega * omega
+        return np.array([omega, 0.0, loss, (rope + motor) * omega])
+
+    def guard_directions(self) -> np.ndarray:
+        """The layer's two edges fire on a downward crossing."""
+        return -np.ones(2 if self.drum.layered else 0)
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The layer's two edges (none without layers)."""
+        if not self.drum.layered:
+            return np.zeros(0)
+        low, high = self.drum.phi_bounds(self.layer)
+        return np.array([x[0] - low, high - x[0]])
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """The rope changes layer."""
+        for i in fired:
+            self._change_layer(t, +1 if i == 0 else -1)
+        self.mode_changes += 1
+        return np.array(x, dtype=float)
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """No invariants."""
+        return x
+
+    def report(self) -> WinchReport:
+        """Outputs for the drum speed of the last step and the held inputs."""
+        phi, omega = float(self.state[0]), float(self.state[1])
+        radius = self.drum.layer_radius(self.layer)
+        brake, motor = self._brake_and_motor(omega)
+        return WinchReport(
+            rope_payout=self.drum.payout(phi, self.layer),
+            rope_payout_rate=radius * omega,
+            drum_speed=omega,
+            drum_angle=phi,
+            drum_layer=self.layer + 1,
+            drum_radius=radius,
+            motor_speed=self.motor_ratio * omega,
+            motor_torque=motor / self.motor_ratio,
+            brake_torque=brake + 0.0,
+            brake_capacity=self.capacities[0],
+            brake_state=self._brake_state_for(omega),
+            stored_energy=0.0,
+            dissipated_energy=float(self.state[2]),
+            external_work=float(self.state[3]),
+        )
+
+    @contextmanager
+    def trial(self, inputs: WinchInputs) -> Iterator[None]:
+        """Other inputs for reading feedthrough outputs, undone on exit."""
+        saved = self.inputs
+        try:
+            self.set_inputs(inputs)
+            yield
+        finally:
+            self.set_inputs(saved)
+
+    def get_state(self) -> dict:
+        """Complete model state as plain data."""
+        return {
+            "x": [float(c) for c in self.state],
+            "layer": int(self.layer),
+            "brake_state": int(self._brake_state),
+            "mode_changes": int(self.mode_changes),
+            "inputs": self.held_inputs(),
+        }
+
+    def set_state(self, data: dict) -> None:
+        """Restore a state from :meth:`get_state`."""
+        self.state = np.array(data["x"], dtype=float)
+        self.layer = int(data["layer"])
+        self._brake_state = int(data["brake_state"])
+        self.mode_changes = int(data["mode_changes"])
+        self.restore_held_inputs(data["inputs"])
