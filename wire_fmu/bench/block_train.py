@@ -38,7 +38,18 @@ def effect_sets() -> list[str]:
 
 
 def lowering(i: int) -> dict[str, float]:
-    """Fast line paid out at SPEED for 100 steps, then held."""
+    """Fast line paid out at SPEED for 100 steps, then held.
+
+    Parameters
+    ----------
+    i : int
+        Step number, from 0.
+
+    Returns
+    -------
+    dict of str to float
+        ``line_a.payout`` (m) and ``line_a.payout_rate`` (m/s).
+    """
     moving = min(i, 100)
     return {"line_a.payout": SPEED * STEP * moving, "line_a.payout_rate": SPEED if i < 100 else 0.0}
 
@@ -60,7 +71,13 @@ def cases() -> list[Case]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point."""
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
     args = command_line(__doc__.splitlines()[0], argv)
     text = run_cases(
         "BlockTrain",

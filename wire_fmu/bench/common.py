@@ -90,7 +90,22 @@ def _core_unit(case: Case) -> Unit:
 
 
 def time_core(case: Case, steps: int) -> tuple[float, int]:
-    """Median ms per step of the core unit, and the size of its state."""
+    """Median ms per step of the core unit, and the size of its state.
+
+    Parameters
+    ----------
+    case : Case
+        The manoeuvre.
+    steps : int
+        Steps timed (the first ``WARM_UP`` do not count).
+
+    Returns
+    -------
+    ms_per_step : float
+        Median wall time of one ``advance``, ms.
+    states : int
+        Length of the unit's continuous state vector.
+    """
     unit = _core_unit(case)
     samples = []
     for i in range(steps):
@@ -114,6 +129,17 @@ class _AdvanceTimer:
         original, timer = self._original, self
 
         def timed(unit, time_, step):
+            """The unit's ``advance``, timed.
+
+            Parameters
+            ----------
+            unit : Unit
+                The unit stepped.
+            time_ : float
+                Start of the step, s.
+            step : float
+                Communication step, s.
+            """
             start = time.perf_counter()
             try:
                 return original(unit, time_, step)
@@ -128,7 +154,24 @@ class _AdvanceTimer:
 
 
 def time_fmu(fmu_path: Path, case: Case, steps: int) -> tuple[float, float]:
-    """Median ms per FMU step (set inputs, doStep, get outputs), and of it outside ``advance``."""
+    """Median ms per FMU step (set inputs, doStep, get outputs), and of it outside ``advance``.
+
+    Parameters
+    ----------
+    fmu_path : Path
+        The built FMU of ``case``'s unit.
+    case : Case
+        The manoeuvre.
+    steps : int
+        Steps timed (the first ``WARM_UP`` do not count).
+
+    Returns
+    -------
+    fmu_ms : float
+        Median wall time of one FMU step, ms.
+    overhead_ms : float
+        Median of its part outside the unit's ``advance``, ms.
+    """
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -172,14 +215,34 @@ def time_fmu(fmu_path: Path, case: Case, steps: int) -> tuple[float, float]:
 
 
 def measure(fmu_path: Path, case: Case, steps: int) -> Row:
-    """Time ``case`` in the core and through the FMU at ``fmu_path``."""
+    """Time ``case`` in the core and through the FMU at ``fmu_path``.
+
+    Parameters
+    ----------
+    fmu_path : Path
+        The built FMU of ``case``'s unit.
+    case : Case
+        The manoeuvre.
+    steps : int
+        Steps timed in each (the first ``WARM_UP`` do not count).
+
+    Returns
+    -------
+    Row
+    """
     core_ms, states = time_core(case, steps)
     fmu_ms, overhead_ms = time_fmu(fmu_path, case, steps)
     return Row(case.label, states, core_ms, fmu_ms, overhead_ms)
 
 
 def table(rows: list[Row]) -> str:
-    """Markdown table of the figures."""
+    """Markdown table of the figures.
+
+    Parameters
+    ----------
+    rows : list of Row
+        One per case.
+    """
     lines = [
         "| effects | states | core ms/step | FMU ms/step | FMI overhead ms | share |",
         "|---|---:|---:|---:|---:|---:|",
@@ -193,7 +256,20 @@ def table(rows: list[Row]) -> str:
 
 
 def command_line(description: str, argv: list[str] | None) -> argparse.Namespace:
-    """Parse the options every unit benchmark takes and set up logging."""
+    """Parse the options every unit benchmark takes and set up logging.
+
+    Parameters
+    ----------
+    description : str
+        The benchmark's description for ``--help``.
+    argv : list of str or None
+        The arguments; None reads the command line.
+
+    Returns
+    -------
+    argparse.Namespace
+        ``steps`` (int) and ``out`` (Path or None).
+    """
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--steps", type=int, default=200, help="steps per measurement")
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
@@ -206,7 +282,24 @@ def command_line(description: str, argv: list[str] | None) -> argparse.Namespace
 
 def run_cases(unit: str, cases: Sequence[Case], steps: int, title: str) -> str:
     """Build our unit type ``unit`` (:mod:`wire_fmu.registry`) into a temporary folder, measure
-    every case, log the table."""
+    every case, log the table.
+
+    Parameters
+    ----------
+    unit : str
+        Name of our unit type, e.g. ``"Winch"``.
+    cases : sequence of Case
+        The manoeuvres.
+    steps : int
+        Steps timed per case.
+    title : str
+        Heading of the logged table.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     from wire_fmu.export.builder import build_fmu
     from wire_fmu.registry import unit_type
 

@@ -38,14 +38,36 @@ def effect_sets() -> list[str]:
 
 
 def heave(i: int) -> dict[str, float]:
-    """Rope force on the rod at step ``i``: a heave-like variation about the rated load."""
+    """Rope force on the rod at step ``i``: a heave-like variation about the rated load.
+
+    Parameters
+    ----------
+    i : int
+        Step number, from 0.
+
+    Returns
+    -------
+    dict of str to float
+        ``rod.force``, N.
+    """
     t = i * STEP
     variation = 0.02 * math.sin(2 * math.pi * 0.2 * t) + 0.01 * math.sin(2 * math.pi * 1.3 * t)
     return {"rod.force": DEFAULT_ROD_FORCE * (1.0 + variation)}
 
 
 def impact(i: int) -> dict[str, float]:
-    """Rated load for 0.2 s, then 15 % of it is lost: the rod runs onto its stop."""
+    """Rated load for 0.2 s, then 15 % of it is lost: the rod runs onto its stop.
+
+    Parameters
+    ----------
+    i : int
+        Step number, from 0.
+
+    Returns
+    -------
+    dict of str to float
+        ``rod.force``, N.
+    """
     return {"rod.force": DEFAULT_ROD_FORCE * (1.0 if i < 20 else 0.85)}
 
 
@@ -77,7 +99,13 @@ def cases() -> list[Case]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point."""
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
     args = command_line(__doc__.splitlines()[0], argv)
     text = run_cases(
         "Hydraulics",

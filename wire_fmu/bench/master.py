@@ -47,7 +47,21 @@ class SceneFigures:
 
 
 def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
-    """Run one scene and collect its figures."""
+    """Run one scene and collect its figures.
+
+    Parameters
+    ----------
+    name : str
+        A shipped scene's name.
+    stop_time : float or None
+        Simulated time, s; None keeps the scene's.
+    out : Path
+        Folder the scene's results go into (in a subfolder named after it).
+
+    Returns
+    -------
+    SceneFigures
+    """
     outcome = run_scene(name, out / name, plots=False, stop_time=stop_time)
     sim, result = outcome.simulation, outcome.result
     if result.status != "finished":
@@ -57,7 +71,13 @@ def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
 
 
 def table(rows: list[SceneFigures]) -> str:
-    """Markdown table of the figures."""
+    """Markdown table of the figures.
+
+    Parameters
+    ----------
+    rows : list of SceneFigures
+        One per scene.
+    """
     lines = [
         "| scene | units | macro steps | simulated s | wall s | real-time factor | "
         "master overhead per unit per step |",
@@ -72,7 +92,13 @@ def table(rows: list[SceneFigures]) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point."""
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop-time", type=float, help="shorten every scene to this, s")
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")

@@ -61,7 +61,15 @@ class Timing:
 
 
 def two_mass_scene(fmu_dir: Path, stop_time: float) -> Scene:
-    """The two-mass oscillator scene, its test FMUs built into ``fmu_dir``."""
+    """The two-mass oscillator scene, its test FMUs built into ``fmu_dir``.
+
+    Parameters
+    ----------
+    fmu_dir : Path
+        Folder the test FMUs are built into.
+    stop_time : float
+        Simulated time of each case, s.
+    """
     import sys
 
     from wire_fmu.export.builder import build_fmu
@@ -166,7 +174,25 @@ def _fastest(
 def measure(
     scene: Scene | str, spec: SweepSpec, workers: int, out: Path, repeat: int = 1
 ) -> Timing:
-    """Run the sweep serially, then on ``workers`` workers; check both agree."""
+    """Run the sweep serially, then on ``workers`` workers; check both agree.
+
+    Parameters
+    ----------
+    scene : Scene or str
+        The scene, or a shipped scene's name.
+    spec : SweepSpec
+        The sweep.
+    workers : int
+        Worker processes of the local Dask cluster.
+    out : Path
+        Folder the runs write into.
+    repeat : int
+        Runs of each, the fastest counts.
+
+    Returns
+    -------
+    Timing
+    """
     load = os.getloadavg()[0]
     serial = _fastest(scene, spec, 0, out, repeat)
     parallel = _fastest(scene, spec, workers, out, repeat)
@@ -192,7 +218,13 @@ def _mean_case(result: SweepResult) -> float:
 
 
 def table(t: Timing) -> str:
-    """Markdown table of the figures."""
+    """Markdown table of the figures.
+
+    Parameters
+    ----------
+    t : Timing
+        The sweep's timings.
+    """
     return "\n".join(
         [
             f"| cases | one case, serial | one case, {t.workers} workers | serial | "
@@ -209,7 +241,13 @@ def table(t: Timing) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point."""
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--stop-time",

@@ -49,7 +49,19 @@ def effect_sets() -> list[str]:
 
 
 def lowering_then_stop(i: int) -> dict[str, float]:
-    """Inputs at step ``i``: lower for 1 s, then brake hard and hold."""
+    """Inputs at step ``i``: lower for 1 s, then brake hard and hold.
+
+    Parameters
+    ----------
+    i : int
+        Step number, from 0.
+
+    Returns
+    -------
+    dict of str to float
+        ``rope.tension`` (N), ``motor.command`` (N m), ``brake.lever_force`` (N)
+        and ``drum.speed_command`` (rad/s).
+    """
     stopping = i >= STOP_STEP
     return {
         "rope.tension": 1.2e5,
@@ -116,7 +128,13 @@ def _payout_after(
 
 
 def accuracy_table(steps: int) -> str:
-    """Error of the rope paid out against Radau at rtol 1e-11, per solver and step (Markdown)."""
+    """Error of the rope paid out against Radau at rtol 1e-11, per solver and step (Markdown).
+
+    Parameters
+    ----------
+    steps : int
+        Steps of the manoeuvre run with each solver.
+    """
     reference, _ = _payout_after("radau", 1e-3, steps, rtol=1e-11)
     lines = ["| solver | max step s | payout error m | core ms/step |", "|---|---:|---:|---:|"]
     for solver in SOLVERS:
@@ -127,7 +145,13 @@ def accuracy_table(steps: int) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point."""
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
     args = command_line(__doc__.splitlines()[0], argv)
     text = run_cases(
         "Winch",
