@@ -65,7 +65,7 @@ Thread friction models
     paper 003's regularised torque (linear inside ``|psi'| < w1``,
     saturated outside) or its ``tanh`` variant; stiff
     (``lambda ~ M1 / (I w1)``) and creeping while held
-    (:meth:`ScrewThread.creep_speed`).
+    (:meth:`~wire_fmu.core.components.screw_nut.thread.ScrewThread.creep_speed`).
 
 The handle is driven either by a torque (dynamics as above) or by a speed
 (kinematically, as in the paper's section 2: "the handle is turned at
@@ -75,32 +75,34 @@ must supply, and a change of the commanded speed is an impulse whose work
 
 Energy: stored ``I psi'^2 / 2 + W y`` (J), dissipated by the thread
 ``-M_f psi'`` (W, >= 0), external work of the handle ``M psi'``.
+
+Modules
+-------
+:mod:`~wire_fmu.core.units.scissor_jack.geometry`
+    The rhombus of tie rods: height and its slopes over the screw travel.
+:mod:`~wire_fmu.core.units.scissor_jack.config`
+    Configuration, inputs and report of the jack.
+:mod:`~wire_fmu.core.units.scissor_jack.mechanics`
+    Kinematics and forces in the current mode (a part of the model).
 """
 
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
-from wire_fmu.core.components.screw_nut.thread import REGULARISATIONS, ScrewThread
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.units.scissor_jack.config import JackConfig, JackInputs, JackReport
+from wire_fmu.core.units.scissor_jack.mechanics import JackMechanics
 
 __all__ = [
-    "JackGeometry",
-    "JackConfig",
-    "JackInputs",
-    "JackReport",
     "ScissorJackModel",
-    "FRICTION_MODELS",
-    "HANDLE_DRIVES",
     "THREAD_FREE",
     "THREAD_SLIDING",
     "THREAD_STUCK",
@@ -108,12 +110,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-FRICTION_MODELS = ("none", "stick_slip", "linear", "tanh")
-"""Thread friction models (module docstring)."""
-
-HANDLE_DRIVES = ("speed", "torque")
-"""How the handle is driven: kinematically by a speed, or by a torque."""
 
 THREAD_FREE, THREAD_SLIDING, THREAD_STUCK, THREAD_CREEPING = 0, 1, 2, 3
 _STATE_WORDS = {
@@ -124,230 +120,8 @@ _STATE_WORDS = {
 }
 
 
-# ============================================================== geometry
-@dataclass(frozen=True)
-class JackGeometry:
-    """The rhombus of tie rods.
-
-    Parameters
-    ----------
-    rod_length : float
-        ``L``, m (paper 003: 130 mm).
-    initial_height : float
-        Height of the shoe above the base joint at ``psi = 0``, m (paper: 130 mm).
-    min_height, max_height : float
-        Travel of the jack, m: steps beyond are refused (end of travel).
-    """
-
-    rod_length: float = 0.130
-    initial_height: float = 0.130
-    min_height: float = 0.04
-    max_height: float = 0.25
-
-    @property
-    def initial_width(self) -> float:
-        """``w0 = sqrt(4 L^2 - y0^2)``, m."""
-        return math.sqrt(4.0 * self.rod_length**2 - self.initial_height**2)
-
-    def height(self, travel: float) -> float:
-        """``y(s)``, m (nan outside the rhombus)."""
-        width = self.initial_width - travel
-        square = 4.0 * self.rod_length**2 - width * width
-        return math.sqrt(square) if square > 0.0 and width > 0.0 else math.nan
-
-    def slopes(self, travel: float) -> tuple[float, float, float]:
-        """``(y, dy/ds, d2y/ds2)`` at screw travel ``s`` (m, 1, 1/m)."""
-        width = self.initial_width - travel
-        y = self.height(travel)
-        return y, width / y, -4.0 * self.rod_length**2 / y**3
-
-    def rod_angle(self, travel: float) -> float:
-        """``theta``, rad."""
-        return math.atan2(self.height(travel), self.initial_width - travel)
-
-    def travel_at_height(self, height: float) -> float:
-        """Screw travel that puts the shoe at ``height`` (m), m."""
-        return self.initial_width - math.sqrt(4.0 * self.rod_length**2 - height * height)
-
-    def problems(self) -> list[str]:
-        """Every problem with the geometry, as sentences."""
-        out = []
-        two_l = 2.0 * self.rod_length
-        if not (self.rod_length > 0.0 and math.isfinite(self.rod_length)):
-            return [f"rod_length must be a positive number of metres, got {self.rod_length}"]
-        for name in ("min_height", "initial_height", "max_height"):
-            value = getattr(self, name)
-            if not (0.0 < value < two_l):
-                out.append(
-                    f"{name} must lie strictly between 0 and twice the rod length "
-                    f"({two_l:.6g} m), got {value}"
-                )
-        if not out and not self.min_height <= self.initial_height <= self.max_height:
-            out.append(
-                f"initial_height {self.initial_height} m must lie within the travel "
-                f"[{self.min_height}, {self.max_height}] m"
-            )
-        return out
-
-
-# ============================================================== configuration
-@dataclass(frozen=True)
-class JackConfig:
-    """Everything a :class:`ScissorJackModel` is built from.
-
-    Parameters
-    ----------
-    geometry : JackGeometry
-        Rods and travel.
-    thread : ScrewThread
-        Lead, mean radius and friction coefficient.
-    load_mass : float
-        Mass moving with the shoe, kg (paper: 306 kg).
-    load_weight : float
-        Weight acting on the shoe, N (paper: 3000 N).
-    handle_inertia : float
-        ``J_s`` of screw and handle about the screw axis, kg m^2.
-    friction : str
-        One of :data:`FRICTION_MODELS`.
-    speed_scale : float
-        ``w1`` of the regularised models, rad/s (paper: 1e-6).
-    drive : str
-        One of :data:`HANDLE_DRIVES`.
-    initial_speed : float
-        Handle speed at the start with a torque drive, rad/s.
-    """
-
-    geometry: JackGeometry
-    thread: ScrewThread
-    load_mass: float = 306.0
-    load_weight: float = 3000.0
-    handle_inertia: float = 5.0e-3
-    friction: str = "stick_slip"
-    speed_scale: float = 1.0e-6
-    drive: str = "torque"
-    initial_speed: float = 0.0
-
-    @property
-    def regularised(self) -> bool:
-        """Whether the thread friction is one of the paper's regularised forms."""
-        return self.friction in REGULARISATIONS
-
-    def static_force(self, travel: float) -> float:
-        """Axial force holding the load at rest, ``W cot(theta)``, N."""
-        _, slope, _ = self.geometry.slopes(travel)
-        return self.load_weight * slope
-
-    def breakaway_torques(self, travel: float) -> tuple[float, float]:
-        """Handle torques (N m) at which a stuck thread starts to lift / to lower.
-
-        ``(h + r mu) F0`` and ``(h - r mu) F0`` with ``F0 = W cot(theta)``;
-        a negative second value means the jack is self-locking (it holds the
-        load with no handle torque and must be driven down).
-        """
-        force = self.static_force(travel)
-        lead = self.thread.lead_torque(force)
-        capacity = self.thread.friction_capacity(force)
-        return lead + capacity, lead - capacity
-
-    def effective_inertia(self, travel: float, direction: float) -> float:
-        """``J_s + q m h^2 cot^2(theta)`` while sliding in ``direction``, kg m^2."""
-        _, slope, _ = self.geometry.slopes(travel)
-        h = self.thread.lead_per_radian
-        q = h + direction * self.thread.mean_radius * self.thread.friction
-        return self.handle_inertia + q * self.load_mass * h * slope * slope
-
-    def problems(self) -> list[str]:
-        """Every problem with the configuration, as sentences."""
-        out = self.geometry.problems() + self.thread.problems()
-        for name in ("load_mass", "load_weight", "handle_inertia", "speed_scale"):
-            value = getattr(self, name)
-            if not (value > 0.0 and math.isfinite(value)):
-                out.append(f"{name} must be a positive number, got {value}")
-        if self.friction not in FRICTION_MODELS:
-            out.append(
-                f"thread friction model {self.friction!r} is unknown; choose one of "
-                f"{', '.join(FRICTION_MODELS)}"
-            )
-        if self.drive not in HANDLE_DRIVES:
-            out.append(
-                f"handle drive {self.drive!r} is unknown; choose one of {', '.join(HANDLE_DRIVES)}"
-            )
-        if not math.isfinite(self.initial_speed):
-            out.append(f"initial handle speed must be finite, got {self.initial_speed}")
-        if out or self.friction == "none":
-            return out
-        lowest = self.geometry.travel_at_height(self.geometry.min_height)
-        if self.effective_inertia(lowest, -1.0) <= 0.0:
-            need = self.handle_inertia - self.effective_inertia(lowest, -1.0)
-            out.append(
-                f"handle_inertia {self.handle_inertia} kg m^2 is too light for lowering at "
-                f"min_height {self.geometry.min_height} m: the effective inertia while the "
-                f"thread slides down vanishes (Painleve's paradox of dry friction); use more "
-                f"than {need:.4g} kg m^2 or raise min_height"
-            )
-        return out
-
-
-@dataclass(frozen=True)
-class JackInputs:
-    """Handle commands held over a step.
-
-    Attributes
-    ----------
-    speed_command : float
-        Handle speed with a speed drive, rad/s (positive lifts).
-    torque_command : float
-        Handle torque with a torque drive, N m (positive lifts).
-    """
-
-    speed_command: float = 0.0
-    torque_command: float = 0.0
-
-    def problems(self) -> list[str]:
-        """Non-finite commands."""
-        return [
-            f"input {name} is not finite ({value})"
-            for name, value in (
-                ("handle.speed_command", self.speed_command),
-                ("handle.torque_command", self.torque_command),
-            )
-            if not math.isfinite(value)
-        ]
-
-
-@dataclass(frozen=True)
-class JackReport:
-    """Outputs of the jack at one instant (SI units), each named as its output (``_`` for ``.``)."""
-
-    handle_angle: float
-    handle_speed: float
-    handle_torque: float
-    screw_travel: float
-    load_height: float
-    load_velocity: float
-    screw_displacement: float
-    rod_angle: float
-    screw_axial_force: float
-    thread_lead_torque: float
-    thread_friction_torque: float
-    thread_state: int
-    stored_energy: float
-    dissipated_energy: float
-    external_work: float
-
-
-@dataclass(frozen=True)
-class _Forces:
-    """Handle acceleration (rad/s^2), axial force (N), thread friction and handle torque (N m)."""
-
-    acceleration: float
-    axial_force: float
-    friction_torque: float
-    handle_torque: float
-
-
 # ============================================================== the model
-class ScissorJackModel:
+class ScissorJackModel(JackMechanics):
     """The jack as a hybrid ODE in the handle angle (module docstring).
 
     State ``[psi, psi', dissipated, external work]`` (rad, rad/s, J, J).
@@ -375,104 +149,6 @@ class ScissorJackModel:
         self.mode_changes = 0
         self.last_events: list[tuple[float, str]] = []
         self._held_angle = 0.0
-
-    # ---------------------------------------------------------- kinematics
-    def travel(self, psi: float) -> float:
-        """Screw travel ``s = h psi``, m."""
-        return self.h * psi
-
-    def inertia(self, psi: float) -> float:
-        """``I(psi) = J_s + m (h cot theta)^2``, kg m^2."""
-        _, slope, _ = self.config.geometry.slopes(self.travel(psi))
-        return self.config.handle_inertia + self.config.load_mass * (self.h * slope) ** 2
-
-    def height(self, psi: float) -> float:
-        """Shoe height, m."""
-        return self.config.geometry.height(self.travel(psi))
-
-    # ---------------------------------------------------------- forces
-    def _axial_force(self, psi: float, omega: float, acceleration: float) -> float:
-        """``F = (W + m y'') cot(theta)``, N."""
-        _, slope, curvature = self.config.geometry.slopes(self.travel(psi))
-        load_acc = self.h * slope * acceleration + self.h**2 * curvature * omega * omega
-        return (self.config.load_weight + self.config.load_mass * load_acc) * slope
-
-    def _sliding(self, psi: float, omega: float, torque: float, shape: float) -> _Forces:
-        """Motion under handle ``torque`` with friction ``-shape r mu |F|`` (``|shape| <= 1``).
-
-        Solves the equation linear in ``psi''`` for each sign of ``F`` and
-        keeps the consistent one (module docstring).
-        """
-        cfg = self.config
-        _, slope, curvature = cfg.geometry.slopes(self.travel(psi))
-        static = cfg.load_weight + cfg.load_mass * self.h**2 * curvature * omega * omega
-        for sign in (1.0, -1.0):
-            q = self.h + shape * self.r_mu * sign
-            inertia = cfg.handle_inertia + q * cfg.load_mass * self.h * slope * slope
-            if inertia <= 0.0:
-                continue
-            acc = (torque - q * slope * static) / inertia
-            force = self._axial_force(psi, omega, acc)
-            if force * sign >= 0.0:
-                friction = -shape * self.r_mu * abs(force)
-                return _Forces(acc, force, friction, torque)
-        raise ModelError(
-            f"scissor jack: no consistent motion at psi = {psi:.6g} rad, speed {omega:.6g} "
-            f"rad/s, handle torque {torque:.6g} N m (dry friction without a solution: "
-            "Painleve's paradox); a heavier handle_inertia avoids it"
-        )
-
-    def _torque_driven(self, x: np.ndarray) -> _Forces:
-        """Acceleration and forces under the torque command in the current mode."""
-        psi, omega = float(x[0]), float(x[1])
-        torque = self.inputs.torque_command
-        friction = self.config.friction
-        if friction == "none":
-            return self._sliding(psi, omega, torque, 0.0)
-        if self.config.regularised:
-            shape, _ = REGULARISATIONS[friction]
-            return self._sliding(psi, omega, torque, shape(omega / self.config.speed_scale))
-        mode = int(self.friction.mode[0])
-        if mode != 0:
-            return self._sliding(psi, omega, torque, float(mode))
-        force = self.config.static_force(self.travel(psi))
-        holding = -(torque - self.h * force)
-        return _Forces(0.0, force, holding, torque)
-
-    def _speed_driven(self, x: np.ndarray) -> _Forces:
-        """Forces and the handle torque needed to turn at the held speed ``x[1]``."""
-        psi, omega = float(x[0]), float(x[1])
-        force = self._axial_force(psi, omega, 0.0)
-        friction = self.config.friction
-        if friction == "none":
-            resist = 0.0
-        elif self.config.regularised:
-            shape, _ = REGULARISATIONS[friction]
-            resist = -shape(omega / self.config.speed_scale) * self.r_mu * abs(force)
-        elif omega != 0.0:
-            resist = -math.copysign(self.r_mu * abs(force), omega)
-        else:  # held still by the drive: the thread holds what it can of the lead torque
-            capacity = self.r_mu * abs(force)
-            resist = max(-capacity, min(capacity, self.h * force))
-        return _Forces(0.0, force, resist, self.h * force - resist)
-
-    def forces(self, x: np.ndarray) -> _Forces:
-        """Acceleration, axial force, friction and handle torque at state ``x``."""
-        if self.config.drive == "speed":
-            return self._speed_driven(x)
-        return self._torque_driven(x)
-
-    def _capacity(self, psi: float) -> np.ndarray:
-        return np.array([self.r_mu * abs(self.config.static_force(self.travel(psi)))])
-
-    def _free_torque(self, x: np.ndarray) -> np.ndarray:
-        """Non-friction generalised torque for :class:`StickSlip` (at rest: static)."""
-        psi, omega = float(x[0]), float(x[1])
-        self.friction.masses[0] = self.inertia(psi)
-        _, slope, curvature = self.config.geometry.slopes(self.travel(psi))
-        centrifugal = self.config.load_mass * self.h**2 * slope * curvature * self.h * omega**2
-        gravity = self.config.load_weight * self.h * slope
-        return np.array([self.inputs.torque_command - gravity - centrifugal])
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:

@@ -47,14 +47,14 @@ from wire_fmu.core.framework.unit import (
     output,
     parameter,
 )
-from wire_fmu.core.units.scissor_jack.model import (
+from wire_fmu.core.units.scissor_jack.config import (
     FRICTION_MODELS,
     HANDLE_DRIVES,
     JackConfig,
-    JackGeometry,
     JackInputs,
-    ScissorJackModel,
 )
+from wire_fmu.core.units.scissor_jack.geometry import JackGeometry
+from wire_fmu.core.units.scissor_jack.model import ScissorJackModel
 
 __all__ = ["ScissorJackUnit", "JACK_EFFECTS"]
 
