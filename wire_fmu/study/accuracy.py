@@ -134,6 +134,17 @@ def reference_run(
 ) -> MonolithicResult:
     """The monolithic model of a study scene on the study's output grid.
 
+    Parameters
+    ----------
+    scene : Scene
+        A study scene (see :func:`~wire_fmu.study.plan.study_scene`), every
+        unit one of ours.
+    settings : StudySettings
+        The plan: its output interval (s) and reference tolerance.
+    rtol : float, optional
+        Relative and absolute tolerance of Radau instead of the plan's
+        ``reference_rtol``.
+
     Raises
     ------
     StudyError
@@ -378,7 +389,13 @@ def _study(
 
 
 def summary_text(study: AccuracyStudy) -> str:
-    """Orders and the equal-error comparison as plain text (for the command line)."""
+    """Orders and the equal-error comparison as plain text (for the command line).
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        What :func:`run_accuracy_study` produced.
+    """
     lines = [f"observed convergence orders ({study.scene}):"]
     width = max((len(o.family) for o in study.orders), default=10)
     for o in study.orders:

@@ -148,7 +148,13 @@ def _run_lines(study: AccuracyStudy) -> list[str]:
 
 
 def accuracy_markdown(study: AccuracyStudy) -> str:
-    """The summary ``accuracy.md``."""
+    """The summary ``accuracy.md``.
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        The study to summarise.
+    """
     files = [
         "",
         "Files: `accuracy.csv` (the table), `accuracy.json`, `work_precision.png`, "
@@ -271,7 +277,15 @@ def _plot_families(ax, study: AccuracyStudy, x_of, y_of, work_precision: bool) -
 
 
 def plot_work_precision(study: AccuracyStudy, path: Path) -> Path:
-    """The work-precision diagram: error (x) against wall s per simulated s (y), log-log."""
+    """The work-precision diagram: error (x) against wall s per simulated s (y), log-log.
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        The study to draw.
+    path : Path
+        PNG file to write (its folder must exist).
+    """
     fig, ax = _figure(
         f"{study.scene}: what accuracy costs",
         "error (max over key outputs of max |y - y_ref| / range of y_ref)",
@@ -293,7 +307,15 @@ def plot_work_precision(study: AccuracyStudy, path: Path) -> Path:
 
 
 def plot_convergence(study: AccuracyStudy, path: Path) -> Path:
-    """Error against macro step for every family, with slope-1 and slope-2 guides."""
+    """Error against macro step for every family, with slope-1 and slope-2 guides.
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        The study to draw.
+    path : Path
+        PNG file to write (its folder must exist).
+    """
     fig, ax = _figure(f"{study.scene}: convergence in the macro step", "macro step H (s)", "error")
     rows = [r for r in study.rows if r.algorithm != "monolithic"]
     _plot_families(
@@ -320,7 +342,15 @@ def plot_convergence(study: AccuracyStudy, path: Path) -> Path:
 
 
 def write_accuracy_files(study: AccuracyStudy, directory: Path) -> dict[str, Path]:
-    """Write the table, the summary, the JSON and both diagrams; return their paths."""
+    """Write the table, the summary, the JSON and both diagrams; return their paths.
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        The study to write.
+    directory : Path
+        Folder for the files (created).
+    """
     directory.mkdir(parents=True, exist_ok=True)
     files = {"csv": write_csv(study.rows, directory / "accuracy.csv")}
     files["md"] = directory / "accuracy.md"

@@ -68,7 +68,13 @@ QUICK_REPEATS, FULL_REPEATS = 1, 3
 
 
 def catalogue(fmu: str) -> EffectCatalogue | None:
-    """The effect catalogue of one of our models (None for a foreign FMU)."""
+    """The effect catalogue of one of our models (None for a foreign FMU).
+
+    Parameters
+    ----------
+    fmu : str
+        Model name of a scene's unit, e.g. ``"BlockTrain"``.
+    """
     return BY_NAME[fmu].effect_catalogue() if fmu in BY_NAME else None
 
 
@@ -103,7 +109,13 @@ class EffectCase:
 
 
 def effect_cases(scene: Scene) -> list[EffectCase]:
-    """Every effect the scene's units include, in scene order."""
+    """Every effect the scene's units include, in scene order.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene with every effect (the baseline).
+    """
     cases = []
     for name, spec in scene.units.items():
         cat = catalogue(spec.fmu)
@@ -113,7 +125,15 @@ def effect_cases(scene: Scene) -> list[EffectCase]:
 
 
 def without(scene: Scene, case: EffectCase) -> Scene:
-    """``scene`` with ``case``'s effects removed from its unit."""
+    """``scene`` with ``case``'s effects removed from its unit.
+
+    Parameters
+    ----------
+    scene : Scene
+        The baseline scene (not changed).
+    case : EffectCase
+        The unit and the effects to leave out.
+    """
     spec = scene.units[case.unit]
     gone = {case.effect, *case.also_removed}
     units = dict(scene.units)
@@ -169,6 +189,13 @@ def effects_scene(scene: Scene, settings: StudySettings) -> Scene:
 
     The output grid is the study's interval rounded up to a multiple of the
     scene's macro step.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene as given.
+    settings : StudySettings
+        Key outputs, stop time (s) and output interval (s) of the study.
     """
     step = scene.run.step
     interval = step * max(1, math.ceil(settings.output_interval / step - 1e-9))
@@ -180,7 +207,13 @@ def effects_scene(scene: Scene, settings: StudySettings) -> Scene:
 def verdict(saved: float, noise: float) -> str:
     """``"saves"``, ``"costs"`` or ``"within noise"`` (``|saved| <= noise``), s per simulated s.
 
-    ``noise`` is NaN when a case ran once: the verdict then says so.
+    Parameters
+    ----------
+    saved : float
+        Wall time saved per simulated second, s/s (negative: it costs).
+    noise : float
+        Spread between repeats, s/s; NaN when a case ran once: the verdict
+        then says so.
     """
     if not math.isfinite(saved):
         return "—"
@@ -321,7 +354,13 @@ def _fmt(value: float, spec: str = ".3g") -> str:
 
 
 def effects_markdown(study: EffectsStudy) -> str:
-    """The summary ``effects.md``."""
+    """The summary ``effects.md``.
+
+    Parameters
+    ----------
+    study : EffectsStudy
+        The study to summarise.
+    """
     s = study.settings
     lines = [
         f"# Effects study: {study.scene}" + (" (quick)" if s.quick else ""),
@@ -357,7 +396,15 @@ def effects_markdown(study: EffectsStudy) -> str:
 
 
 def plot_effects(study: EffectsStudy, path: Path) -> Path:
-    """Bar chart: time saved (share of the baseline) and output change, per effect."""
+    """Bar chart: time saved (share of the baseline) and output change, per effect.
+
+    Parameters
+    ----------
+    study : EffectsStudy
+        The study to draw.
+    path : Path
+        PNG file to write (its folder must exist).
+    """
     from matplotlib.figure import Figure
 
     rows = [r for r in study.rows if r.status == "finished"]
@@ -383,7 +430,15 @@ def plot_effects(study: EffectsStudy, path: Path) -> Path:
 
 
 def write_effects_files(study: EffectsStudy, directory: Path) -> dict[str, Path]:
-    """Write the table, the summary, the JSON and the chart; return their paths."""
+    """Write the table, the summary, the JSON and the chart; return their paths.
+
+    Parameters
+    ----------
+    study : EffectsStudy
+        The study to write.
+    directory : Path
+        Folder for the files (created).
+    """
     directory.mkdir(parents=True, exist_ok=True)
     files = {"csv": write_csv(study.rows, directory / "effects.csv")}
     files["md"] = directory / "effects.md"
@@ -395,7 +450,13 @@ def write_effects_files(study: EffectsStudy, directory: Path) -> dict[str, Path]
 
 
 def summary_text(study: EffectsStudy) -> str:
-    """The price list as plain text (for the command line)."""
+    """The price list as plain text (for the command line).
+
+    Parameters
+    ----------
+    study : EffectsStudy
+        What :func:`run_effects_study` produced.
+    """
     lines = [
         f"effects of {study.scene!r}: all effects {study.baseline_wall_per_sim_s:.3g} s "
         "per simulated s"

@@ -76,7 +76,18 @@ class ResponsePoint:
 def drive_unit(
     parameters: Mapping[str, Any], effects: Sequence[str] = (), name: str = "drive"
 ) -> DriveUnit:
-    """A configured :class:`DriveUnit` (not initialised) from scene-style parameters."""
+    """A configured :class:`DriveUnit` (not initialised) from scene-style parameters.
+
+    Parameters
+    ----------
+    parameters : mapping
+        Unit parameters as a scene gives them (tables and lists are passed
+        on as JSON); names the unit does not have are ignored.
+    effects : sequence of str
+        The unit's effects.
+    name : str
+        Instance name.
+    """
     unit = DriveUnit(name)
     for key, value in parameters.items():
         if key in unit.values:
@@ -97,7 +108,15 @@ def _with_motor_slope(tree: DriveTree, slope: float) -> DriveTree:
 
 
 def analytic_response(unit: DriveUnit, frequency: float) -> ResponsePoint:
-    """Paper 002's impedance formulas for the drive ``unit`` simulates, at ``frequency`` (Hz)."""
+    """Paper 002's impedance formulas for the drive ``unit`` simulates, at ``frequency`` (Hz).
+
+    Parameters
+    ----------
+    unit : DriveUnit
+        A configured drive (its tree, motor slope and load).
+    frequency : float
+        Excitation frequency, Hz.
+    """
     model = unit.model
     tree = _with_motor_slope(model.tree, model.motor_slope)
     omega = 2.0 * math.pi * frequency
@@ -134,6 +153,13 @@ def _periodic_state(unit: DriveUnit, omega: float, steps: int) -> np.ndarray:
     free = [k for k in range(n) if k != load] + list(range(n, 2 * n))
 
     def mismatch(z: np.ndarray) -> np.ndarray:
+        """Change of the shaft twists and speeds over one period (the load's angle left out).
+
+        Parameters
+        ----------
+        z : ndarray, shape (2 n - 1,)
+            The free start states: twists (rad) and speeds (rad/s).
+        """
         x0 = np.zeros(2 * n + 2)
         x0[free] = z
         x1 = _period(unit, x0, omega, steps)
@@ -175,6 +201,13 @@ def simulated_response(unit: DriveUnit, frequency: float, steps: int = 200) -> R
     hold_gain = math.sin(0.5 * omega * h) / (0.5 * omega * h)
 
     def harmonic(series: np.ndarray) -> complex:
+        """Complex amplitude at the excitation frequency per unit torque, hold gain divided out.
+
+        Parameters
+        ----------
+        series : ndarray, shape (steps,)
+            A speed sampled at the step ends of one period, rad/s.
+        """
         coefficient = 2.0 / steps * complex(series @ phase)
         return 1j * coefficient / hold_gain  # input sin(w t) = Re(-j e^{j w t})
 
@@ -187,7 +220,17 @@ def simulated_response(unit: DriveUnit, frequency: float, steps: int = 200) -> R
 def frequency_response(
     unit: DriveUnit, frequencies: Sequence[float], simulate: Sequence[float] = ()
 ) -> dict[str, list[ResponsePoint]]:
-    """Analytic responses at ``frequencies`` and simulated ones at ``simulate`` (Hz)."""
+    """Analytic responses at ``frequencies`` and simulated ones at ``simulate`` (Hz).
+
+    Parameters
+    ----------
+    unit : DriveUnit
+        A configured drive.
+    frequencies : sequence of float
+        Frequencies of the analytic response, Hz.
+    simulate : sequence of float
+        Frequencies at which the unit is also simulated, Hz.
+    """
     return {
         "analytic": [analytic_response(unit, f) for f in frequencies],
         "simulated": [simulated_response(unit, f) for f in simulate],

@@ -41,6 +41,15 @@ def output_error(
     """The study's error metric (module docstring) and the key output that sets it.
 
     Returns ``(nan, reason)`` if the run does not cover the reference grid.
+
+    Parameters
+    ----------
+    values : mapping of str to ndarray
+        The run's recorded columns by name (``"unit.variable"``).
+    reference : mapping of str to ndarray
+        The reference's columns on the same grid.
+    keys : sequence of VarRef or str
+        The key outputs compared.
     """
     worst, which = 0.0, ""
     for key in map(str, keys):
@@ -117,7 +126,15 @@ def _row(config: Configuration, run: TimedRun, error: float, worst: str) -> RunR
 
 
 def one_line(message: str, limit: int = 300) -> str:
-    """A message on one line (a unit's list of problems joined), at most ``limit`` characters."""
+    """A message on one line (a unit's list of problems joined), at most ``limit`` characters.
+
+    Parameters
+    ----------
+    message : str
+        Any text.
+    limit : int
+        Most characters kept (the cut ends in ``...``).
+    """
     text = " ".join(message.split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
 

@@ -64,6 +64,15 @@ class _Instant:
         self.drivers = drivers
 
     def values(self, unit: str, t: float) -> dict[str, float]:
+        """The drivers' values and rates for ``unit`` at ``t``.
+
+        Parameters
+        ----------
+        unit : str
+            Unit name.
+        t : float
+            Time, s.
+        """
         return self.drivers.values(unit, t, None)
 
 
@@ -113,7 +122,13 @@ class MonolithicModel:
 
     # -- set-up ------------------------------------------------------------------
     def initialize(self, t0: float = 0.0) -> np.ndarray:
-        """Initialise the units in step order, as the master does; return the state."""
+        """Initialise the units in step order, as the master does; return the state.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time, s.
+        """
         self.events.fire_due(t0)
         ready: set[str] = set()
         for name in self.order:  # as the master: sources first, each from what is ready
@@ -172,12 +187,28 @@ class MonolithicModel:
 
     # -- HybridSystem ----------------------------------------------------------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Joint state derivative."""
+        """Joint state derivative.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Joint state, the units' states in step order.
+        """
         self._propagate(t, x)
         return np.concatenate([self.views[n].rhs(t, x[self.slices[n]]) for n in self.order])
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Every unit's guards."""
+        """Every unit's guards, in step order.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Joint state.
+        """
         self._propagate(t, x)
         return (
             np.concatenate(
@@ -192,7 +223,17 @@ class MonolithicModel:
         return self._dirs
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Hand each fired guard to its unit."""
+        """Hand each fired guard to its unit.
+
+        Parameters
+        ----------
+        t : float
+            Event time, s.
+        x : ndarray
+            Joint state at the event.
+        fired : list of int
+            Indices of the fired guards in the joint guard vector.
+        """
         x = np.array(x, dtype=float)
         self._propagate(t, x)
         for name in self.order:
@@ -208,13 +249,27 @@ class MonolithicModel:
         return x
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """Every unit's invariants."""
+        """Every unit's invariants.
+
+        Parameters
+        ----------
+        x : ndarray
+            Joint state, projected in place.
+        """
         for name in self.order:
             x[self.slices[name]] = self.views[name].project(x[self.slices[name]])
         return x
 
     def reconcile(self, t: float, x: np.ndarray) -> np.ndarray:
-        """After an event: every unit settles its modes for the new inputs."""
+        """After an event: every unit settles its modes for the new inputs.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Joint state.
+        """
         x = np.array(x, dtype=float)
         self._propagate(t, x)
         for name in self.order:
@@ -222,7 +277,17 @@ class MonolithicModel:
         return x
 
     def outputs(self, t: float, x: np.ndarray, refs: list[VarRef]) -> list[float]:
-        """Values of ``refs`` at state ``x``."""
+        """Values of ``refs`` at state ``x``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Joint state.
+        refs : list of VarRef
+            Unit variables to read.
+        """
         self._propagate(t, x)
         return [float(self.units[r.unit].values[r.variable]) for r in refs]
 

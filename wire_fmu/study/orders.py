@@ -63,6 +63,13 @@ def theoretical_order(scene: Scene, extrapolation: str) -> int | None:
     less than an effort's: second order even held constant. Every other
     held input (efforts, plain signals) has :data:`THEORY`'s order. None
     when nothing is held (no connections).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its connections and bonds say what is held.
+    extrapolation : str
+        The scheme of the connections that do not set their own.
     """
     with_position = {b.name for b in scene.bonds if b.position is not None}
     orders = []
@@ -85,8 +92,16 @@ def _slope(steps: Sequence[float], errors: Sequence[float]) -> float:
 def observed_orders(rows: Sequence[RunRow], scene: Scene, min_error: float = 0.0) -> list[OrderRow]:
     """The order of every family over its runs where coupling error dominates.
 
-    ``min_error``: errors at or below it are the reference's own (the
-    study passes 100 times the reference's tolerance).
+    Parameters
+    ----------
+    rows : sequence of RunRow
+        Every run of the study, the monolithic ones (the solvers' floors)
+        included.
+    scene : Scene
+        The study scene (for the theoretical orders).
+    min_error : float
+        Errors at or below it are the reference's own (the study passes 100
+        times the reference's tolerance); a fraction of the outputs' range.
     """
     floors = {
         r.solver: r.error for r in rows if r.family == f"monolithic / {r.solver}" and r.usable
@@ -179,7 +194,15 @@ def _cost_at(runs: Sequence[RunRow], target: float) -> float:
 
 
 def default_targets(rows: Sequence[RunRow], count: int = 4) -> list[float]:
-    """Decades between the largest and the smallest achieved error (at most ``count``)."""
+    """Decades between the largest and the smallest achieved error (at most ``count``).
+
+    Parameters
+    ----------
+    rows : sequence of RunRow
+        The study's runs; only usable ones count.
+    count : int
+        Most targets.
+    """
     errors = [r.error for r in rows if r.usable and r.error > 0]
     if not errors:
         return []
@@ -189,7 +212,15 @@ def default_targets(rows: Sequence[RunRow], count: int = 4) -> list[float]:
 
 
 def equal_error(rows: Sequence[RunRow], targets: Sequence[float]) -> list[EqualErrorRow]:
-    """For each target error: every family's interpolated cost and the cheapest family."""
+    """For each target error: every family's interpolated cost and the cheapest family.
+
+    Parameters
+    ----------
+    rows : sequence of RunRow
+        The study's runs.
+    targets : sequence of float
+        Target errors (fractions of the outputs' range).
+    """
     families = _families(rows)
     out = []
     for target in targets:

@@ -246,7 +246,21 @@ def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
 
 
 def with_stop_time(settings: StudySettings, stop_time: float | None) -> StudySettings:
-    """``settings`` with another stop time (a multiple of the output interval); None: as is."""
+    """``settings`` with another stop time (a multiple of the output interval); None: as is.
+
+    Parameters
+    ----------
+    settings : StudySettings
+        The plan.
+    stop_time : float or None
+        Simulated time per run, s, rounded down to a multiple of the output
+        interval (at least one interval).
+
+    Raises
+    ------
+    ValueError
+        If ``stop_time`` is not a positive finite number.
+    """
     if stop_time is None:
         return settings
     if not (math.isfinite(stop_time) and stop_time > 0):
@@ -272,12 +286,28 @@ class Configuration:
 
 
 def family_label(algorithm: str, extrapolation: str, solver: str) -> str:
-    """``"gauss_seidel / linear / ros2 h=1e-3"``."""
+    """``"gauss_seidel / linear / ros2 h=1e-3"``.
+
+    Parameters
+    ----------
+    algorithm, extrapolation : str
+        The coupling scheme.
+    solver : str
+        The solver choice's label.
+    """
     return f"{algorithm} / {extrapolation} / {solver}"
 
 
 def solver_choices(scene: Scene, settings: StudySettings) -> list[SolverChoice]:
-    """The scene's own solvers, then every choice of the plan that differs and applies."""
+    """The scene's own solvers, then every choice of the plan that differs and applies.
+
+    Parameters
+    ----------
+    scene : Scene
+        The study scene.
+    settings : StudySettings
+        The plan, with its solver choices.
+    """
     own = scene_solver(scene)
     out = [own]
     for choice in settings.solvers:
@@ -294,6 +324,13 @@ def build_grid(scene: Scene, settings: StudySettings) -> list[Configuration]:
     ``slices`` (the default): every algorithm and extrapolation with the
     scene's own solvers, then every other solver with the scene's own
     algorithm and extrapolation; ``product``: every combination.
+
+    Parameters
+    ----------
+    scene : Scene
+        The study scene (its own coupling and solvers).
+    settings : StudySettings
+        The plan: algorithms, extrapolations, macro steps, solvers, grid.
     """
     solvers = solver_choices(scene, settings)
     couplings = [(a, e) for a in settings.algorithms for e in settings.extrapolations]
@@ -324,7 +361,15 @@ def _solver_parameters(
 
 
 def study_scene(scene: Scene, settings: StudySettings) -> Scene:
-    """The scene as every run of the study sees it: stop time, grid, key outputs recorded."""
+    """The scene as every run of the study sees it: stop time, grid, key outputs recorded.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene as given.
+    settings : StudySettings
+        Stop time (s), output interval (s) and key outputs of the study.
+    """
     scene = with_run_settings(
         scene,
         stop_time=settings.stop_time,
@@ -337,7 +382,18 @@ def study_scene(scene: Scene, settings: StudySettings) -> Scene:
 def configured_scene(
     scene: Scene, config: Configuration, structure: Structure | None = None
 ) -> Scene:
-    """A copy of a study scene set up for ``config`` (parameters deep-copied)."""
+    """A copy of a study scene set up for ``config`` (parameters deep-copied).
+
+    Parameters
+    ----------
+    scene : Scene
+        A study scene (see :func:`study_scene`).
+    config : Configuration
+        Coupling, macro step and solver of the run.
+    structure : Structure, optional
+        The validated scene: the solver parameters go only to units that
+        have a ``solver`` variable (without it, to every unit).
+    """
     scene = with_run_settings(
         scene, step=config.step, algorithm=config.algorithm, extrapolation=config.extrapolation
     )
@@ -345,7 +401,13 @@ def configured_scene(
 
 
 def load_study_scene(scene: Scene | str | Path) -> Scene:
-    """A parsed scene from a scene, a shipped name or a file."""
+    """A parsed scene from a scene, a shipped name or a file.
+
+    Parameters
+    ----------
+    scene : Scene, str or Path
+        A parsed scene (returned as is), a shipped scene's name or a scene file.
+    """
     return scene if isinstance(scene, Scene) else load_scene(find_scene(scene))
 
 

@@ -68,7 +68,13 @@ class SolverChoice:
     settings: Mapping[str, Any] | None = None
 
     def applies_to(self, scene: Scene) -> bool:
-        """Whether the scene has the units this choice is about."""
+        """Whether the scene has the units this choice is about.
+
+        Parameters
+        ----------
+        scene : Scene
+            The study scene.
+        """
         return self.only is None or any(u.fmu == self.only for u in scene.units.values())
 
     @property
@@ -77,7 +83,13 @@ class SolverChoice:
         return {**UNIT_SOLVER_DEFAULTS, **(self.settings or self.parameters)}
 
     def for_model(self, fmu: str) -> Mapping[str, Any]:
-        """Parameters for a unit of model ``fmu``."""
+        """Parameters for a unit of model ``fmu``.
+
+        Parameters
+        ----------
+        fmu : str
+            The unit's model name, e.g. ``"Winch"``.
+        """
         if self.only is None or fmu == self.only:
             return self.parameters
         return self.parameters_others
@@ -109,7 +121,14 @@ SOLVER_KEYS = tuple(UNIT_SOLVER_DEFAULTS)
 
 
 def describe_solver(settings: Mapping[str, Any]) -> str:
-    """``"ros2 h=1e-3"``, ``"radau rtol=1e-08"``: a solver by what sets its accuracy."""
+    """``"ros2 h=1e-3"``, ``"radau rtol=1e-08"``: a solver by what sets its accuracy.
+
+    Parameters
+    ----------
+    settings : mapping
+        Solver parameters (``solver``, ``solver_max_step`` in s,
+        ``solver_rtol``, ...); missing ones take :data:`UNIT_SOLVER_DEFAULTS`.
+    """
     full = {**UNIT_SOLVER_DEFAULTS, **settings}
     method = str(full["solver"])
     if method in ("rk4", "ros2"):
@@ -135,7 +154,14 @@ def _import(target: str) -> Any:
 
 
 def scene_solver(scene: Scene) -> SolverChoice:
-    """The internal solvers as the scene sets them (nothing overridden)."""
+    """The internal solvers as the scene sets them (nothing overridden).
+
+    Parameters
+    ----------
+    scene : Scene
+        The study scene; units that set different solvers make one
+        ``(mixed)`` choice.
+    """
     complete = [
         {
             **_unit_solver_defaults(spec.fmu),

@@ -136,7 +136,26 @@ def unit_trajectory(
     motor: Mapping[str, float] | None = None,
     initial_speed: float = 10.0,
 ) -> Trajectory:
-    """Step the machine unit with ``solver``; samples at every communication point."""
+    """Step the machine unit with ``solver``; samples at every communication point.
+
+    Parameters
+    ----------
+    solver : str
+        The unit's solver (``energy1``, ``energy``, ``rk4``, ...).
+    max_step : float
+        Internal step, s.
+    stop_time : float
+        End of the simulated window, s.
+    step : float
+        Communication step, s.
+    machine : mapping, optional
+        Machine description (default :func:`~wire_fmu.core.units.machine.model.crank_press`).
+    motor : mapping, optional
+        Motor characteristic ``a`` (N m) and ``b`` (N m s/rad) at the shaft
+        (default :data:`DEFAULT_MOTOR`).
+    initial_speed : float
+        Shaft speed at t = 0, rad/s.
+    """
     unit = _unit(machine or crank_press(), motor or DEFAULT_MOTOR, solver, max_step, initial_speed)
     n = int(round(stop_time / step))
     phi, omega = [unit.values["shaft.angle"]], [unit.values["shaft.speed"]]
@@ -164,7 +183,20 @@ def reference_trajectory(
     motor: Mapping[str, float] | None = None,
     initial_speed: float = 10.0,
 ) -> Trajectory:
-    """DOP853 at ``rtol = atol = 1e-12`` on the Lagrange equation, sampled at ``times``."""
+    """DOP853 at ``rtol = atol = 1e-12`` on the Lagrange equation, sampled at ``times``.
+
+    Parameters
+    ----------
+    times : ndarray
+        Sample times from 0, s.
+    machine : mapping, optional
+        Machine description (default :func:`~wire_fmu.core.units.machine.model.crank_press`).
+    motor : mapping, optional
+        Motor characteristic ``a`` (N m) and ``b`` (N m s/rad) at the shaft
+        (default :data:`DEFAULT_MOTOR`).
+    initial_speed : float
+        Shaft speed at t = 0, rad/s.
+    """
     spec, problems = parse_machine(machine or crank_press())
     if spec is None:
         raise ValueError("; ".join(problems))
@@ -187,7 +219,13 @@ def reference_trajectory(
 
 
 def last_delta(trajectory: Trajectory) -> float:
-    """``delta`` of the last complete revolution, from the samples (as the unit reports it)."""
+    """``delta`` of the last complete revolution, from the samples (as the unit reports it).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        Samples of angle (rad) and speed (rad/s).
+    """
     stats = CycleStatistics()
     t, phi, omega = trajectory.time, trajectory.phi, trajectory.omega
     stats.start(float(t[0]), float(phi[0]), float(omega[0]))
@@ -205,7 +243,23 @@ def compare(
     reference: Trajectory,
     **machine_kw,
 ) -> list[Run]:
-    """Accuracy and cost of ``solver`` at each internal step, with observed orders."""
+    """Accuracy and cost of ``solver`` at each internal step, with observed orders.
+
+    Parameters
+    ----------
+    solver : str
+        The unit's solver.
+    max_steps : sequence of float
+        Internal steps, s, largest first (orders between successive ones).
+    stop_time : float
+        End of the simulated window, s.
+    step : float
+        Communication step, s.
+    reference : Trajectory
+        The reference at the same communication points.
+    **machine_kw
+        ``machine``, ``motor``, ``initial_speed`` of :func:`unit_trajectory`.
+    """
     ref_delta = last_delta(reference)
     runs: list[Run] = []
     for h in max_steps:
@@ -247,6 +301,19 @@ def steady_motion_study(
     solvers: Sequence[str] = ("energy1", "energy", "rk4"),
 ) -> dict:
     """Run the comparison and write its CSV, Markdown table and work-precision plot.
+
+    Parameters
+    ----------
+    directory : Path
+        Folder for the files (created).
+    stop_time : float
+        End of the simulated window, s.
+    step : float
+        Communication step, s.
+    max_steps : sequence of float
+        Internal steps of each solver, s.
+    solvers : sequence of str
+        The unit's solvers compared.
 
     Returns
     -------

@@ -16,7 +16,15 @@ __all__ = ["write_csv", "to_json", "dumps"]
 
 
 def write_csv(rows: Sequence[Any], path: Path) -> Path:
-    """Write dataclass rows to ``path`` (header from the fields)."""
+    """Write dataclass rows to ``path`` (header from the fields).
+
+    Parameters
+    ----------
+    rows : sequence of dataclass instances
+        One CSV row each (NaN as an empty cell); none: an empty file.
+    path : Path
+        CSV file to write (its folder is created).
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="") as f:
         if not rows:
@@ -38,7 +46,14 @@ def _cell(value: Any) -> Any:
 
 
 def to_json(value: Any) -> Any:
-    """Plain JSON data (NaN and infinity as None)."""
+    """Plain JSON data (NaN and infinity as None).
+
+    Parameters
+    ----------
+    value : object
+        Numbers, text, mappings, sequences, paths, variable references and
+        dataclasses, nested.
+    """
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, Mapping):
@@ -53,5 +68,11 @@ def to_json(value: Any) -> Any:
 
 
 def dumps(value: Any) -> str:
-    """JSON text of study data."""
+    """JSON text of study data.
+
+    Parameters
+    ----------
+    value : object
+        Anything :func:`to_json` takes.
+    """
     return json.dumps(to_json(value), indent=2)

@@ -138,14 +138,34 @@ class _TimingObserver:
         return seconds, calls, steps
 
     def on_start(self, sim: Simulation) -> None:
-        """Stamp the start of stepping."""
+        """Stamp the start of stepping (:class:`~wire_fmu.master.observers.Observer`).
+
+        Parameters
+        ----------
+        sim : Simulation
+            The running simulation.
+        """
         self._start = (time.perf_counter(), self.timer.elapsed, *self._fmi(sim))
 
     def on_step(self, sim: Simulation) -> None:
-        """Nothing per step."""
+        """Nothing per step (:class:`~wire_fmu.master.observers.Observer`).
+
+        Parameters
+        ----------
+        sim : Simulation
+            The running simulation.
+        """
 
     def on_end(self, sim: Simulation, result) -> None:
-        """Stamp the end."""
+        """Stamp the end (:class:`~wire_fmu.master.observers.Observer`).
+
+        Parameters
+        ----------
+        sim : Simulation
+            The simulation at its end.
+        result : RunResult
+            How it ended (not used).
+        """
         wall0, physics0, fmi0, calls0, steps0 = self._start
         if wall0 == 0.0:
             return
@@ -180,6 +200,17 @@ def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsT
     :func:`~wire_fmu.master.run.run_scene` does, without validating again
     (which would instantiate every unit once more, and rebuild FMUs if the
     core changed on disk during a study). A failure of any kind is a result.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene of one configuration.
+    structure : Structure
+        The validated (pinned) FMUs.
+    workdir : Path
+        Folder for the run's recorded CSV (overwritten by each run).
+    timer : PhysicsTimer
+        The entered timer of the core classes.
     """
     timing = _TimingObserver(timer)
     recorder = CsvRecorder(workdir, scene.run.output_interval)
@@ -205,6 +236,13 @@ def fastest_run(
 
     A shared machine only ever slows a run down, so the minimum is the
     best estimate of its cost; outputs do not depend on the repeat.
+
+    Parameters
+    ----------
+    scene, structure, workdir, timer
+        As for :func:`timed_run`.
+    repeats : int
+        Runs made (at least one).
     """
     runs = [timed_run(scene, structure, workdir, timer) for _ in range(max(1, repeats))]
     finished = [r for r in runs if r.status == "finished"]
@@ -221,6 +259,13 @@ def pinned(structure: Structure, directory: Path) -> Structure:
     A study keeps running the FMUs it validated, even if ours are rebuilt
     meanwhile because another process changed the core on disk (their
     guard would refuse an FMU whose core differs from the one imported here).
+
+    Parameters
+    ----------
+    structure : Structure
+        The validated scene.
+    directory : Path
+        Where the copies go (an existing folder that outlives the study).
     """
     copies: dict[Path, Path] = {}
     for path in structure.paths.values():
@@ -251,13 +296,25 @@ class StudyProgress:
         self._start = time.perf_counter()
 
     def note(self, text: str) -> None:
-        """A line that is not a run."""
+        """A line that is not a run.
+
+        Parameters
+        ----------
+        text : str
+            The line (without its newline).
+        """
         if self.enabled:
             (self.stream or sys.stderr).write(text + "\n")
             (self.stream or sys.stderr).flush()
 
     def advance(self, text: str) -> None:
-        """One run done."""
+        """One run done.
+
+        Parameters
+        ----------
+        text : str
+            What the run gave, after the bar, the count and the time.
+        """
         self.done += 1
         elapsed = time.perf_counter() - self._start
         left = elapsed / self.done * (self.total - self.done)

@@ -137,6 +137,11 @@ class Sampling:
         equal strata of every dimension (strata permuted independently,
         point uniform within its stratum); ``random`` draws independently.
         Both are reproducible from ``seed`` (numpy's PCG64).
+
+        Parameters
+        ----------
+        dimensions : int
+            Number of sampled axes.
         """
         rng = np.random.default_rng(self.seed)
         n = self.samples

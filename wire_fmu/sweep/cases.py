@@ -65,7 +65,13 @@ class Case:
     values: Mapping[str, Any]
 
     def label(self, width: int = 60) -> str:
-        """Short ``name=value, ...`` text (last target component), cut at ``width``."""
+        """Short ``name=value, ...`` text (last target component), cut at ``width``.
+
+        Parameters
+        ----------
+        width : int
+            Most characters (the cut ends in ``...``).
+        """
         text = ", ".join(f"{t.rsplit('.', 1)[-1]}={_short(v)}" for t, v in self.values.items())
         return text if len(text) <= width else text[: width - 3] + "..."
 
@@ -79,6 +85,11 @@ def case_id(values: Mapping[str, Any]) -> str:
 
     Floats are written by ``repr`` (exact), keys sorted, so the id depends on
     the values only, not on the order of the axes or of the cases.
+
+    Parameters
+    ----------
+    values : mapping
+        Target -> value of the case.
     """
     text = json.dumps(values, sort_keys=True, separators=(",", ":"), allow_nan=True, default=str)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:ID_LENGTH]
@@ -99,6 +110,11 @@ def expand(spec: SweepSpec) -> list[Case]:
     The first grid axis varies slowest; samples vary fastest. Cases whose
     values coincide (possible when sampled integer axes round alike) are
     kept once.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The parsed spec.
     """
     grid_axes = spec.grid_axes
     cases: list[Case] = []
@@ -368,7 +384,15 @@ def apply_case(scene: Scene, values: Mapping[str, Any]) -> Scene:
 
 
 def with_figures_recorded(scene: Scene, figures: tuple[Figure, ...]) -> Scene:
-    """``scene`` recording every unit column a key figure reads (others are always recorded)."""
+    """``scene`` recording every unit column a key figure reads (others are always recorded).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; one that records every output is returned as is.
+    figures : tuple of Figure
+        The sweep's key figures.
+    """
     if scene.outputs is None:
         return scene
     wanted = list(scene.outputs)

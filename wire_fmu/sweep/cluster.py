@@ -114,7 +114,15 @@ class _DaskRun:
         self.submitted = 0
 
     def submit(self, task: CaseTask, attempt: int) -> Any:
-        """Submit one case (``attempt`` counts from 1)."""
+        """Submit one case (``attempt`` counts from 1).
+
+        Parameters
+        ----------
+        task : CaseTask
+            The case.
+        attempt : int
+            How many times it has been submitted, this one included.
+        """
         self.submitted += 1
         future = self.client.submit(
             _dask_case,
@@ -128,7 +136,15 @@ class _DaskRun:
         return future
 
     def run(self, tasks: Sequence[CaseTask], sink: Callable[[CaseOutcome], None]) -> None:
-        """Submit ``tasks``; outcomes go to ``sink`` in the order they complete."""
+        """Submit ``tasks``; outcomes go to ``sink`` in the order they complete.
+
+        Parameters
+        ----------
+        tasks : sequence of CaseTask
+            The cases.
+        sink : callable
+            Takes each :class:`~wire_fmu.sweep.results.CaseOutcome`.
+        """
         from distributed import as_completed
 
         queue = as_completed([self.submit(t, 1) for t in tasks])
@@ -142,7 +158,17 @@ class _DaskRun:
             sink(outcome)
 
     def collect(self, future: Any, task: CaseTask, attempt: int) -> CaseOutcome | None:
-        """The outcome of a completed future; None when the case was lost and goes again."""
+        """The outcome of a completed future; None when the case was lost and goes again.
+
+        Parameters
+        ----------
+        future : distributed.Future
+            The completed task.
+        task : CaseTask
+            Its case.
+        attempt : int
+            Its submission, from 1 (``lost`` after ``max_attempts``).
+        """
         from distributed.scheduler import KilledWorker
 
         try:

@@ -114,7 +114,13 @@ class CaseOutcome:
 
 
 def summary_schema(spec: SweepSpec) -> pa.Schema:
-    """Arrow schema of a record and of the summary table of ``spec``."""
+    """Arrow schema of a record and of the summary table of ``spec``.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep: one column per axis target and per key figure.
+    """
     fields = [
         pa.field("case_id", pa.string(), nullable=False),
         pa.field("index", pa.int64()),
@@ -171,6 +177,12 @@ class ResultStore:
     def open(self, manifest: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
         """Create the folder or check it holds this scene's sweep; the records on disk.
 
+        Parameters
+        ----------
+        manifest : mapping
+            What the sweep is (scene, its key, spec, core version), written
+            as ``sweep.json``.
+
         Raises
         ------
         SweepError
@@ -215,11 +227,25 @@ class ResultStore:
 
     # -- writing a case -----------------------------------------------------------------
     def case_dir(self, case_id: str) -> Path:
-        """Results folder of one case."""
+        """Results folder of one case.
+
+        Parameters
+        ----------
+        case_id : str
+            The case's id.
+        """
         return self.cases_dir / case_id
 
     def write(self, case: Case, outcome: CaseOutcome) -> dict[str, Any]:
-        """Write a finished case: its files, then its record; the record row."""
+        """Write a finished case: its files, then its record; the record row.
+
+        Parameters
+        ----------
+        case : Case
+            The case.
+        outcome : CaseOutcome
+            Its status, figures and files.
+        """
         folder = self.case_dir(case.case_id)
         if folder.exists():
             shutil.rmtree(folder)

@@ -101,12 +101,26 @@ class ProgressWriter:
         self.start = time.perf_counter()
 
     def note(self, text: str) -> None:
-        """A free line."""
+        """A free line.
+
+        Parameters
+        ----------
+        text : str
+            The line (without its newline).
+        """
         self.stream.write(text + "\n")
         self.stream.flush()
 
     def case(self, case: Case, row: Mapping[str, Any]) -> None:
-        """The line of a finished case."""
+        """The line of a finished case.
+
+        Parameters
+        ----------
+        case : Case
+            The case.
+        row : mapping
+            Its summary row (status, wall time in s, error).
+        """
         self.done += 1
         ran = self.done - self.initial
         elapsed = time.perf_counter() - self.start
@@ -169,7 +183,13 @@ class SweepResult:
 
 
 def scene_key(scene: Scene) -> str:
-    """Hash of what a scene asks for (not where its file is): results of one scene only."""
+    """Hash of what a scene asks for (not where its file is): results of one scene only.
+
+    Parameters
+    ----------
+    scene : Scene
+        The parsed scene.
+    """
     normal = dataclasses.replace(scene, base_dir=Path("."), source=None)
     return hashlib.sha256(repr(normal).encode("utf-8")).hexdigest()[:16]
 

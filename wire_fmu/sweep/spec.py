@@ -153,6 +153,11 @@ class SweepSpec:
 def load_sweep_spec(path: Path) -> SweepSpec:
     """Read and parse a sweep spec file.
 
+    Parameters
+    ----------
+    path : Path
+        The TOML file.
+
     Raises
     ------
     SweepSpecError

@@ -52,7 +52,13 @@ class _View:
     normal: np.ndarray
 
     def project(self, points: Any) -> np.ndarray:
-        """Page coordinates of 3-D points, shape (..., 2), m."""
+        """Page coordinates of 3-D points, shape (..., 2), m.
+
+        Parameters
+        ----------
+        points : array_like, shape (..., 3)
+            Points in 3-D, m.
+        """
         p = np.asarray(points, dtype=float)
         return np.stack([p @ self.u, p @ self.v], axis=-1)
 
