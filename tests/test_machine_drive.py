@@ -19,13 +19,9 @@ from scipy.integrate import quad
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.unit import Causality
-from wire_fmu.core.units.machine.model import (
-    CrankSliderInertia,
-    CycleStatistics,
-    FourierSeries,
-    crank_press,
-    parse_machine,
-)
+from wire_fmu.core.units.machine.cycle_statistics import CycleStatistics
+from wire_fmu.core.units.machine.laws import CrankSliderInertia, FourierSeries
+from wire_fmu.core.units.machine.spec import crank_press, parse_machine
 from wire_fmu.core.units.machine.unit import MachineDriveUnit
 from wire_fmu.study.steady_motion import (
     compare,

@@ -1,6 +1,6 @@
 """Paper 004's method against a reference: accuracy and cost of the machine unit's steady motion.
 
-The machine (:func:`~wire_fmu.core.units.machine.model.crank_press` by default)
+The machine (:func:`~wire_fmu.core.units.machine.spec.crank_press` by default)
 is solved by the :class:`~wire_fmu.core.units.machine.unit.MachineDriveUnit`
 stepped as a master would, with paper 004's energy form (``energy1``: the
 first-order step (9)/(15) alone; ``energy``: with successive second-order
@@ -35,7 +35,8 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from wire_fmu.core.units.machine.model import CycleStatistics, crank_press, parse_machine
+from wire_fmu.core.units.machine.cycle_statistics import CycleStatistics
+from wire_fmu.core.units.machine.spec import crank_press, parse_machine
 from wire_fmu.core.units.machine.unit import MachineDriveUnit
 
 __all__ = [
@@ -149,7 +150,7 @@ def unit_trajectory(
     step : float
         Communication step, s.
     machine : mapping, optional
-        Machine description (default :func:`~wire_fmu.core.units.machine.model.crank_press`).
+        Machine description (default :func:`~wire_fmu.core.units.machine.spec.crank_press`).
     motor : mapping, optional
         Motor characteristic ``a`` (N m) and ``b`` (N m s/rad) at the shaft
         (default :data:`DEFAULT_MOTOR`).
@@ -190,7 +191,7 @@ def reference_trajectory(
     times : ndarray
         Sample times from 0, s.
     machine : mapping, optional
-        Machine description (default :func:`~wire_fmu.core.units.machine.model.crank_press`).
+        Machine description (default :func:`~wire_fmu.core.units.machine.spec.crank_press`).
     motor : mapping, optional
         Motor characteristic ``a`` (N m) and ``b`` (N m s/rad) at the shaft
         (default :data:`DEFAULT_MOTOR`).

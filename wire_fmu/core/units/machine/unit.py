@@ -14,7 +14,7 @@ Ports
     Per revolution of the main shaft: ``period`` (s), ``omega_mean``,
     ``omega_max``, ``omega_min`` (rad/s) and the coefficient of
     non-uniformity ``delta = (omega_max - omega_min) / omega_mean``
-    (:class:`~wire_fmu.core.units.machine.model.CycleStatistics`; extremes over the
+    (:class:`~wire_fmu.core.units.machine.cycle_statistics.CycleStatistics`; extremes over the
     communication points, updated by :meth:`MachineDriveUnit.advance` -- a
     monolithic model, which has no communication points, leaves them at 0).
 ``solver``
@@ -27,7 +27,7 @@ second-order refinement to tolerance; ``energy1`` -- its first-order step
 alone (:mod:`wire_fmu.core.framework.energy_integrator`); or any reference integrator of
 :mod:`wire_fmu.core.framework.hybrid` (``radau`` at tight tolerance is the reference).
 The machine's laws are the JSON parameter ``machine``
-(:func:`~wire_fmu.core.units.machine.model.parse_machine`), a crank press by default.
+(:func:`~wire_fmu.core.units.machine.spec.parse_machine`), a crank press by default.
 """
 
 from __future__ import annotations
@@ -55,12 +55,9 @@ from wire_fmu.core.framework.unit import (
     output,
     parameter,
 )
-from wire_fmu.core.units.machine.model import (
-    CycleStatistics,
-    MachineDriveModel,
-    crank_press,
-    parse_machine,
-)
+from wire_fmu.core.units.machine.cycle_statistics import CycleStatistics
+from wire_fmu.core.units.machine.model import MachineDriveModel
+from wire_fmu.core.units.machine.spec import crank_press, parse_machine
 
 __all__ = ["MachineDriveUnit"]
 
