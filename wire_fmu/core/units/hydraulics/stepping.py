@@ -1,0 +1,167 @@
+"""Stepping a cylinder over one communication step, refined at end-stop impacts and cushions.
+
+Fixed-step solvers (``ros2``, ``rk4``) step at ``solver_max_step`` except
+where the physics is much faster: during a stop impact they step at
+``CONTACT_STEP_FACTOR / omega`` for the impact's transient, and while the rod
+runs into a cushion at ``CUSHION_STEP_FACTOR m / (c v)``. The integration is
+restarted at located events and in fixed pieces, so the result depends only
+on the state and the step (bit-reproducible). :class:`RefinedStepping` is the
+part of :class:`~wire_fmu.core.units.hydraulics.model.HydraulicsModel` that
+does this.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+
+__all__ = [
+    "CONTACT_CHUNK_STEPS",
+    "CONTACT_STEP_FACTOR",
+    "CUSHION_CHUNK_STEPS",
+    "CUSHION_STEP_FACTOR",
+    "RefinedStepping",
+]
+
+
+class _Resolve(Exception):  # noqa: N818 - control flow, not an error
+    """Raised from an event handler to restart integration with a finer or coarser solver."""
+
+    def __init__(self, time: float, state: np.ndarray) -> None:
+        super().__init__(time)
+        self.time = time
+        self.state = state
+
+
+CONTACT_STEP_FACTOR = 0.02
+"""While on a stop, fixed-step solvers step at most ``CONTACT_STEP_FACTOR / omega``
+(``omega = sqrt(k / m)``): the restitution error of ROS2 is about
+``2 (omega h)^2``, so about 0.1 %."""
+
+CONTACT_CHUNK_STEPS = 16
+"""While on a stop, the solver is restarted every this many steps, which refreshes
+ROS2's Jacobian (the stop damper's loss ``c v^2`` changes slope as the rod rebounds)."""
+
+CUSHION_STEP_FACTOR = 0.03
+"""While the rod runs into a cushion at speed ``v``, fixed-step solvers step at most
+``CUSHION_STEP_FACTOR m / (c v)`` (``m / (c v)`` is the time in which the cushion
+would halve the speed); the error in ``v(x)`` and in the ledger is then about 0.1 %."""
+
+CUSHION_CHUNK_STEPS = 8
+"""In a cushion the step is re-chosen (and the Jacobian refreshed) every this many steps."""
+
+_FIXED_STEP = ("rk4", "ros2")
+
+
+class RefinedStepping:
+    """Advance, settle and the refined integration of a cylinder model (a mixin).
+
+    The model provides ``state``, ``force``, ``settings``, ``solver``, ``stops``, ``seal``,
+    ``mass``, ``spec``, ``check_limits``, ``project`` and ``_settle_friction``.
+    """
+
+    def _make_contact_solver(self, settings: SolverSettings):
+        """A solver resolving the stop contact (fixed-step methods only), or None.
+
+        Also sets :attr:`contact_transient`: how long after contact begins
+        the fine steps are kept (two periods of the contact oscillation or
+        five decay times, whichever is longer), s.
+        """
+        self.contact_transient = 0.0
+        if self.stops is None or settings.method not in _FIXED_STEP:
+            return None
+        omega, zeta = self.stops.contact_frequency(self.mass)
+        self.contact_transient = max(
+            4.0 * math.pi / omega, 5.0 / (zeta * omega) if zeta > 0.0 else math.inf
+        )
+        fine = min(settings.max_step, CONTACT_STEP_FACTOR / omega)
+        if fine >= settings.max_step:
+            return None
+        return make_solver(replace(settings, max_step=fine))
+
+    # -------------------------------------------------------------- stepping
+    def advance(self, t: float, h: float, force: float) -> int:
+        """Advance from ``t`` by ``h`` (s) with the rod ``force`` (N) held; return events.
+
+        Raises
+        ------
+        HydraulicLimitError
+            At a limit (the caller restores the state and refuses the step).
+        """
+        self.last_events = []
+        self.force = float(force)
+        self.check_limits(t, self.state)
+        self.state = self.settle(self.state)
+        start = float(self.state[0])
+        x, events = self._integrate(t, self.state, t + h)
+        self.state = x
+        self.external_work += self.force * (float(x[0]) - start)
+        return events
+
+    def settle(self, x: np.ndarray) -> np.ndarray:
+        """Seal mode consistent with the force now held (it may have jumped); the new state."""
+        before = self._seal_mode()
+        x = self._settle_friction(np.array(x, dtype=float), [])
+        self.mode_changes += int(self._seal_mode() != before)
+        return self.project(x)
+
+    def _seal_mode(self) -> list[int]:
+        return [] if self.seal is None else self.seal.friction.get_mode()
+
+    def _integrate(self, t: float, x: np.ndarray, t_end: float) -> tuple[np.ndarray, int]:
+        """Integrate to ``t_end``; fixed-step solvers refine on a stop and in a cushion.
+
+        The refined pieces start at located events and have fixed lengths, so
+        the result depends only on the state and ``t_end`` (bit-reproducible).
+        """
+        events = 0
+        tolerance = self.settings.event_time_tolerance
+        self._integrating = True
+        try:
+            while t < t_end - tolerance:
+                solver, stop = self._piece(t, x, t_end)
+                try:
+                    x, count = solver.advance(self, t, x, stop)
+                    t, events = stop, events + count
+                except _Resolve as restart:
+                    t, x, events = restart.time, restart.state, events + 1
+        finally:
+            self._integrating = False
+        return x, events
+
+    @property
+    def _refining(self) -> bool:
+        """Whether event handlers may restart the integration (only inside :meth:`advance`)."""
+        return self._integrating and self.stops is not None and self.settings.method in _FIXED_STEP
+
+    def _resolution(self, t: float, x: np.ndarray) -> str:
+        """``"contact"`` (impact transient), ``"cushion"`` (running into one) or ``"coarse"``."""
+        stops = self.stops
+        if any(stops.contact) and t < stops.contact_since + self.contact_transient:
+            return "contact"
+        if stops.cushion_speed(float(x[1])) > 0.0:
+            return "cushion"
+        return "coarse"
+
+    def _piece(self, t: float, x: np.ndarray, t_end: float):
+        """The solver for the next piece of integration and where the piece ends."""
+        self._current_resolution = self._resolution(t, x) if self._refining else "coarse"
+        if self._current_resolution == "contact" and self.contact_solver is not None:
+            solver = self.contact_solver
+            settled = self.stops.contact_since + self.contact_transient
+            return solver, min(
+                t_end,
+                t + CONTACT_CHUNK_STEPS * solver.settings.max_step,
+                max(settled, t + solver.settings.max_step),
+            )
+        if self._current_resolution == "cushion":
+            c = self.spec.stops.cushion_coefficient
+            h = CUSHION_STEP_FACTOR * self.mass / (c * self.stops.cushion_speed(float(x[1])))
+            if h < self.settings.max_step:
+                solver = make_solver(replace(self.settings, max_step=h))
+                return solver, min(t_end, t + CUSHION_CHUNK_STEPS * h)
+        return self.solver, t_end
