@@ -63,12 +63,12 @@ the cheapest configuration named.
 Timing
 ------
 Wall time is measured from the end of initialisation to the end of the
-run. Physics time is the time spent inside the core units' ``advance``
-(our FMUs run the ``wire_fmu`` imported by this process, so wrapping the
-class method sees it); FMI time is the time the master spends in FMI calls
-(:attr:`Slave.seconds`); FMI overhead is FMI time minus physics; the master
-is the rest. The machine is shared: repeat a study before trusting a 20 %
-difference in cost.
+run. Physics time is the time spent inside the units' ``advance``, as each
+FMU of ours counts it in its local variable ``physics_seconds``, read
+through FMI at the end of the run (unknown for a run that failed); FMI time
+is the time the master spends in FMI calls (:attr:`Slave.seconds`); FMI
+overhead is FMI time minus physics; the master is the rest. The machine
+is shared: repeat a study before trusting a 20 % difference in cost.
 
 The study's pieces
 ------------------
@@ -120,7 +120,7 @@ from .plan import (
     study_scene,
 )
 from .solvers import SolverChoice
-from .timing import PhysicsTimer, StudyProgress, core_classes, fastest_run, pinned
+from .timing import StudyProgress, fastest_run, pinned
 
 __all__ = ["REFERENCE_MARGIN", "reference_run", "run_accuracy_study", "summary_text"]
 
@@ -186,33 +186,31 @@ def _run_grid(
 ) -> list[RunRow]:
     rows: list[RunRow] = []
     over_budget: dict[str, float] = {}
-    with PhysicsTimer(core_classes(scene)) as timer:
-        for config in grid:
-            if config.family in over_budget:
-                row = _skipped(
-                    config,
-                    f"skipped: the run at a larger step took "
-                    f"{over_budget[config.family]:.1f} s (budget "
-                    f"{settings.run_budget:g} s)",
-                )
-            else:
-                run, _ = fastest_run(
-                    configured_scene(scene, config, structure),
-                    structure,
-                    workdir,
-                    timer,
-                    settings.repeats,
-                )
-                error, worst = (
-                    output_error(run.columns, reference.values, settings.key_outputs)
-                    if run.status == "finished"
-                    else (math.nan, "")
-                )
-                row = _row(config, run, error, worst)
-                if 2.0 * row.wall_time_s > settings.run_budget:
-                    over_budget[config.family] = row.wall_time_s
-            rows.append(row)
-            progress.advance(_describe(row))
+    for config in grid:
+        if config.family in over_budget:
+            row = _skipped(
+                config,
+                f"skipped: the run at a larger step took "
+                f"{over_budget[config.family]:.1f} s (budget "
+                f"{settings.run_budget:g} s)",
+            )
+        else:
+            run, _ = fastest_run(
+                configured_scene(scene, config, structure),
+                structure,
+                workdir,
+                settings.repeats,
+            )
+            error, worst = (
+                output_error(run.columns, reference.values, settings.key_outputs)
+                if run.status == "finished"
+                else (math.nan, "")
+            )
+            row = _row(config, run, error, worst)
+            if 2.0 * row.wall_time_s > settings.run_budget:
+                over_budget[config.family] = row.wall_time_s
+        rows.append(row)
+        progress.advance(_describe(row))
     return rows
 
 

@@ -42,7 +42,7 @@ from wire_fmu.registry import BY_NAME, UNIT_TYPES
 from .measures import one_line, output_error
 from .plan import StudyError, StudyOptions, StudySettings
 from .tables import dumps, write_csv
-from .timing import PhysicsTimer, StudyProgress, TimedRun, core_classes, fastest_run, pinned
+from .timing import StudyProgress, TimedRun, fastest_run, pinned
 
 __all__ = [
     "EFFECT_CATALOGUES",
@@ -305,12 +305,9 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: An
     )
     rows = []
     keys = [str(k) for k in settings.key_outputs]
-    with (
-        tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp,
-        PhysicsTimer(core_classes(base)) as timer,
-    ):
+    with tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp:
         structure = pinned(validate_scene(base, opts.fmu_dir), Path(tmp))
-        baseline, spread = fastest_run(base, structure, Path(tmp) / "run", timer, repeats)
+        baseline, spread = fastest_run(base, structure, Path(tmp) / "run", repeats)
         report.advance(
             f"all effects: {baseline.status}, {baseline.timing.per_simulated_second:.3g} s/s"
         )
@@ -321,7 +318,7 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: An
             )
         for case in cases:
             run, case_spread = fastest_run(
-                without(base, case), structure, Path(tmp) / "run", timer, repeats
+                without(base, case), structure, Path(tmp) / "run", repeats
             )
             rows.append(_effect_row(case, run, case_spread, baseline, spread, keys))
             report.advance(_describe(rows[-1]))

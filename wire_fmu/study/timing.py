@@ -2,7 +2,9 @@
 
 Shared by the accuracy study (:mod:`wire_fmu.study.accuracy`) and the
 effects study (:mod:`wire_fmu.study.effects`); see the accuracy study's
-"Timing" section for what is measured.
+"Timing" section for what is measured. The physics time is read through
+FMI, like any variable: every FMU of ours counts the wall-clock time its
+unit spends in its physics in the local variable :data:`PHYSICS_SECONDS`.
 """
 
 from __future__ import annotations
@@ -12,10 +14,9 @@ import math
 import shutil
 import sys
 import time
-from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
 import numpy as np
 
@@ -23,15 +24,13 @@ from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.plots import read_results
 from wire_fmu.master.scene import Scene
 from wire_fmu.master.simulation import Simulation
+from wire_fmu.master.slave import UnitFailedError
 from wire_fmu.master.validate import Structure
 
-from .monolithic import CORE_UNITS
-from .solvers import _import
-
 __all__ = [
+    "PHYSICS_SECONDS",
     "Timing",
-    "PhysicsTimer",
-    "core_classes",
+    "physics_seconds",
     "TimedRun",
     "timed_run",
     "fastest_run",
@@ -40,6 +39,10 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
+
+PHYSICS_SECONDS = "physics_seconds"
+"""Local Real of every FMU of ours: wall-clock time spent in its unit's physics (its
+``advance``) since instantiation, s."""
 
 
 @dataclass
@@ -70,65 +73,35 @@ class Timing:
         )
 
 
-class PhysicsTimer:
-    """Accumulates the time spent in ``advance`` of some core unit classes (wraps them).
+def physics_seconds(sim: Simulation) -> float:
+    """Wall-clock time the units' physics took so far, read through FMI, s.
+
+    The sum of :data:`PHYSICS_SECONDS` over the units that have it (ours;
+    a foreign FMU's physics counts as FMI time); NaN if a unit cannot be
+    asked (it failed).
 
     Parameters
     ----------
-    classes : iterable of type
-        Core unit classes whose ``advance`` is timed while the timer is entered.
+    sim : Simulation
+        A simulation whose units are instantiated.
     """
-
-    def __init__(self, classes: Iterable[type]) -> None:
-        self.classes = list(dict.fromkeys(classes))
-        self.elapsed = 0.0
-        self._originals: dict[type, Any] = {}
-
-    def __enter__(self) -> PhysicsTimer:
-        for cls in self.classes:
-            self._originals[cls] = cls.__dict__.get("advance")
-            cls.advance = self._timed(cls.advance)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for cls, original in self._originals.items():
-            if original is None:
-                del cls.advance
-            else:
-                cls.advance = original
-        self._originals.clear()
-
-    def _timed(self, original):
-        timer = self
-
-        def advance(unit, time_, step):
-            start = time.perf_counter()
+    total = 0.0
+    for slave in sim.slaves.values():
+        if PHYSICS_SECONDS in slave.variables:
             try:
-                return original(unit, time_, step)
-            finally:
-                timer.elapsed += time.perf_counter() - start
-
-        return advance
-
-
-def core_classes(scene: Scene) -> list[type]:
-    """Core unit classes of the scene's units of ours (those that cannot be imported skipped)."""
-    out = []
-    for fmu in sorted({u.fmu for u in scene.units.values() if u.fmu in CORE_UNITS}):
-        try:
-            out.append(_import(CORE_UNITS[fmu]))
-        except (ImportError, AttributeError) as exc:
-            logger.warning("cannot time the physics of %s: %s", fmu, exc)
-    return out
+                total += float(slave.get([PHYSICS_SECONDS])[PHYSICS_SECONDS])
+            except UnitFailedError as exc:
+                logger.debug("physics time of %s unknown: %s", slave.name, exc)
+                return math.nan
+    return total
 
 
 class _TimingObserver:
-    """Stamps the stepping phase: wall, physics and FMI time, call counts."""
+    """Stamps the stepping phase: wall and FMI time, call counts; at the end, the physics."""
 
-    def __init__(self, timer: PhysicsTimer) -> None:
-        self.timer = timer
+    def __init__(self) -> None:
         self.timing = Timing()
-        self._start = (0.0, 0.0, 0.0, 0, 0)
+        self._start = (0.0, 0.0, 0, 0)
 
     @staticmethod
     def _fmi(sim: Simulation) -> tuple[float, int, int]:
@@ -145,7 +118,7 @@ class _TimingObserver:
         sim : Simulation
             The running simulation.
         """
-        self._start = (time.perf_counter(), self.timer.elapsed, *self._fmi(sim))
+        self._start = (time.perf_counter(), *self._fmi(sim))
 
     def on_step(self, sim: Simulation) -> None:
         """Nothing per step (:class:`~wire_fmu.master.observers.Observer`).
@@ -159,21 +132,27 @@ class _TimingObserver:
     def on_end(self, sim: Simulation, result) -> None:
         """Stamp the end (:class:`~wire_fmu.master.observers.Observer`).
 
+        The physics time is read from the units after the stamps (the calls
+        that read it are not counted); it covers the stepping phase, since
+        the units step in no other. After a failure it is unknown (NaN): a
+        unit that failed may not be asked anything more.
+
         Parameters
         ----------
         sim : Simulation
-            The simulation at its end.
+            The simulation at its end, its units not yet freed.
         result : RunResult
-            How it ended (not used).
+            How it ended.
         """
-        wall0, physics0, fmi0, calls0, steps0 = self._start
+        wall0, fmi0, calls0, steps0 = self._start
         if wall0 == 0.0:
             return
         fmi, calls, steps = self._fmi(sim)
+        wall = time.perf_counter() - wall0
         self.timing = Timing(
-            time.perf_counter() - wall0,
+            wall,
             sim.time,
-            self.timer.elapsed - physics0,
+            physics_seconds(sim) if result.status != "failed" else math.nan,
             fmi - fmi0,
             calls - calls0,
             steps - steps0,
@@ -192,7 +171,7 @@ class TimedRun:
     rejected: int = 0
 
 
-def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsTimer) -> TimedRun:
+def timed_run(scene: Scene, structure: Structure, workdir: Path) -> TimedRun:
     """Run ``scene`` with the master, recording its outputs and timing the stepping.
 
     The scene was validated once (``structure``); each run builds a
@@ -209,10 +188,8 @@ def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsT
         The validated (pinned) FMUs.
     workdir : Path
         Folder for the run's recorded CSV (overwritten by each run).
-    timer : PhysicsTimer
-        The entered timer of the core classes.
     """
-    timing = _TimingObserver(timer)
+    timing = _TimingObserver()
     recorder = CsvRecorder(workdir, scene.run.output_interval)
     try:
         sim = Simulation(scene, structure, [timing, recorder])
@@ -229,7 +206,7 @@ def timed_run(scene: Scene, structure: Structure, workdir: Path, timer: PhysicsT
 
 
 def fastest_run(
-    scene: Scene, structure: Structure, workdir: Path, timer: PhysicsTimer, repeats: int = 1
+    scene: Scene, structure: Structure, workdir: Path, repeats: int = 1
 ) -> tuple[TimedRun, float]:
     """The fastest of ``repeats`` runs, and the spread of their costs (s per simulated s;
     NaN with fewer than two finished runs).
@@ -239,12 +216,12 @@ def fastest_run(
 
     Parameters
     ----------
-    scene, structure, workdir, timer
+    scene, structure, workdir
         As for :func:`timed_run`.
     repeats : int
         Runs made (at least one).
     """
-    runs = [timed_run(scene, structure, workdir, timer) for _ in range(max(1, repeats))]
+    runs = [timed_run(scene, structure, workdir) for _ in range(max(1, repeats))]
     finished = [r for r in runs if r.status == "finished"]
     if not finished:
         return runs[-1], math.nan
