@@ -14,11 +14,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from wire_fmu.core.framework.energy_integrator import (
-    EnergyFormBreakdownError,
-    EnergyFormIntegrator,
-    MachineUnit,
-)
+from wire_fmu.core.framework.energy_integrator import EnergyFormBreakdownError, EnergyFormIntegrator
+from wire_fmu.core.framework.machine_unit import MachineUnit
 
 TIGHT = {"method": "DOP853", "rtol": 1e-13, "atol": 1e-13}
 

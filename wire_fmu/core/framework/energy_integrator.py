@@ -53,12 +53,16 @@ an angle), the logarithmic linearisation ``ln(1 + x) ~ x`` fails once
 ``|domega| ~ |omega|``, and ``E = I omega^2 / 2`` loses the sign of
 ``omega``, so a reversal cannot be represented. Start-up from rest and a
 band brake bringing the drum to rest are exactly these cases. The
-time-stepped solver :class:`EnergyFormSolver` therefore steps in time
-form (explicit Euler for the first-order variant, Heun for the refined
-one -- same order) whenever ``omega_i = 0``, the first-order prediction
+time-stepped solver
+:class:`~wire_fmu.core.framework.energy_solver.EnergyFormSolver` therefore
+steps in time form (explicit Euler for the first-order variant, Heun for the
+refined one -- same order) whenever ``omega_i = 0``, the first-order prediction
 changes ``omega`` by more than half of itself or reverses it, or the
 refinement fails to converge; a drum *held* by the brake is a stuck mode
 with ``omega = 0`` exactly and is not integrated at all.
+
+The machine unit itself is :class:`~wire_fmu.core.framework.machine_unit.MachineUnit`;
+the solver a unit chooses by name is in :mod:`wire_fmu.core.framework.energy_solver`.
 """
 
 from __future__ import annotations
@@ -66,132 +70,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from types import MappingProxyType
-from typing import Protocol
 
-import numpy as np
+from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 
-from wire_fmu.core.framework.hybrid import SolverSettings, _FixedStepSolver
-
-__all__ = [
-    "MachineUnit",
-    "StepWork",
-    "EnergyStep",
-    "EnergyFormBreakdownError",
-    "EnergyFormIntegrator",
-    "EnergyFormSolver",
-    "RigidMachineSystem",
-    "ENERGY_SOLVERS",
-    "make_energy_solver",
-]
-
-
-def _zero(_: float) -> float:
-    return 0.0
+__all__ = ["EnergyStep", "EnergyFormBreakdownError", "EnergyFormIntegrator"]
 
 
 class EnergyFormBreakdownError(ArithmeticError):
     """The energy form cannot take this step (omega at or through zero, no convergence)."""
-
-
-@dataclass(frozen=True)
-class MachineUnit:
-    """Paper 004's machine unit: ``I(phi)``, ``M_d = a - b omega`` and resistances.
-
-    Parameters
-    ----------
-    inertia : callable
-        ``I(phi)``, kg m^2 (> 0).
-    inertia_slope : callable
-        ``dI/dphi``, kg m^2/rad.
-    a : float
-        Motor torque at zero speed, N m.
-    b : float
-        Slope of the motor characteristic, N m s/rad.
-    resistance_angle : callable
-        ``M_c(phi)``, N m.
-    resistance_angle_work : callable or None
-        ``(phi0, phi1) -> integral of M_c(phi) dphi``, J; Simpson's rule if None.
-    resistance_speed, resistance_speed_slope : callable
-        ``M_c(omega)`` (N m) and ``dM_c/domega`` (N m s/rad).
-    resistance_time : callable
-        ``M_c(t)``, N m.
-    """
-
-    inertia: Callable[[float], float]
-    inertia_slope: Callable[[float], float] = _zero
-    a: float = 0.0
-    b: float = 0.0
-    resistance_angle: Callable[[float], float] = _zero
-    resistance_angle_work: Callable[[float, float], float] | None = None
-    resistance_speed: Callable[[float], float] = _zero
-    resistance_speed_slope: Callable[[float], float] = _zero
-    resistance_time: Callable[[float], float] = _zero
-
-    def driving_torque(self, omega: float) -> float:
-        """``M_d = a - b omega`` (eq. 6), N m."""
-        return self.a - self.b * omega
-
-    def speed_torque(self, omega: float) -> float:
-        """Net speed-dependent torque ``M_d(omega) - M_c(omega)``, N m."""
-        return self.a - self.b * omega - self.resistance_speed(omega)
-
-    def speed_torque_slope(self, omega: float) -> float:
-        """``d(M_d - M_c(omega))/domega``, N m s/rad (the paper's ``k - b``)."""
-        return -self.b - self.resistance_speed_slope(omega)
-
-    def angle_work(self, phi0: float, phi1: float) -> float:
-        """Work absorbed by ``M_c(phi)`` from ``phi0`` to ``phi1``, J."""
-        if self.resistance_angle_work is not None:
-            return self.resistance_angle_work(phi0, phi1)
-        mid = self.resistance_angle(0.5 * (phi0 + phi1))
-        ends = self.resistance_angle(phi0) + self.resistance_angle(phi1)
-        return (phi1 - phi0) * (ends + 4.0 * mid) / 6.0
-
-    def net_torque(self, t: float, phi: float, omega: float) -> float:
-        """All torques, N m."""
-        return self.speed_torque(omega) - self.resistance_angle(phi) - self.resistance_time(t)
-
-    def acceleration(self, t: float, phi: float, omega: float) -> float:
-        """``omega'`` from the Lagrange equation, rad/s^2."""
-        centrifugal = 0.5 * self.inertia_slope(phi) * omega * omega
-        return (self.net_torque(t, phi, omega) - centrifugal) / self.inertia(phi)
-
-    def rhs_time(self, t: float, y: np.ndarray) -> np.ndarray:
-        """``d[phi, omega]/dt`` (for reference solutions)."""
-        return np.array([y[1], self.acceleration(t, y[0], y[1])])
-
-    def rhs_angle(self, phi: float, y: np.ndarray) -> np.ndarray:
-        """``d[omega, t]/dphi`` (for reference solutions; omega must not vanish)."""
-        omega, t = y
-        return np.array([self.acceleration(t, phi, omega) / omega, 1.0 / omega])
-
-    def kinetic_energy(self, phi: float, omega: float) -> float:
-        """``I(phi) omega^2 / 2``, J."""
-        return 0.5 * self.inertia(phi) * omega * omega
-
-
-@dataclass(frozen=True)
-class StepWork:
-    """Works over one step, J.
-
-    Attributes
-    ----------
-    driving : float
-        Done by ``M_d(omega)`` on the machine.
-    angle, speed, time : float
-        Absorbed by ``M_c(phi)``, ``M_c(omega)``, ``M_c(t)``.
-    """
-
-    driving: float
-    angle: float
-    speed: float
-    time: float
-
-    @property
-    def net(self) -> float:
-        """Change of kinetic energy these works imply, J."""
-        return self.driving - self.angle - self.speed - self.time
 
 
 @dataclass(frozen=True)
@@ -419,71 +305,3 @@ def _time_work(
         time=half
         * (machine.resistance_time(t) * omega0 + machine.resistance_time(t + dt) * omega1),
     )
-
-
-# ------------------------------------------------------------------ solver
-class RigidMachineSystem(Protocol):
-    """A hybrid system that is a rigid one-degree-of-freedom machine in every mode.
-
-    Its state is ``[phi, omega, dissipated energy, external work]``
-    (rad, rad/s, J, J). Besides the
-    :class:`~wire_fmu.core.framework.hybrid.HybridSystem` methods it offers:
-    """
-
-    def machine(self, t: float, x: np.ndarray) -> MachineUnit | None:
-        """The machine unit of the current mode; None while it is held at rest."""
-        ...
-
-    def book(self, work: StepWork) -> tuple[float, float]:
-        """Split a step's works into (dissipated, external work), J."""
-        ...
-
-
-class EnergyFormSolver(_FixedStepSolver):
-    """Paper 004's integrator as a fixed-step solver of :mod:`wire_fmu.core.framework.hybrid`.
-
-    Takes ``ceil(H / max_step)`` equal time steps per communication step,
-    each by :meth:`EnergyFormIntegrator.step_time`; guards and events are
-    handled by the shared fixed-step machinery (events located by
-    re-stepping). Only for :class:`RigidMachineSystem` models.
-
-    Parameters
-    ----------
-    settings : SolverSettings
-        ``max_step`` is used; the refinement tolerance is 1e-12 (relative),
-        near round-off, which costs 2-4 corrections per step.
-    refinements : int or None
-        0 for the first-order variant, None for refinement to tolerance.
-    """
-
-    def __init__(self, settings: SolverSettings, refinements: int | None) -> None:
-        super().__init__(settings)
-        self.integrator = EnergyFormIntegrator(refinements)
-        self.fallbacks = 0
-
-    def _step(self, system: RigidMachineSystem, t: float, x: np.ndarray, h: float) -> np.ndarray:
-        machine = system.machine(t, x)
-        if machine is None:
-            return np.array(x, dtype=float)
-        before = self.integrator.torque_evaluations
-        result = self.integrator.step_time(machine, t, float(x[0]), float(x[1]), h)
-        self.rhs_calls += self.integrator.torque_evaluations - before
-        self.fallbacks += result.form == "time"
-        dissipated, external = system.book(result.work)
-        return np.array([result.phi, result.omega, x[2] + dissipated, x[3] + external])
-
-
-ENERGY_SOLVERS = MappingProxyType({"energy": None, "energy1": 0})
-"""Solver names of paper 004's integrator -> refinements (None: to tolerance)."""
-
-
-def make_energy_solver(settings: SolverSettings) -> EnergyFormSolver:
-    """An :class:`EnergyFormSolver` for ``settings.method`` in :data:`ENERGY_SOLVERS`."""
-    try:
-        refinements = ENERGY_SOLVERS[settings.method]
-    except KeyError:
-        raise ValueError(
-            f"solver {settings.method!r} is not an energy-form solver; choose one of "
-            f"{sorted(ENERGY_SOLVERS)}"
-        ) from None
-    return EnergyFormSolver(settings, refinements)

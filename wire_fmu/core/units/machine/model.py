@@ -24,8 +24,8 @@ eq. 6), ``a`` an input (``motor.command``), ``b`` a parameter.
 
 :class:`MachineDriveModel` is both a :class:`~wire_fmu.core.framework.hybrid.HybridSystem`
 (for the reference integrators) and a
-:class:`~wire_fmu.core.framework.energy_integrator.RigidMachineSystem` (for paper 004's
-energy-form integrator, :class:`~wire_fmu.core.framework.energy_integrator.EnergyFormSolver`),
+:class:`~wire_fmu.core.framework.energy_solver.RigidMachineSystem` (for paper 004's
+energy-form integrator, :class:`~wire_fmu.core.framework.energy_solver.EnergyFormSolver`),
 so the same machine is solved both ways.
 
 Modules
@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wire_fmu.core.framework.energy_integrator import MachineUnit, StepWork
+from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 from wire_fmu.core.units.machine.spec import MachineSpec
 
 __all__ = ["MachineDriveModel"]

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from wire_fmu.core.framework.energy_integrator import MachineUnit
+from wire_fmu.core.framework.machine_unit import MachineUnit
 from wire_fmu.core.units.machine.laws import (
     CrankSliderInertia,
     FourierInertia,

@@ -40,10 +40,7 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.framework.energy_integrator import (
-    ENERGY_SOLVERS,
-    make_energy_solver,
-)
+from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import make_solver
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings

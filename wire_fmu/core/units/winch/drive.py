@@ -12,13 +12,9 @@ from contextlib import contextmanager
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
-from wire_fmu.core.framework.energy_integrator import (
-    ENERGY_SOLVERS,
-    MachineUnit,
-    StepWork,
-    make_energy_solver,
-)
+from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
 from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLDING, BRAKE_SLIPPING
 

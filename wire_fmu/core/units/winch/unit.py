@@ -49,7 +49,7 @@ import numpy as np
 from wire_fmu.core.components.drive_train import DriveChain, default_drive_train, parse_drive_train
 from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.framework.energy_integrator import ENERGY_SOLVERS
+from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
 from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.report_outputs import ReportOutputs
