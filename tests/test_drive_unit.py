@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from wire_fmu.core.components.drive_train import DriveChain
-from wire_fmu.core.components.drive_tree import (
-    DriveTree,
+from wire_fmu.core.components.drive_data import (
     default_multimass_drive,
     parse_drive,
     two_motor_drive,
 )
+from wire_fmu.core.components.drive_train import DriveChain
+from wire_fmu.core.components.drive_tree import DriveTree
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.unit import Causality
 from wire_fmu.core.units.multimass_drive.unit import DriveUnit

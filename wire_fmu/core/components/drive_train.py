@@ -130,7 +130,21 @@ class DriveChain:
     def from_elements(
         cls, masses: Sequence[ChainElement], shafts: Sequence[ChainElement]
     ) -> DriveChain:
-        """Reduce masses and shafts (own units, own ratios) to the drum shaft."""
+        """Reduce masses and shafts (own units, own ratios) to the drum shaft.
+
+        Parameters
+        ----------
+        masses : sequence of ChainElement
+            The masses from the motor rotor to the drum, each in its own units
+            with its speed ratio to the drum.
+        shafts : sequence of ChainElement
+            The shafts between consecutive masses, likewise.
+
+        Returns
+        -------
+        DriveChain
+            Inertias, dampings and stiffnesses reduced to the drum shaft.
+        """
         return cls(
             tuple(m.reduced_value for m in masses),
             tuple(m.reduced_damping for m in masses),
@@ -190,6 +204,11 @@ class DriveChain:
         Interior masses are eliminated smallest inertia first (they carry
         the highest frequencies); motor and drum are never eliminated.
         ``masses = 1`` gives :meth:`rigid`.
+
+        Parameters
+        ----------
+        masses : int
+            Masses to keep, 0 (all) or 1 .. ``n``.
         """
         if masses == 0 or masses >= self.n:
             return self
@@ -232,11 +251,27 @@ class DriveChain:
         return np.sqrt(np.clip(eig, 0.0, None))
 
     def mass_impedance(self, k: int, omega: complex) -> complex:
-        """``Z_k = J_k p + beta_k`` at ``p = j omega``, N m s/rad."""
+        """``Z_k = J_k p + beta_k`` at ``p = j omega``, N m s/rad.
+
+        Parameters
+        ----------
+        k : int
+            The mass.
+        omega : float
+            Angular frequency, rad/s.
+        """
         return self.inertias[k] * 1j * omega + self.dampings[k]
 
     def link_impedance(self, k: int, omega: complex) -> complex:
-        """``Z_k,k+1 = c/p + beta`` at ``p = j omega``, N m s/rad."""
+        """``Z_k,k+1 = c/p + beta`` at ``p = j omega``, N m s/rad.
+
+        Parameters
+        ----------
+        k : int
+            The shaft between masses ``k`` and ``k + 1``.
+        omega : float
+            Angular frequency, rad/s.
+        """
         return self.stiffnesses[k] / (1j * omega) + self.link_dampings[k]
 
     def input_impedance(self, omega: float) -> complex:
@@ -246,6 +281,11 @@ class DriveChain:
         (Z_link + Z_next)``; for two masses this is paper 002's
         ``(Z1 Z2 + Z1 Z12 + Z12 Z2) / (Z2 + Z12)``. ``1 / Z_in`` is the
         frequency response from motor torque to motor speed.
+
+        Parameters
+        ----------
+        omega : float
+            Angular frequency, rad/s.
         """
         z = self.mass_impedance(self.n - 1, omega)
         for k in range(self.n - 2, -1, -1):
@@ -254,7 +294,13 @@ class DriveChain:
         return z
 
     def output_impedance(self, omega: float) -> complex:
-        """``Z_out(j omega) = M_c / w_n`` with no motor torque, N m s/rad (reduced)."""
+        """``Z_out(j omega) = M_c / w_n`` with no motor torque, N m s/rad (reduced).
+
+        Parameters
+        ----------
+        omega : float
+            Angular frequency, rad/s.
+        """
         z = self.mass_impedance(0, omega)
         for k in range(1, self.n):
             link = self.link_impedance(k - 1, omega)
@@ -266,6 +312,16 @@ class DriveChain:
 
         Solves ``(j omega M + B + K / (j omega)) w = e_0`` directly; entry 0
         is ``1 / Z_in``, the last the transfer to the drum.
+
+        Parameters
+        ----------
+        omega : float
+            Angular frequency, rad/s.
+
+        Returns
+        -------
+        ndarray of complex, shape (n,)
+            Speed of each mass per N m of motor torque, rad/s/(N m).
         """
         p = 1j * omega
         system = p * self.mass_matrix() + self.damping_matrix() + self.stiffness_matrix() / p

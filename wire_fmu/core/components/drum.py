@@ -80,7 +80,13 @@ class Drum:
         return 2.0 * math.pi * self.wraps_per_layer
 
     def layer_radius(self, k: int) -> float:
-        """Winding radius of layer ``k`` (0-based), m."""
+        """Winding radius of layer ``k`` (0-based), m.
+
+        Parameters
+        ----------
+        k : int
+            The layer, 0 on the barrel.
+        """
         return self.radius + k * self.rope_diameter if self.layered else self.radius
 
     def capacity(self) -> float:
@@ -92,7 +98,13 @@ class Drum:
         return sum(self.layer_angle * self.layer_radius(j) ** power for j in range(k))
 
     def wound_angle(self, length: float) -> float:
-        """Wound angle holding ``length`` metres of rope, rad."""
+        """Wound angle holding ``length`` metres of rope, rad.
+
+        Parameters
+        ----------
+        length : float
+            Rope on the drum, m.
+        """
         k = 0
         while k < self.max_layers - 1 and length > self._below(k + 1, 1):
             k += 1
@@ -120,6 +132,11 @@ class Drum:
 
         Below ``low`` the rope winds onto layer ``k + 1``; above ``high`` it
         pays out from layer ``k - 1``. Infinite without layers.
+
+        Parameters
+        ----------
+        k : int
+            The layer, 0 on the barrel.
         """
         if not self.layered:
             return -math.inf, math.inf
@@ -153,21 +170,43 @@ class Drum:
         return tuple(zip(p, radii, q, slopes, strict=True))
 
     def payout(self, phi: float, k: int) -> float:
-        """Rope paid out at drum angle ``phi`` while on layer ``k``, m (0 at ``phi = 0``)."""
+        """Rope paid out at drum angle ``phi`` while on layer ``k``, m (0 at ``phi = 0``).
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle since the start, rad (positive paying out).
+        k : int
+            The layer the rope leaves from.
+        """
         if not self.layered:
             return self.radius * phi
         offset, radius, _, _ = self._lines[k]
         return offset + radius * phi
 
     def rope_inertia(self, phi: float, k: int) -> float:
-        """Inertia of the rope on the drum at ``phi`` on layer ``k``, kg m^2."""
+        """Inertia of the rope on the drum at ``phi`` on layer ``k``, kg m^2.
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle since the start, rad.
+        k : int
+            The outer layer.
+        """
         if not self.layered:
             return 0.0
         _, _, offset, slope = self._lines[k]
         return offset + slope * phi
 
     def rope_inertia_slope(self, k: int) -> float:
-        """``dI/dphi`` of the rope on layer ``k``, kg m^2/rad (<= 0: paying out unwinds)."""
+        """``dI/dphi`` of the rope on layer ``k``, kg m^2/rad (<= 0: paying out unwinds).
+
+        Parameters
+        ----------
+        k : int
+            The outer layer.
+        """
         if not self.layered:
             return 0.0
         return self._lines[k][3]

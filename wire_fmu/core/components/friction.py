@@ -96,13 +96,27 @@ class StickSlip:
         return [int(m) for m in self.mode]
 
     def set_mode(self, mode: list[int]) -> None:
-        """Restore modes saved by :meth:`get_mode`."""
+        """Restore modes saved by :meth:`get_mode`.
+
+        Parameters
+        ----------
+        mode : list of int
+            Per link: 0 stuck, +1 or -1 the sliding direction.
+        """
         self.mode = np.array(mode, dtype=int)
         self._plan = None
 
     # -- dynamics --------------------------------------------------------------
     def relative_velocity(self, v: np.ndarray, k: int) -> float:
-        """Relative velocity of link ``k``, m/s (or rad/s)."""
+        """Relative velocity of link ``k``, m/s (or rad/s).
+
+        Parameters
+        ----------
+        v : ndarray
+            Velocities of the bodies, m/s (or rad/s).
+        k : int
+            The link.
+        """
         link = self.links[k]
         rel = v[link.body]
         if link.other != GROUND:
@@ -179,7 +193,18 @@ class StickSlip:
         return total
 
     def guards(self, v: np.ndarray, link_force: np.ndarray, capacities: np.ndarray) -> np.ndarray:
-        """Guard values per link (see module docstring); all >= 0 inside the mode."""
+        """Guard values per link (see module docstring); all >= 0 inside the mode.
+
+        Parameters
+        ----------
+        v : ndarray
+            Velocities of the bodies, m/s (or rad/s).
+        link_force : ndarray
+            Force (N, or torque N m) each link transmits in its mode.
+        capacities : ndarray, shape (n_links,) or (n_links, 2)
+            Friction capacity of each link, N (or N m); two columns for
+            capacities against positive and negative motion.
+        """
         caps = _by_direction(capacities)
         g = np.empty(len(self.links))
         for k in range(len(self.links)):
@@ -202,6 +227,23 @@ class StickSlip:
         (momentum conserving) and sticks if it can hold; a stuck link that
         cannot hold starts sliding in the direction the net force drives it.
         The modes of all links are then made consistent with each other.
+
+        Parameters
+        ----------
+        v : ndarray
+            Velocities of the bodies, m/s (or rad/s).
+        forces : ndarray
+            All forces on the bodies but the links' friction, N (or N m).
+        capacities : ndarray, shape (n_links,) or (n_links, 2)
+            Friction capacity of each link, N (or N m); two columns for
+            capacities against positive and negative motion.
+        fired : list of int
+            Links whose guard fired.
+
+        Returns
+        -------
+        ndarray
+            The velocities with stuck links at zero relative velocity.
         """
         v = np.array(v, dtype=float)
         for k in fired:

@@ -85,19 +85,45 @@ class PolytropicGas:
         return self.reference_pressure * self.reference_volume
 
     def pressure(self, volume: float) -> float:
-        """Absolute pressure at ``volume`` (m^3), Pa."""
+        """Absolute pressure at ``volume`` (m^3), Pa.
+
+        Parameters
+        ----------
+        volume : float
+            Gas volume, m^3.
+        """
         return self.reference_pressure * (self.reference_volume / volume) ** self.exponent
 
     def volume(self, pressure: float) -> float:
-        """Volume at absolute ``pressure`` (Pa), m^3."""
+        """Volume at absolute ``pressure`` (Pa), m^3.
+
+        Parameters
+        ----------
+        pressure : float
+            Absolute gas pressure, Pa.
+        """
         return self.reference_volume * (self.reference_pressure / pressure) ** (1.0 / self.exponent)
 
     def compliance(self, volume: float) -> float:
-        """``-dV/dp = V / (n p)`` at ``volume``, m^3/Pa."""
+        """``-dV/dp = V / (n p)`` at ``volume``, m^3/Pa.
+
+        Parameters
+        ----------
+        volume : float
+            Gas volume, m^3.
+        """
         return volume / (self.exponent * self.pressure(volume))
 
     def stiffness(self, volume: float, area: float) -> float:
-        """Spring rate ``n p A^2 / V`` seen through a piston of ``area`` (m^2), N/m."""
+        """Spring rate ``n p A^2 / V`` seen through a piston of ``area`` (m^2), N/m.
+
+        Parameters
+        ----------
+        volume : float
+            Gas volume, m^3.
+        area : float
+            Piston area, m^2.
+        """
         return self.exponent * self.pressure(volume) * area * area / volume
 
     def energy(self, volume: float) -> float:
@@ -106,6 +132,11 @@ class PolytropicGas:
         Written as ``p0 V0 expm1((n-1) ln(V0/V)) / (n-1)``, which is exact
         for every ``n`` and tends to the isothermal ``p0 V0 ln(V0/V)`` as
         ``n -> 1`` without cancellation.
+
+        Parameters
+        ----------
+        volume : float
+            Gas volume, m^3.
         """
         log_ratio = math.log(self.reference_volume / volume)
         m = self.exponent - 1.0
@@ -114,7 +145,13 @@ class PolytropicGas:
         return self.constant * math.expm1(m * log_ratio) / m
 
     def work_on_gas(self, volume_from: float, volume_to: float) -> float:
-        """Work done *on* the gas from ``volume_from`` to ``volume_to`` (m^3), J."""
+        """Work done *on* the gas from ``volume_from`` to ``volume_to`` (m^3), J.
+
+        Parameters
+        ----------
+        volume_from, volume_to : float
+            Gas volume before and after, m^3.
+        """
         return self.energy(volume_to) - self.energy(volume_from)
 
 

@@ -118,11 +118,23 @@ class HydraulicLine:
         return self.laminar_resistance / r_t if r_t > 0.0 else math.inf
 
     def reynolds(self, flow: float) -> float:
-        """Reynolds number ``rho |q| d / (mu A)`` at ``flow`` (m^3/s), 1."""
+        """Reynolds number ``rho |q| d / (mu A)`` at ``flow`` (m^3/s), 1.
+
+        Parameters
+        ----------
+        flow : float
+            Volume flow through the line, m^3/s.
+        """
         return self.density * abs(flow) * self.diameter / (self.viscosity * self.area)
 
     def pressure_drop(self, flow: float) -> float:
-        """``R_l q + R_t q |q|`` at ``flow`` (m^3/s), Pa (same sign as the flow)."""
+        """``R_l q + R_t q |q|`` at ``flow`` (m^3/s), Pa (same sign as the flow).
+
+        Parameters
+        ----------
+        flow : float
+            Volume flow through the line, m^3/s.
+        """
         return (self.laminar_resistance + self.turbulent_resistance * abs(flow)) * flow
 
     def flow(self, pressure_drop: float) -> float:
@@ -130,6 +142,11 @@ class HydraulicLine:
 
         ``q = 2 dp / (R_l + sqrt(R_l^2 + 4 R_t |dp|))``, the rationalised root
         of the quadratic (no cancellation when either term is small).
+
+        Parameters
+        ----------
+        pressure_drop : float
+            Pressure drop along the line, Pa.
 
         Raises
         ------

@@ -190,7 +190,13 @@ def rope_forces(
 
 
 def taut_guard(forces: RopeForces) -> np.ndarray:
-    """Positive while a taut spring stays taut; crosses zero when it goes slack, N."""
+    """Positive while a taut spring stays taut; crosses zero when it goes slack, N.
+
+    Parameters
+    ----------
+    forces : RopeForces
+        The springs' forces at the state (:func:`rope_forces`).
+    """
     return forces.trial_tension
 
 
@@ -199,6 +205,11 @@ def slack_guard(forces: RopeForces) -> np.ndarray:
 
     A spring engages when it is stretched *and* the damper would not pull it
     apart, i.e. when both ``EA eps`` and the trial tension are positive.
+
+    Parameters
+    ----------
+    forces : RopeForces
+        The springs' forces at the state (:func:`rope_forces`).
     """
     return np.maximum(-forces.elastic_tension, -forces.trial_tension)
 
@@ -208,6 +219,22 @@ def snap_load(mass: float, stiffness: float, speed: float, gravity: float = 9.81
 
     Closed form ``T_max = m g (1 + sqrt(1 + k v0^2 / (m g^2)))`` (SPEC section 17)
     for a linear spring of stiffness ``k`` (N/m) engaged at zero stretch.
+
+    Parameters
+    ----------
+    mass : float
+        The falling mass, kg.
+    stiffness : float
+        Rope stiffness ``k``, N/m.
+    speed : float
+        Speed of the mass when the rope engages, m/s.
+    gravity : float, optional
+        Gravitational acceleration, m/s^2.
+
+    Returns
+    -------
+    float
+        Peak rope tension, N.
     """
     weight = mass * gravity
     return weight * (1.0 + math.sqrt(1.0 + stiffness * speed**2 / (mass * gravity**2)))

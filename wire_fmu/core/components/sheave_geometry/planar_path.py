@@ -63,7 +63,13 @@ class PlanarFrame:
     names: tuple[str, ...]
 
     def project(self, point: Sequence[float]) -> tuple[float, float]:
-        """Plane coordinates (x, y) of a 3-D point, m."""
+        """Plane coordinates (x, y) of a 3-D point, m.
+
+        Parameters
+        ----------
+        point : sequence of 3 float
+            A point in 3-D, m.
+        """
         rel = _sub(_vec(point), self.origin)
         return _dot(rel, self.u), _dot(rel, self.v)
 

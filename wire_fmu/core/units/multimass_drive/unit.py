@@ -26,7 +26,7 @@ Ports
 
 Parameters
 ----------
-``drive`` (JSON, :func:`~wire_fmu.core.components.drive_tree.parse_drive`) and
+``drive`` (JSON, :func:`~wire_fmu.core.components.drive_data.parse_drive`) and
 ``masses_kept``: a chain may be reduced to fewer masses by paper 002's
 delta-star elimination (:meth:`~wire_fmu.core.components.drive_train.DriveChain.reduced`,
 interior masses smallest first; motor and load are kept). ``mode_k``
@@ -48,7 +48,8 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.components.drive_tree import DriveTree, default_multimass_drive, parse_drive
+from wire_fmu.core.components.drive_data import default_multimass_drive, parse_drive
+from wire_fmu.core.components.drive_tree import DriveTree
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.ports import PortSide, port
