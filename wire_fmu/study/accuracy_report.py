@@ -12,7 +12,7 @@ import numpy as np
 from .measures import MONOLITHIC_RADAU, RunRow
 from .orders import ASYMPTOTIC_LIMIT, DOMINANCE, EqualErrorRow, OrderRow, _families
 from .plan import StudySettings
-from .tables import dumps, write_csv
+from .tables import write_tables
 
 __all__ = [
     "AccuracyStudy",
@@ -351,24 +351,16 @@ def write_accuracy_files(study: AccuracyStudy, directory: Path) -> dict[str, Pat
     directory : Path
         Folder for the files (created).
     """
-    directory.mkdir(parents=True, exist_ok=True)
-    files = {"csv": write_csv(study.rows, directory / "accuracy.csv")}
-    files["md"] = directory / "accuracy.md"
-    files["md"].write_text(accuracy_markdown(study))
-    files["json"] = directory / "accuracy.json"
-    files["json"].write_text(
-        dumps(
-            {
-                "scene": study.scene,
-                "settings": study.settings,
-                "elapsed_s": study.elapsed,
-                "reference_wall_per_sim_s": study.reference_wall_per_sim_s,
-                "orders": study.orders,
-                "equal_error": study.comparison,
-                "runs": study.rows,
-            }
-        )
-    )
+    data = {
+        "scene": study.scene,
+        "settings": study.settings,
+        "elapsed_s": study.elapsed,
+        "reference_wall_per_sim_s": study.reference_wall_per_sim_s,
+        "orders": study.orders,
+        "equal_error": study.comparison,
+        "runs": study.rows,
+    }
+    files = write_tables(directory, "accuracy", study.rows, accuracy_markdown(study), data)
     files["work_precision"] = plot_work_precision(study, directory / "work_precision.png")
     files["convergence"] = plot_convergence(study, directory / "convergence.png")
     return files

@@ -41,7 +41,7 @@ from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 from .measures import one_line, output_error
 from .plan import StudyError, StudyOptions, StudySettings
-from .tables import dumps, write_csv
+from .tables import write_tables
 from .timing import StudyProgress, TimedRun, fastest_run, pinned
 
 __all__ = [
@@ -436,12 +436,7 @@ def write_effects_files(study: EffectsStudy, directory: Path) -> dict[str, Path]
     directory : Path
         Folder for the files (created).
     """
-    directory.mkdir(parents=True, exist_ok=True)
-    files = {"csv": write_csv(study.rows, directory / "effects.csv")}
-    files["md"] = directory / "effects.md"
-    files["md"].write_text(effects_markdown(study))
-    files["json"] = directory / "effects.json"
-    files["json"].write_text(dumps(study))
+    files = write_tables(directory, "effects", study.rows, effects_markdown(study), study)
     files["png"] = plot_effects(study, directory / "effects.png")
     return files
 

@@ -12,7 +12,7 @@ from typing import Any
 
 from wire_fmu.master.scene import VarRef
 
-__all__ = ["write_csv", "to_json", "dumps"]
+__all__ = ["write_csv", "to_json", "dumps", "write_tables"]
 
 
 def write_csv(rows: Sequence[Any], path: Path) -> Path:
@@ -76,3 +76,35 @@ def dumps(value: Any) -> str:
         Anything :func:`to_json` takes.
     """
     return json.dumps(to_json(value), indent=2)
+
+
+def write_tables(
+    directory: Path, stem: str, rows: Sequence[Any], markdown: str, data: Any
+) -> dict[str, Path]:
+    """Write a study's table, summary and JSON into ``directory``; their paths by kind.
+
+    Parameters
+    ----------
+    directory : Path
+        Folder for the files (created).
+    stem : str
+        File name stem: ``<stem>.csv``, ``<stem>.md`` and ``<stem>.json``.
+    rows : sequence of dataclass instances
+        The table (see :func:`write_csv`).
+    markdown : str
+        The summary.
+    data : object
+        What the JSON holds (see :func:`to_json`).
+
+    Returns
+    -------
+    dict of str to Path
+        ``"csv"``, ``"md"`` and ``"json"``.
+    """
+    directory.mkdir(parents=True, exist_ok=True)
+    files = {"csv": write_csv(rows, directory / f"{stem}.csv")}
+    files["md"] = directory / f"{stem}.md"
+    files["md"].write_text(markdown)
+    files["json"] = directory / f"{stem}.json"
+    files["json"].write_text(dumps(data))
+    return files
