@@ -49,7 +49,13 @@ class EffectCatalogue:
         return tuple(e.name for e in self.effects)
 
     def problems(self, requested: Iterable[str]) -> list[str]:
-        """Every problem with a requested set of effects."""
+        """Every problem with a requested set of effects.
+
+        Parameters
+        ----------
+        requested : iterable of str
+            Effect names.
+        """
         requested = list(requested)
         by_name = {e.name: e for e in self.effects}
         out = []
@@ -71,7 +77,13 @@ class EffectCatalogue:
         return out
 
     def parse(self, text: str | Iterable[str]) -> tuple[frozenset[str], list[str]]:
-        """Parse a comma- or space-separated list; return (effects, problems)."""
+        """Parse a comma- or space-separated list; return (effects, problems).
+
+        Parameters
+        ----------
+        text : str or iterable of str
+            Effect names, comma or space separated in a string.
+        """
         if isinstance(text, str):
             names = [n.strip() for n in text.replace(",", " ").split()]
         else:

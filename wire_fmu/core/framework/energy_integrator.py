@@ -148,6 +148,19 @@ class EnergyFormIntegrator:
     ) -> EnergyStep:
         """One step of angle ``dphi`` (the paper's own form; ``dphi`` has the sign of omega).
 
+        Parameters
+        ----------
+        machine : MachineUnit
+            The machine unit of the step.
+        t : float
+            Time at the start of the step, s.
+        phi : float
+            Shaft angle at the start, rad.
+        omega : float
+            Shaft speed at the start, rad/s.
+        dphi : float
+            Angle step, rad.
+
         Raises
         ------
         EnergyFormBreakdownError
@@ -160,6 +173,13 @@ class EnergyFormIntegrator:
             )
 
         def kinematics(omega1: float | None) -> tuple[float, float]:
+            """Angle step (rad) and end time (s): by (13), or by (16) given ``omega1``.
+
+            Parameters
+            ----------
+            omega1 : float or None
+                Speed at the end of the step, rad/s (None for the first-order step).
+            """
             if omega1 is None:
                 return dphi, t + dphi / omega  # (13)
             return dphi, t + 2.0 * dphi / (omega + omega1)  # (16), corrected
@@ -174,10 +194,26 @@ class EnergyFormIntegrator:
         First order: ``dphi = omega_i dt``; refined: ``dphi = (omega_i +
         omega_{i+1}) dt / 2``, iterated with the speed. Falls back to the
         time form near ``omega = 0`` (module docstring).
+
+        Parameters
+        ----------
+        machine : MachineUnit
+            The machine unit of the step.
+        t, phi, omega : float
+            Time (s), shaft angle (rad) and shaft speed (rad/s) at the start.
+        dt : float
+            Time step, s.
         """
         if omega != 0.0:
 
             def kinematics(omega1: float | None) -> tuple[float, float]:
+                """Angle step (rad) and end time (s) of the time step ``dt``.
+
+                Parameters
+                ----------
+                omega1 : float or None
+                    Speed at the end of the step, rad/s (None for the first-order step).
+                """
                 if omega1 is None:
                     return omega * dt, t + dt
                 return 0.5 * (omega + omega1) * dt, t + dt

@@ -30,11 +30,25 @@ class RigidMachineSystem(Protocol):
     """
 
     def machine(self, t: float, x: np.ndarray) -> MachineUnit | None:
-        """The machine unit of the current mode; None while it is held at rest."""
+        """The machine unit of the current mode; None while it is held at rest.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model.
+        """
         ...
 
     def book(self, work: StepWork) -> tuple[float, float]:
-        """Split a step's works into (dissipated, external work), J."""
+        """Split a step's works into (dissipated, external work), J.
+
+        Parameters
+        ----------
+        work : StepWork
+            The works of the step, J.
+        """
         ...
 
 
@@ -77,7 +91,18 @@ ENERGY_SOLVERS = MappingProxyType({"energy": None, "energy1": 0})
 
 
 def make_energy_solver(settings: SolverSettings) -> EnergyFormSolver:
-    """An :class:`EnergyFormSolver` for ``settings.method`` in :data:`ENERGY_SOLVERS`."""
+    """An :class:`EnergyFormSolver` for ``settings.method`` in :data:`ENERGY_SOLVERS`.
+
+    Parameters
+    ----------
+    settings : SolverSettings
+        ``method`` one of :data:`ENERGY_SOLVERS`; ``max_step`` is used.
+
+    Raises
+    ------
+    ValueError
+        If the method is not an energy-form solver.
+    """
     try:
         refinements = ENERGY_SOLVERS[settings.method]
     except KeyError:

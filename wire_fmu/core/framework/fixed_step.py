@@ -53,7 +53,19 @@ class FixedStepSolver:
     def advance(
         self, system: HybridSystem, t0: float, x0: np.ndarray, t1: float
     ) -> tuple[np.ndarray, int]:
-        """Integrate from ``t0`` to ``t1``; return the state and the number of events."""
+        """Integrate from ``t0`` to ``t1``; return the state and the number of events.
+
+        Parameters
+        ----------
+        system : HybridSystem
+            The model.
+        t0 : float
+            Start time, s.
+        x0 : ndarray
+            State at ``t0``.
+        t1 : float
+            End time, s.
+        """
         n = max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
         t, x = t0, np.array(x0, dtype=float)
         events = 0
@@ -201,7 +213,22 @@ class ROS2(FixedStepSolver):
 
 
 def finite_difference_jacobian(system: HybridSystem, t: float, x: np.ndarray) -> np.ndarray:
-    """Forward-difference Jacobian of the current mode's right-hand side."""
+    """Forward-difference Jacobian of the current mode's right-hand side.
+
+    Parameters
+    ----------
+    system : HybridSystem
+        The model, in its current mode.
+    t : float
+        Time, s.
+    x : ndarray
+        Continuous state of the model.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        ``d rhs / d x`` at ``(t, x)``.
+    """
     n = x.size
     jac = np.zeros((n, n))
     if n == 0:

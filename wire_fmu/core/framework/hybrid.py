@@ -45,6 +45,7 @@ from wire_fmu.core.framework.step_limits import IntegrationError
 
 __all__ = [
     "HybridSystem",
+    "SmoothSystem",
     "SolverSettings",
     "IntegrationError",
     "SOLVERS",
@@ -62,11 +63,27 @@ class HybridSystem(Protocol):
     """
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Time derivative of the state in the current mode."""
+        """Time derivative of the state in the current mode.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model.
+        """
         ...
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Guard function values in the current mode."""
+        """Guard function values in the current mode.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model.
+        """
         ...
 
     def guard_directions(self) -> np.ndarray:
@@ -74,12 +91,75 @@ class HybridSystem(Protocol):
         ...
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Switch mode after the guards ``fired``; return the (projected) state."""
+        """Switch mode after the guards ``fired``; return the (projected) state.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model.
+        fired : list of int
+            Indices of the guards that crossed.
+        """
         ...
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """Enforce the current mode's algebraic invariants on ``x`` (exactly)."""
+        """Enforce the current mode's algebraic invariants on ``x`` (exactly).
+
+        Parameters
+        ----------
+        x : ndarray
+            Continuous state, changed in place and returned.
+        """
         ...
+
+
+class SmoothSystem:
+    """Base of a :class:`HybridSystem` with one mode: no guards, no events, no invariants.
+
+    A subclass gives :meth:`HybridSystem.rhs`; the rest of the protocol is here.
+    """
+
+    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
+        """None: the system has no modes.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model.
+        """
+        return np.zeros(0)
+
+    def guard_directions(self) -> np.ndarray:
+        """None."""
+        return np.zeros(0)
+
+    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
+        """Never called: without guards nothing fires.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            Continuous state of the model, returned as it is.
+        fired : list of int
+            Indices of the guards that crossed (none).
+        """
+        return x
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """No invariants: ``x`` as it is.
+
+        Parameters
+        ----------
+        x : ndarray
+            Continuous state of the model.
+        """
+        return x
 
 
 @dataclass(frozen=True)
@@ -110,6 +190,11 @@ class SolverSettings:
 
         ``known`` adds method names a unit offers beyond :data:`SOLVERS`
         (paper 004's energy-form integrator in the winch and the machine unit).
+
+        Parameters
+        ----------
+        known : collection of str, optional
+            Further method names the unit accepts.
         """
         out = []
         names = set(SOLVERS) | set(known)
@@ -130,7 +215,17 @@ axis and 2.83 on the imaginary axis), with a margin."""
 
 
 def fastest_mode(system: HybridSystem, t: float, x: np.ndarray) -> float:
-    """Largest ``|lambda|`` (1/s) of the system's Jacobian at ``(t, x)`` (finite differences)."""
+    """Largest ``|lambda|`` (1/s) of the system's Jacobian at ``(t, x)`` (finite differences).
+
+    Parameters
+    ----------
+    system : HybridSystem
+        The model, in its current mode.
+    t : float
+        Time, s.
+    x : ndarray
+        Continuous state of the model.
+    """
     if x.size == 0:
         return 0.0
     return float(np.max(np.abs(np.linalg.eigvals(finite_difference_jacobian(system, t, x)))))
@@ -148,7 +243,13 @@ SOLVERS = {
 
 
 def make_solver(settings: SolverSettings):
-    """A fresh solver object for ``settings`` (raises ValueError if unknown)."""
+    """A fresh solver object for ``settings`` (raises ValueError if unknown).
+
+    Parameters
+    ----------
+    settings : SolverSettings
+        ``method`` one of :data:`SOLVERS`.
+    """
     try:
         factory = SOLVERS[settings.method]
     except KeyError:

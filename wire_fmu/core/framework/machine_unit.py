@@ -54,19 +54,43 @@ class MachineUnit:
     resistance_time: Callable[[float], float] = _zero
 
     def driving_torque(self, omega: float) -> float:
-        """``M_d = a - b omega`` (eq. 6), N m."""
+        """``M_d = a - b omega`` (eq. 6), N m.
+
+        Parameters
+        ----------
+        omega : float
+            Shaft speed, rad/s.
+        """
         return self.a - self.b * omega
 
     def speed_torque(self, omega: float) -> float:
-        """Net speed-dependent torque ``M_d(omega) - M_c(omega)``, N m."""
+        """Net speed-dependent torque ``M_d(omega) - M_c(omega)``, N m.
+
+        Parameters
+        ----------
+        omega : float
+            Shaft speed, rad/s.
+        """
         return self.a - self.b * omega - self.resistance_speed(omega)
 
     def speed_torque_slope(self, omega: float) -> float:
-        """``d(M_d - M_c(omega))/domega``, N m s/rad (the paper's ``k - b``)."""
+        """``d(M_d - M_c(omega))/domega``, N m s/rad (the paper's ``k - b``).
+
+        Parameters
+        ----------
+        omega : float
+            Shaft speed, rad/s.
+        """
         return -self.b - self.resistance_speed_slope(omega)
 
     def angle_work(self, phi0: float, phi1: float) -> float:
-        """Work absorbed by ``M_c(phi)`` from ``phi0`` to ``phi1``, J."""
+        """Work absorbed by ``M_c(phi)`` from ``phi0`` to ``phi1``, J.
+
+        Parameters
+        ----------
+        phi0, phi1 : float
+            Shaft angles at the start and the end, rad.
+        """
         if self.resistance_angle_work is not None:
             return self.resistance_angle_work(phi0, phi1)
         mid = self.resistance_angle(0.5 * (phi0 + phi1))
@@ -74,25 +98,69 @@ class MachineUnit:
         return (phi1 - phi0) * (ends + 4.0 * mid) / 6.0
 
     def net_torque(self, t: float, phi: float, omega: float) -> float:
-        """All torques, N m."""
+        """All torques, N m.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        phi : float
+            Shaft angle, rad.
+        omega : float
+            Shaft speed, rad/s.
+        """
         return self.speed_torque(omega) - self.resistance_angle(phi) - self.resistance_time(t)
 
     def acceleration(self, t: float, phi: float, omega: float) -> float:
-        """``omega'`` from the Lagrange equation, rad/s^2."""
+        """``omega'`` from the Lagrange equation, rad/s^2.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        phi : float
+            Shaft angle, rad.
+        omega : float
+            Shaft speed, rad/s.
+        """
         centrifugal = 0.5 * self.inertia_slope(phi) * omega * omega
         return (self.net_torque(t, phi, omega) - centrifugal) / self.inertia(phi)
 
     def rhs_time(self, t: float, y: np.ndarray) -> np.ndarray:
-        """``d[phi, omega]/dt`` (for reference solutions)."""
+        """``d[phi, omega]/dt`` (for reference solutions).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        y : ndarray, shape (2,)
+            ``[phi (rad), omega (rad/s)]``.
+        """
         return np.array([y[1], self.acceleration(t, y[0], y[1])])
 
     def rhs_angle(self, phi: float, y: np.ndarray) -> np.ndarray:
-        """``d[omega, t]/dphi`` (for reference solutions; omega must not vanish)."""
+        """``d[omega, t]/dphi`` (for reference solutions; omega must not vanish).
+
+        Parameters
+        ----------
+        phi : float
+            Shaft angle, rad.
+        y : ndarray, shape (2,)
+            ``[omega (rad/s), t (s)]``.
+        """
         omega, t = y
         return np.array([self.acceleration(t, phi, omega) / omega, 1.0 / omega])
 
     def kinetic_energy(self, phi: float, omega: float) -> float:
-        """``I(phi) omega^2 / 2``, J."""
+        """``I(phi) omega^2 / 2``, J.
+
+        Parameters
+        ----------
+        phi : float
+            Shaft angle, rad.
+        omega : float
+            Shaft speed, rad/s.
+        """
         return 0.5 * self.inertia(phi) * omega * omega
 
 

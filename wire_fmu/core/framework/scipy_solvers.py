@@ -39,6 +39,19 @@ class ScipySolver:
         self.steps = 0
 
     def advance(self, system, t0, x0, t1):
+        """Integrate from ``t0`` to ``t1``; return the state and the number of events.
+
+        Parameters
+        ----------
+        system : HybridSystem
+            The model.
+        t0 : float
+            Start time, s.
+        x0 : ndarray
+            State at ``t0``.
+        t1 : float
+            End time, s.
+        """
         internal_steps(t0, t1, self.settings.max_step)
         tol = self.settings.event_time_tolerance
         t, x = t0, np.array(x0, dtype=float)
@@ -80,6 +93,15 @@ class ScipySolver:
         cache: dict = {}
 
         def guards(t, x):
+            """The system's guards at ``(t, x)``, computed once per point for all event functions.
+
+            Parameters
+            ----------
+            t : float
+                Time, s.
+            x : ndarray
+                Continuous state of the model.
+            """
             key = (t, x.tobytes())
             if cache.get("key") != key:
                 cache["key"], cache["g"] = key, system.guards(t, x)
@@ -89,6 +111,17 @@ class ScipySolver:
         for i, direction in enumerate(directions):
 
             def event(t, x, i=i):
+                """Guard ``i`` at ``(t, x)`` for ``solve_ivp``, a zero read as ``+0``.
+
+                Parameters
+                ----------
+                t : float
+                    Time, s.
+                x : ndarray
+                    Continuous state of the model.
+                i : int
+                    The guard.
+                """
                 # our guards hold while >= 0 and fire when < 0; SciPy would also fire on
                 # a guard resting at exactly 0 (a released brake), so a zero counts as +0
                 g = guards(t, x)[i]

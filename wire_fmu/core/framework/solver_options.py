@@ -54,7 +54,16 @@ def solver_parameters(
 def solver_settings(
     values: Mapping[str, Any], also: Collection[str] = ()
 ) -> tuple[SolverSettings, list[str]]:
-    """The settings the solver parameters in ``values`` ask for, and their problems."""
+    """The settings the solver parameters in ``values`` ask for, and their problems.
+
+    Parameters
+    ----------
+    values : mapping
+        The unit's variable values, with ``solver``, ``solver_max_step``,
+        ``solver_rtol`` and ``solver_atol``.
+    also : collection of str, optional
+        Solvers the unit offers beyond :data:`~wire_fmu.core.framework.hybrid.SOLVERS`.
+    """
     settings = SolverSettings(
         str(values["solver"]),
         float(values["solver_max_step"]),

@@ -24,6 +24,13 @@ at once (its message says how long a step may be) rather than run for hours."""
 def internal_steps(t0: float, t1: float, max_step: float) -> float:
     """How many steps of at most ``max_step`` (s) span ``[t0, t1]`` (s).
 
+    Parameters
+    ----------
+    t0, t1 : float
+        Start and end of the communication step, s.
+    max_step : float
+        Largest internal step, s.
+
     Raises
     ------
     IntegrationError

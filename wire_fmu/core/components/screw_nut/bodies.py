@@ -18,7 +18,18 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def rotation_from_quaternion(q: np.ndarray) -> np.ndarray:
-    """Rotation matrix of a unit quaternion ``[w, x, y, z]`` (normalised here)."""
+    """Rotation matrix of a unit quaternion ``[w, x, y, z]`` (normalised here).
+
+    Parameters
+    ----------
+    q : array_like, shape (4,)
+        Orientation ``[w, x, y, z]``, body to world.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Rotation matrix body -> world.
+    """
     w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
     return np.array(
         [
@@ -110,7 +121,15 @@ class BodyState:
 
     @classmethod
     def at_rest(cls, position=(0.0, 0.0, 0.0), quaternion=(1.0, 0.0, 0.0, 0.0)) -> BodyState:
-        """A body at ``position`` with orientation ``quaternion``, not moving."""
+        """A body at ``position`` with orientation ``quaternion``, not moving.
+
+        Parameters
+        ----------
+        position : array_like, shape (3,), optional
+            Centre of mass, m.
+        quaternion : array_like, shape (4,), optional
+            Orientation ``[w, x, y, z]``, body to world.
+        """
         return cls(
             np.array(position, dtype=float),
             np.array(quaternion, dtype=float),
@@ -126,7 +145,13 @@ class BodyState:
 
     @classmethod
     def unpack(cls, y: np.ndarray) -> BodyState:
-        """Inverse of :meth:`pack` (copies)."""
+        """Inverse of :meth:`pack` (copies).
+
+        Parameters
+        ----------
+        y : array_like, shape (13,)
+            ``[position (m), quaternion, velocity (m/s), angular velocity (rad/s)]``.
+        """
         y = np.asarray(y, dtype=float)
         return cls(y[0:3].copy(), y[3:7].copy(), y[7:10].copy(), y[10:13].copy())
 

@@ -65,11 +65,25 @@ class ScrewNutJoint:
 
     # -- frames ---------------------------------------------------------------
     def frame(self, s1: BodyState) -> np.ndarray:
-        """Columns ``e1, e2, c`` in the world frame (they turn with body 1)."""
+        """Columns ``e1, e2, c`` in the world frame (they turn with body 1).
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        """
         return s1.rotation @ self.frame_1
 
     def relative_angle(self, s1: BodyState, s2: BodyState) -> float:
-        """Angle of the nut relative to the screw about the axis, unwrapped, rad."""
+        """Angle of the nut relative to the screw about the axis, unwrapped, rad.
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        s2 : BodyState
+            State of body 2, the nut.
+        """
         frame = self.frame(s1)
         u = s2.rotation @ self.reference_2
         wrapped = math.atan2(float(u @ frame[:, 1]), float(u @ frame[:, 0]))
@@ -82,6 +96,13 @@ class ScrewNutJoint:
 
         ``gamma`` collects the velocity-product terms of the constraints'
         time derivatives (``G`` depends on the poses).
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        s2 : BodyState
+            State of body 2, the nut.
         """
         frame = self.frame(s1)
         e1, e2, c = frame.T
@@ -118,6 +139,13 @@ class ScrewNutJoint:
 
         Their gradients coincide with the rows of :meth:`jacobian` on the
         constraint manifold (so the velocity Jacobian serves for projection).
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        s2 : BodyState
+            State of body 2, the nut.
         """
         frame = self.frame(s1)
         e1, e2, c = frame.T
@@ -129,12 +157,30 @@ class ScrewNutJoint:
         return np.array([-(e2 @ c2), e1 @ c2, e1 @ gap, e2 @ gap, c @ gap - self.h * angle])
 
     def velocity_residual(self, s1: BodyState, s2: BodyState) -> np.ndarray:
-        """``G v`` (rad/s, rad/s, m/s, m/s, m/s): the paper's velocity equations."""
+        """``G v`` (rad/s, rad/s, m/s, m/s, m/s): the paper's velocity equations.
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        s2 : BodyState
+            State of body 2, the nut.
+        """
         g, _ = self.jacobian(s1, s2)
         return g @ _velocities(s1, s2)
 
     def wrenches(self, s1: BodyState, s2: BodyState, multipliers: np.ndarray) -> dict:
         """Reaction on each body from the multipliers (``G^T lambda``), split physically.
+
+        Parameters
+        ----------
+        s1 : BodyState
+            State of body 1, the screw.
+        s2 : BodyState
+            State of body 2, the nut.
+        multipliers : array_like, shape (5,)
+            The joint's multipliers (rows of :meth:`jacobian`): two bending
+            moments (N m) and the reaction force along ``e1, e2, c`` (N).
 
         Returns
         -------

@@ -121,7 +121,13 @@ class ScrewNutSystem:
         return row, -float(_cross(states[0].angular_velocity, c) @ dw)
 
     def relative_speed(self, states: list[BodyState] | None = None) -> float:
-        """``c . (w2 - w1)``: the nut's speed relative to the screw about the axis, rad/s."""
+        """``c . (w2 - w1)``: the nut's speed relative to the screw about the axis, rad/s.
+
+        Parameters
+        ----------
+        states : list of BodyState, optional
+            Screw and nut (default: the current states).
+        """
         states = self.states if states is None else states
         row, _ = self._axis_row(states)
         return float(row @ _velocities(*states))
@@ -173,6 +179,18 @@ class ScrewNutSystem:
 
         The multipliers are the joint's five (bending moments, reaction
         force); a stuck thread's holding torque is :attr:`friction_torque`.
+
+        Parameters
+        ----------
+        states : list of BodyState
+            Screw and nut.
+
+        Returns
+        -------
+        accelerations : ndarray, shape (12,)
+            ``[a1 (m/s^2), alpha1 (rad/s^2), a2, alpha2]``.
+        multipliers : ndarray, shape (5,)
+            The joint's multipliers (N m, N m, N, N, N).
         """
         acc, lam, _ = self._solve(states, self.mode)
         return acc, lam[: ScrewNutJoint.N_CONSTRAINTS]
@@ -212,7 +230,13 @@ class ScrewNutSystem:
             self._project_velocities(self._stuck())
 
     def guard(self, states: list[BodyState] | None = None) -> float:
-        """Thread guard, >= 0 inside the mode: holding margin (N m) or ``sigma`` times speed."""
+        """Thread guard, >= 0 inside the mode: holding margin (N m) or ``sigma`` times speed.
+
+        Parameters
+        ----------
+        states : list of BodyState, optional
+            Screw and nut (default: the current states).
+        """
         states = self.states if states is None else states
         if not self.thread_friction:
             return 1.0
@@ -222,7 +246,13 @@ class ScrewNutSystem:
         return self.r_mu * abs(lam[4]) - abs(torque)
 
     def step(self, h: float) -> None:
-        """Advance ``h`` seconds: RK4, stick/slip events located, projection onto the joint."""
+        """Advance ``h`` seconds: RK4, stick/slip events located, projection onto the joint.
+
+        Parameters
+        ----------
+        h : float
+            Time step, s.
+        """
         remaining, guard = h, self.guard()
         for _ in range(1000):
             if remaining <= 0.0:

@@ -59,15 +59,33 @@ class ScrewThread:
         return self.lead / _TWO_PI
 
     def axial_travel(self, relative_angle: float) -> float:
-        """Axial travel of the nut for a relative angle (rad), m."""
+        """Axial travel of the nut for a relative angle (rad), m.
+
+        Parameters
+        ----------
+        relative_angle : float
+            Angle of the nut relative to the screw, rad.
+        """
         return self.lead_per_radian * relative_angle
 
     def lead_torque(self, axial_force: float) -> float:
-        """Torque ``M_a = h F_axial`` the axial force exerts about the axis, N m."""
+        """Torque ``M_a = h F_axial`` the axial force exerts about the axis, N m.
+
+        Parameters
+        ----------
+        axial_force : float
+            Axial force in the thread, N.
+        """
         return self.lead_per_radian * axial_force
 
     def friction_capacity(self, axial_force: float) -> float:
-        """``M1 = r_mean mu |F_axial|``, N m."""
+        """``M1 = r_mean mu |F_axial|``, N m.
+
+        Parameters
+        ----------
+        axial_force : float
+            Axial force in the thread, N.
+        """
         return self.mean_radius * self.friction * abs(axial_force)
 
     def self_locking(self) -> bool:
@@ -101,6 +119,17 @@ class ScrewThread:
         The speed at which the regularised torque balances the torque that
         drives the thread (sign: that torque's); ``inf`` when the torque
         exceeds the capacity (the thread slides).
+
+        Parameters
+        ----------
+        held_torque : float
+            Torque that drives the thread, N m.
+        axial_force : float
+            Axial force in the thread, N.
+        speed_scale : float
+            ``w1``, rad/s.
+        shape : str
+            ``"linear"`` or ``"tanh"``.
         """
         capacity = self.friction_capacity(axial_force)
         ratio = abs(held_torque) / capacity if capacity > 0.0 else math.inf

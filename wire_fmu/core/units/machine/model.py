@@ -42,13 +42,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from wire_fmu.core.framework.hybrid import SmoothSystem
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 from wire_fmu.core.units.machine.spec import MachineSpec
 
 __all__ = ["MachineDriveModel"]
 
 
-class MachineDriveModel:
+class MachineDriveModel(SmoothSystem):
     """The machine unit as a hybrid ODE and as a rigid machine for the energy form.
 
     State ``[phi, omega, dissipated, external work]`` (rad, rad/s, J, J).
@@ -82,7 +83,7 @@ class MachineDriveModel:
         """Paper 004's machine unit for the inputs now held."""
         return self._machine
 
-    # -- HybridSystem -----------------------------------------------------------
+    # -- HybridSystem (no modes: the rest is SmoothSystem's) -------------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """``[omega, omega', dissipated', external work']``."""
         m = self._machine
@@ -92,22 +93,6 @@ class MachineDriveModel:
             m.driving_torque(omega) - m.resistance_angle(phi) - m.resistance_time(t)
         ) * omega
         return np.array([omega, m.acceleration(t, phi, omega), dissipated, external])
-
-    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """None: the machine has no modes."""
-        return np.zeros(0)
-
-    def guard_directions(self) -> np.ndarray:
-        """None."""
-        return np.zeros(0)
-
-    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Never called."""
-        return x
-
-    def project(self, x: np.ndarray) -> np.ndarray:
-        """No invariants."""
-        return x
 
     # -- RigidMachineSystem -----------------------------------------------------
     def machine(self, t: float, x: np.ndarray) -> MachineUnit:

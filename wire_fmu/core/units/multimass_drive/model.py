@@ -12,12 +12,12 @@ import math
 import numpy as np
 
 from wire_fmu.core.components.drive_tree import DriveTree
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import SmoothSystem, SolverSettings, make_solver
 
 __all__ = ["DriveModel"]
 
 
-class DriveModel:
+class DriveModel(SmoothSystem):
     """The drive's linear ODE as a hybrid system without modes.
 
     State ``[theta (n), omega (n), dissipated, external work]`` (rad,
@@ -68,7 +68,7 @@ class DriveModel:
             ]
         )
 
-    # -- HybridSystem ---------------------------------------------------------
+    # -- HybridSystem (no modes: the rest is SmoothSystem's) -----------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         """``[theta', omega', dissipated', external work']``."""
         n = self.n
@@ -80,22 +80,6 @@ class DriveModel:
         out[2 * n] = float(omega @ self.damping @ omega)
         out[2 * n + 1] = float(external @ omega)
         return out
-
-    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """None: the drive has no modes."""
-        return np.zeros(0)
-
-    def guard_directions(self) -> np.ndarray:
-        """None."""
-        return np.zeros(0)
-
-    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Never called."""
-        return x
-
-    def project(self, x: np.ndarray) -> np.ndarray:
-        """No invariants."""
-        return x
 
     # -- life cycle -------------------------------------------------------------
     def initialize(self, speed: float) -> None:
