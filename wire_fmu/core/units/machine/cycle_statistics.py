@@ -49,14 +49,32 @@ class CycleStatistics:
     _turn: int = field(default=0, repr=False)
 
     def start(self, t: float, phi: float, omega: float) -> None:
-        """Begin counting at ``(t, phi, omega)``; revolutions end at multiples of ``2 pi``."""
+        """Begin counting at ``(t, phi, omega)``; revolutions end at multiples of ``2 pi``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        phi : float
+            Shaft angle, rad.
+        omega : float
+            Shaft speed, rad/s.
+        """
         self.count = 0
         self.start_time = t
         self.omega_max = self.omega_min = omega
         self._turn = math.floor(phi / _TWO_PI)
 
     def update(self, t0: float, x0: Sequence[float], t1: float, x1: Sequence[float]) -> None:
-        """Account for the step from ``(t0, x0)`` to ``(t1, x1)`` (states ``[phi, omega, ...]``)."""
+        """Account for the step from ``(t0, x0)`` to ``(t1, x1)`` (states ``[phi, omega, ...]``).
+
+        Parameters
+        ----------
+        t0, t1 : float
+            Start and end of the step, s.
+        x0, x1 : sequence of float
+            States at ``t0`` and ``t1``: angle (rad) and speed (rad/s) first.
+        """
         turn = math.floor(x1[0] / _TWO_PI)
         if turn > self._turn:  # a revolution ended within the step
             t_end = _crossing_time(t0, x0, t1, x1, turn * _TWO_PI)
@@ -92,7 +110,13 @@ class CycleStatistics:
         }
 
     def set_state(self, data: Mapping[str, Any]) -> None:
-        """Restore :meth:`get_state`."""
+        """Restore :meth:`get_state`.
+
+        Parameters
+        ----------
+        data : mapping
+            Statistics from :meth:`get_state`.
+        """
         self.count = int(data["count"])
         self.start_time = float(data["start_time"])
         self.omega_max = float(data["omega_max"])
@@ -109,6 +133,13 @@ def _crossing_time(
     p0, p1, m0, m1 = float(x0[0]), float(x1[0]), float(x0[1]) * h, float(x1[1]) * h
 
     def hermite(s: float) -> float:
+        """The interpolant minus ``level`` at the step fraction ``s``, rad.
+
+        Parameters
+        ----------
+        s : float
+            Fraction of the step, 0 to 1.
+        """
         s2, s3 = s * s, s * s * s
         return (
             (2 * s3 - 3 * s2 + 1) * p0

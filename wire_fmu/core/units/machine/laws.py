@@ -49,7 +49,13 @@ class FourierSeries:
         return total
 
     def derivative(self, x: float) -> float:
-        """``d/dx``."""
+        """``d/dx``.
+
+        Parameters
+        ----------
+        x : float
+            Where, in the series' variable (rad or s).
+        """
         w = self.rate
         total = 0.0
         for k, a in enumerate(self.cos, start=1):
@@ -59,7 +65,13 @@ class FourierSeries:
         return total
 
     def integral(self, x0: float, x1: float) -> float:
-        """``int_x0^x1`` exactly."""
+        """``int_x0^x1`` exactly.
+
+        Parameters
+        ----------
+        x0, x1 : float
+            The bounds, in the series' variable (rad or s).
+        """
         w = self.rate
         total = self.mean * (x1 - x0)
         for k, a in enumerate(self.cos, start=1):
@@ -107,7 +119,13 @@ class CrankSliderInertia:
         return self.base + self.slider_mass * x1 * x1
 
     def derivative(self, phi: float) -> float:
-        """``dI/dphi``, kg m^2/rad."""
+        """``dI/dphi``, kg m^2/rad.
+
+        Parameters
+        ----------
+        phi : float
+            Crank angle, rad.
+        """
         x1, x2 = self._slider(phi)
         return 2.0 * self.slider_mass * x1 * x2
 
@@ -134,7 +152,13 @@ class FourierInertia:
         return self.series(phi)
 
     def derivative(self, phi: float) -> float:
-        """``dI/dphi``, kg m^2/rad."""
+        """``dI/dphi``, kg m^2/rad.
+
+        Parameters
+        ----------
+        phi : float
+            Shaft angle, rad.
+        """
         return self.series.derivative(phi)
 
     def problems(self) -> list[str]:
@@ -161,7 +185,13 @@ class Polynomial:
         return total
 
     def derivative(self, x: float) -> float:
-        """``d/dx``."""
+        """``d/dx``.
+
+        Parameters
+        ----------
+        x : float
+            Where, in the polynomial's variable (rad/s for ``M_c(omega)``).
+        """
         total = 0.0
         for j in range(len(self.coefficients) - 1, 0, -1):
             total = total * x + j * self.coefficients[j]

@@ -73,7 +73,15 @@ class MachineDriveModel(SmoothSystem):
         self._machine = spec.machine(0.0, motor_slope)
 
     def set_inputs(self, command: float, load: float) -> None:
-        """Motor ``a`` (N m) and extra load torque (N m), held over a step."""
+        """Motor ``a`` (N m) and extra load torque (N m), held over a step.
+
+        Parameters
+        ----------
+        command : float
+            Motor torque at zero speed ``a``, N m.
+        load : float
+            Extra load torque, N m.
+        """
         if (command, load) != (self.command, self.load):
             self.command, self.load = command, load
             self._machine = self.spec.machine(command, self.b, load)
@@ -85,7 +93,15 @@ class MachineDriveModel(SmoothSystem):
 
     # -- HybridSystem (no modes: the rest is SmoothSystem's) -------------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``[omega, omega', dissipated', external work']``."""
+        """``[omega, omega', dissipated', external work']``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         m = self._machine
         phi, omega = float(x[0]), float(x[1])
         dissipated = m.resistance_speed(omega) * omega
@@ -96,15 +112,40 @@ class MachineDriveModel(SmoothSystem):
 
     # -- RigidMachineSystem -----------------------------------------------------
     def machine(self, t: float, x: np.ndarray) -> MachineUnit:
-        """The machine for paper 004's integrator (never held at rest)."""
+        """The machine for paper 004's integrator (never held at rest).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         return self._machine
 
     def book(self, work: StepWork) -> tuple[float, float]:
-        """``M_c(omega)`` dissipates; the motor, ``M_c(phi)`` and ``M_c(t)`` are external."""
+        """``M_c(omega)`` dissipates; the motor, ``M_c(phi)`` and ``M_c(t)`` are external.
+
+        Parameters
+        ----------
+        work : StepWork
+            The works of the step, J.
+
+        Returns
+        -------
+        tuple of float
+            (dissipated, external work), J.
+        """
         return work.speed, work.driving - work.angle - work.time
 
     # -- outputs ----------------------------------------------------------------
     def kinetic_energy(self, x: np.ndarray | None = None) -> float:
-        """``I(phi) omega^2 / 2``, J."""
+        """``I(phi) omega^2 / 2``, J.
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State ``[phi (rad), omega (rad/s), ...]`` (default: the current one).
+        """
         x = self.state if x is None else x
         return self._machine.kinetic_energy(float(x[0]), float(x[1]))

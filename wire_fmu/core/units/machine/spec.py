@@ -42,7 +42,17 @@ class MachineSpec:
     resistance_time: FourierSeries = field(default_factory=lambda: FourierSeries(period=1.0))
 
     def machine(self, a: float, b: float, load: float = 0.0) -> MachineUnit:
-        """Paper 004's :class:`MachineUnit` for motor ``a - b omega`` and an extra load (N m)."""
+        """Paper 004's :class:`MachineUnit` for motor ``a - b omega`` and an extra load (N m).
+
+        Parameters
+        ----------
+        a : float
+            Motor torque at zero speed, N m.
+        b : float
+            Slope of the motor characteristic, N m s/rad.
+        load : float, optional
+            Extra load torque added to ``M_c(t)``, N m.
+        """
         time_law = self.resistance_time
         angle_law = self.resistance_angle
         return MachineUnit(
@@ -165,7 +175,21 @@ def _inertia(data: Mapping[str, Any], problems: list[str]):
 
 
 def parse_machine(data: Any) -> tuple[MachineSpec | None, list[str]]:
-    """A :class:`MachineSpec` from JSON data (see :func:`crank_press`); every problem found."""
+    """A :class:`MachineSpec` from JSON data (see :func:`crank_press`); every problem found.
+
+    Parameters
+    ----------
+    data : mapping
+        Tables ``inertia``, ``resistance_angle``, ``resistance_speed`` and
+        ``resistance_time``.
+
+    Returns
+    -------
+    spec : MachineSpec or None
+        None when there are problems.
+    problems : list of str
+        Every problem, one sentence each.
+    """
     if not isinstance(data, Mapping):
         return None, [f"machine must be a table, got {data!r}"]
     problems: list[str] = []

@@ -200,7 +200,13 @@ class MachineDriveUnit(Unit):
         )
 
     def initialize(self, start_time: float) -> None:
-        """Start at ``initial_angle`` and ``initial_speed``."""
+        """Start at ``initial_angle`` and ``initial_speed``.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
         model = self._require_model()
         self._bind(model)
         model.state = np.array(
@@ -256,7 +262,13 @@ class MachineDriveUnit(Unit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state from :meth:`get_state`.
+        """
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.set_inputs(*state["inputs"])
@@ -307,13 +319,11 @@ class _MachineOde(ModelOdeView):
     """:class:`MachineDriveUnit` as a piece of a monolithic ODE (inputs read as instantaneous)."""
 
     def bind_inputs(self, t: float) -> None:
-        """Inputs in ``values`` are those at ``t``."""
+        """Inputs in ``values`` are those at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time the inputs belong to, s.
+        """
         self.unit._bind(self.model)
-
-    def handle_events(self, t, x, fired):
-        """Never called."""
-        return x
-
-    def project(self, x):
-        """No invariants."""
-        return x

@@ -49,7 +49,13 @@ class DriveModel(SmoothSystem):
         self.modes = self._modes()
 
     def motor_torques(self, omega: np.ndarray) -> np.ndarray:
-        """Torque each motor develops at the masses' speeds, N m."""
+        """Torque each motor develops at the masses' speeds, N m.
+
+        Parameters
+        ----------
+        omega : ndarray, shape (n,)
+            Speeds of the masses, rad/s.
+        """
         return self.commands - self.motor_slope * omega[self.motors]
 
     def _torques(self, omega: np.ndarray) -> np.ndarray:
@@ -59,7 +65,13 @@ class DriveModel(SmoothSystem):
         return f
 
     def shaft_torques(self, x: np.ndarray) -> np.ndarray:
-        """Torque in each shaft (drives its second mass forward), N m."""
+        """Torque in each shaft (drives its second mass forward), N m.
+
+        Parameters
+        ----------
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         theta, omega = x[: self.n], x[self.n : 2 * self.n]
         return np.array(
             [
@@ -70,7 +82,15 @@ class DriveModel(SmoothSystem):
 
     # -- HybridSystem (no modes: the rest is SmoothSystem's) -----------------
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``[theta', omega', dissipated', external work']``."""
+        """``[theta', omega', dissipated', external work']``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         n = self.n
         theta, omega = x[:n], x[n : 2 * n]
         external = self._torques(omega)
@@ -83,7 +103,13 @@ class DriveModel(SmoothSystem):
 
     # -- life cycle -------------------------------------------------------------
     def initialize(self, speed: float) -> None:
-        """All masses at ``speed``, shafts twisted as in rigid acceleration (no ringing)."""
+        """All masses at ``speed``, shafts twisted as in rigid acceleration (no ringing).
+
+        Parameters
+        ----------
+        speed : float
+            Speed of every mass at the start, rad/s.
+        """
         n = self.n
         omega = np.full(n, speed)
         f = self._torques(omega) - self.damping @ omega
@@ -96,11 +122,25 @@ class DriveModel(SmoothSystem):
         self.state = np.concatenate([theta, omega, [0.0, 0.0]])
 
     def advance(self, t: float, h: float) -> None:
-        """Advance by ``h`` with the torques held."""
+        """Advance by ``h`` with the torques held.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        """
         self.state, _ = self.solver.advance(self, t, self.state, t + h)
 
     def stored_energy(self, x: np.ndarray | None = None) -> float:
-        """``omega^T J omega / 2 + theta^T K theta / 2``, J."""
+        """``omega^T J omega / 2 + theta^T K theta / 2``, J.
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State (default: the current one).
+        """
         x = self.state if x is None else x
         theta, omega = x[: self.n], x[self.n : 2 * self.n]
         return 0.5 * float(self.inertia @ omega**2) + 0.5 * float(theta @ self.stiffness @ theta)

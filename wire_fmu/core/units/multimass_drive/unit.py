@@ -240,7 +240,13 @@ class DriveUnit(Unit):
         self.model = model
 
     def initialize(self, start_time: float) -> None:
-        """Start at ``initial_speed`` with the shafts carrying their quasi-static torques."""
+        """Start at ``initial_speed`` with the shafts carrying their quasi-static torques.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
         model = self._require_model()
         self._bind(model)
         model.initialize(float(self.values["initial_speed"]))
@@ -287,7 +293,13 @@ class DriveUnit(Unit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state from :meth:`get_state`.
+        """
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.commands = np.array(state["commands"], dtype=float)
@@ -386,13 +398,11 @@ class _DriveOde(ModelOdeView):
     """:class:`DriveUnit` as a piece of a monolithic ODE (torques read as instantaneous)."""
 
     def bind_inputs(self, t: float) -> None:
-        """Torques in ``values`` are those at ``t``."""
+        """Torques in ``values`` are those at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time the torques belong to, s.
+        """
         self.unit._bind(self.model)
-
-    def handle_events(self, t, x, fired):
-        """Never called."""
-        return x
-
-    def project(self, x):
-        """No invariants."""
-        return x

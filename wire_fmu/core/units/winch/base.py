@@ -127,7 +127,13 @@ class _WinchBase:
         self._caps = np.zeros((1, 2))
 
     def set_inputs(self, inputs: WinchInputs) -> None:
-        """Hold ``inputs`` from now on."""
+        """Hold ``inputs`` from now on.
+
+        Parameters
+        ----------
+        inputs : WinchInputs
+            Inputs held from now on.
+        """
         self.inputs = inputs
         if self.config.has_brake:
             self._caps = np.array([self.brake.capacities(inputs.lever_force)])
@@ -171,5 +177,12 @@ class _WinchBase:
         }
 
     def restore_held_inputs(self, data: dict[str, float]) -> None:
-        """Restore inputs saved by :meth:`held_inputs`."""
+        """Restore inputs saved by :meth:`held_inputs`.
+
+        Parameters
+        ----------
+        data : dict
+            Tension (N), lever force (N), motor command (N m) and speed command
+            (rad/s) as from :meth:`held_inputs`.
+        """
         self.set_inputs(WinchInputs(**{k: float(v) for k, v in data.items()}))

@@ -46,11 +46,23 @@ class BandBrake:
     wrap_angle: float = 5.24
 
     def band_tension(self, lever_force: float) -> float:
-        """Tension the lever puts into the band's live end, N (0 if not pulled)."""
+        """Tension the lever puts into the band's live end, N (0 if not pulled).
+
+        Parameters
+        ----------
+        lever_force : float
+            Force on the brake lever, N.
+        """
         return max(lever_force, 0.0) * self.lever_ratio * self.efficiency
 
     def capacities(self, lever_force: float) -> tuple[float, float]:
-        """Torque capacities (against paying out, against hauling in), N m."""
+        """Torque capacities (against paying out, against hauling in), N m.
+
+        Parameters
+        ----------
+        lever_force : float
+            Force on the brake lever, N (<= 0: released).
+        """
         base = self.rim_radius * self.band_tension(lever_force)
         mu_alpha = self.friction * self.wrap_angle
         return base * math.expm1(mu_alpha), -base * math.expm1(-mu_alpha)

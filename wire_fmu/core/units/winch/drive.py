@@ -77,7 +77,13 @@ class WinchModel(_WinchBase):
 
     # ---------------------------------------------------------- torques
     def motor_torque(self, motor_speed: float) -> float:
-        """Motor torque at the motor shaft, N m, at real motor speed (rad/s)."""
+        """Motor torque at the motor shaft, N m, at real motor speed (rad/s).
+
+        Parameters
+        ----------
+        motor_speed : float
+            Motor shaft speed, rad/s.
+        """
         if self.characteristic:
             return self.inputs.motor_command - self.config.motor_slope * motor_speed
         return self.inputs.motor_command
@@ -116,7 +122,15 @@ class WinchModel(_WinchBase):
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``[theta', omega', dissipated', external work']``."""
+        """``[theta', omega', dissipated', external work']``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         n = self.n
         omega = x[n : 2 * n]
         acc, link = self._dynamics(x)
@@ -147,6 +161,13 @@ class WinchModel(_WinchBase):
         lever force); it can only fire when the lever force varies within a
         step, as in a monolithic model -- held inputs are settled at the
         start of every step.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
         """
         out = []
         if self.config.has_brake:
@@ -163,7 +184,17 @@ class WinchModel(_WinchBase):
         return np.array(out, dtype=float)
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Brake stick/slip, or the rope changing layer."""
+        """Brake stick/slip, or the rope changing layer.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        fired : list of int
+            Indices of the guards that crossed.
+        """
         x = np.array(x, dtype=float)
         n_brake = self._n_brake_guards
         for i in fired:
@@ -187,7 +218,13 @@ class WinchModel(_WinchBase):
         x[2 * n - 1] *= math.sqrt(before / after)
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """A held drum stays exactly where it stuck, at rest."""
+        """A held drum stays exactly where it stuck, at rest.
+
+        Parameters
+        ----------
+        x : ndarray
+            State, changed in place and returned.
+        """
         if self.drum_held():
             x[self.n - 1] = self._held_angle
             x[2 * self.n - 1] = 0.0
@@ -195,7 +232,20 @@ class WinchModel(_WinchBase):
 
     # ------------------------------------------ RigidMachineSystem protocol
     def machine(self, t: float, x: np.ndarray) -> MachineUnit | None:
-        """Paper 004's machine unit of the current mode (rigid chain only)."""
+        """Paper 004's machine unit of the current mode (rigid chain only).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+
+        Returns
+        -------
+        MachineUnit or None
+            None while the brake holds the drum.
+        """
         if self.drum_held():
             return None
         sliding = 0.0
@@ -217,7 +267,18 @@ class WinchModel(_WinchBase):
         )
 
     def book(self, work: StepWork) -> tuple[float, float]:
-        """Brake and dampers dissipate; motor and rope are external."""
+        """Brake and dampers dissipate; motor and rope are external.
+
+        Parameters
+        ----------
+        work : StepWork
+            The works of the step, J.
+
+        Returns
+        -------
+        tuple of float
+            (dissipated, external work), J.
+        """
         return work.speed, work.driving - work.angle
 
     # ---------------------------------------------------------- modes
@@ -259,6 +320,13 @@ class WinchModel(_WinchBase):
         The shafts are twisted as in quasi-static motion: every mass has the
         acceleration the chain would have if it were rigid (zero when the
         brake holds), so the start causes no shaft vibration.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time, s.
+        inputs : WinchInputs
+            Inputs at the start.
         """
         self.set_inputs(inputs)
         self.layer = self.drum.initial_layer()
@@ -291,7 +359,17 @@ class WinchModel(_WinchBase):
         return (torque - direction * (plus if direction > 0 else minus)) / inertia
 
     def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
-        """Advance by ``h`` with ``inputs`` held; return the number of events."""
+        """Advance by ``h`` with ``inputs`` held; return the number of events.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        inputs : WinchInputs
+            Inputs held over the step.
+        """
         self.last_events = []
         self.set_inputs(inputs)
         self.state = self._settle_modes(t, self.state)
@@ -302,7 +380,13 @@ class WinchModel(_WinchBase):
 
     # ---------------------------------------------------------- outputs
     def stored_energy(self, x: np.ndarray | None = None) -> float:
-        """Kinetic energy of every mass plus shaft strain energy, J."""
+        """Kinetic energy of every mass plus shaft strain energy, J.
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State (default: the current one).
+        """
         x = self.state if x is None else x
         n = self.n
         theta, omega = x[:n], x[n : 2 * n]
@@ -336,7 +420,13 @@ class WinchModel(_WinchBase):
 
     @contextmanager
     def trial(self, inputs: WinchInputs) -> Iterator[None]:
-        """Modes settled for other inputs, undone on exit (for feedthrough outputs)."""
+        """Modes settled for other inputs, undone on exit (for feedthrough outputs).
+
+        Parameters
+        ----------
+        inputs : WinchInputs
+            The inputs to read the outputs for.
+        """
         saved = (
             self.inputs,
             self.engaged,
@@ -379,7 +469,13 @@ class WinchModel(_WinchBase):
         }
 
     def set_state(self, data: dict) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        data : dict
+            A state from :meth:`get_state`.
+        """
         self.state = np.array(data["x"], dtype=float)
         self.layer = int(data["layer"])
         self.engaged = bool(data["engaged"])

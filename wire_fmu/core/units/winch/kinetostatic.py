@@ -42,7 +42,15 @@ class KinetostaticWinch(_WinchBase):
         self.solver = None
 
     def initialize(self, t0: float, inputs: WinchInputs) -> None:
-        """At rest at ``phi = 0``, turning at the speed command from the start."""
+        """At rest at ``phi = 0``, turning at the speed command from the start.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time, s.
+        inputs : WinchInputs
+            Inputs at the start.
+        """
         self.set_inputs(inputs)
         self.layer = self.drum.initial_layer()
         self.state = np.array([0.0, inputs.speed_command, 0.0, 0.0])
@@ -68,7 +76,22 @@ class KinetostaticWinch(_WinchBase):
         return brake, self.beta * omega - rope - brake
 
     def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
-        """Turn at the commanded speed for ``h``; exact payout, work and losses."""
+        """Turn at the commanded speed for ``h``; exact payout, work and losses.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        inputs : WinchInputs
+            Inputs held over the step.
+
+        Returns
+        -------
+        int
+            The number of events (layer changes, brake changes).
+        """
         self.last_events = []
         self.set_inputs(inputs)
         omega = inputs.speed_command
@@ -110,7 +133,15 @@ class KinetostaticWinch(_WinchBase):
 
     # ------------------------------ HybridSystem protocol (monolithic models)
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``[phi', 0, dissipated', external work']`` at the commanded speed."""
+        """``[phi', 0, dissipated', external work']`` at the commanded speed.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         omega = self.inputs.speed_command
         brake, motor = self._brake_and_motor(omega)
         rope = self.inputs.tension * self.drum.layer_radius(self.layer)
@@ -122,21 +153,45 @@ class KinetostaticWinch(_WinchBase):
         return -np.ones(2 if self.drum.layered else 0)
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """The layer's two edges (none without layers)."""
+        """The layer's two edges (none without layers).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
         if not self.drum.layered:
             return np.zeros(0)
         low, high = self.drum.phi_bounds(self.layer)
         return np.array([x[0] - low, high - x[0]])
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """The rope changes layer."""
+        """The rope changes layer.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        fired : list of int
+            Indices of the guards that crossed.
+        """
         for i in fired:
             self._change_layer(t, +1 if i == 0 else -1)
         self.mode_changes += 1
         return np.array(x, dtype=float)
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """No invariants."""
+        """No invariants.
+
+        Parameters
+        ----------
+        x : ndarray
+            State, returned as it is.
+        """
         return x
 
     def report(self) -> WinchReport:
@@ -163,7 +218,13 @@ class KinetostaticWinch(_WinchBase):
 
     @contextmanager
     def trial(self, inputs: WinchInputs) -> Iterator[None]:
-        """Other inputs for reading feedthrough outputs, undone on exit."""
+        """Other inputs for reading feedthrough outputs, undone on exit.
+
+        Parameters
+        ----------
+        inputs : WinchInputs
+            The inputs to read the outputs for.
+        """
         saved = self.inputs
         try:
             self.set_inputs(inputs)
@@ -182,7 +243,13 @@ class KinetostaticWinch(_WinchBase):
         }
 
     def set_state(self, data: dict) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        data : dict
+            A state from :meth:`get_state`.
+        """
         self.state = np.array(data["x"], dtype=float)
         self.layer = int(data["layer"])
         self._brake_state = int(data["brake_state"])

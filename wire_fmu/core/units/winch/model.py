@@ -114,7 +114,15 @@ def fastest_rate(chain: DriveChain, motor_slope: float = 0.0) -> float:
 
 
 def build_winch(config: WinchConfig, solver: SolverSettings) -> WinchModel | KinetostaticWinch:
-    """The model the effects call for: with ``drum_inertia`` a hybrid ODE, else kinetostatic."""
+    """The model the effects call for: with ``drum_inertia`` a hybrid ODE, else kinetostatic.
+
+    Parameters
+    ----------
+    config : WinchConfig
+        The winch.
+    solver : SolverSettings
+        Internal solver (used with ``drum_inertia``).
+    """
     drum = replace(config.drum, layered="rope_layers" in config.effects)
     config = replace(config, drum=drum)
     if "drum_inertia" in config.effects:

@@ -35,6 +35,9 @@ cannot be stable (``|lambda| h >= 2.5``) are refused by :meth:`configure`
 with the step size that would do. ``energy``/``energy1`` select paper
 004's integrator (:mod:`wire_fmu.core.framework.energy_integrator`) for a rigid drive
 train; without ``drum_inertia`` nothing is integrated.
+
+The variables themselves (units, descriptions, defaults) are declared in
+:mod:`wire_fmu.core.units.winch.variables`.
 """
 
 from __future__ import annotations
@@ -46,207 +49,30 @@ from typing import Any
 
 import numpy as np
 
-from wire_fmu.core.components.drive_train import DriveChain, default_drive_train, parse_drive_train
+from wire_fmu.core.components.drive_train import DriveChain, parse_drive_train
 from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
 from wire_fmu.core.framework.ports import Port, PortSide
 from wire_fmu.core.framework.report_outputs import ReportOutputs
-from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
+from wire_fmu.core.framework.solver_options import solver_settings
 from wire_fmu.core.framework.unit import (
     HeldInputsUnit,
     ModelOdeView,
     OdeView,
-    input_,
-    output,
-    parameter,
 )
 from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs
 from wire_fmu.core.units.winch.brake import BandBrake
 from wire_fmu.core.units.winch.drive import WinchModel
 from wire_fmu.core.units.winch.kinetostatic import KinetostaticWinch
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS, build_winch, fastest_rate
+from wire_fmu.core.units.winch.variables import winch_inputs, winch_outputs, winch_parameters
 
 __all__ = ["WinchUnit"]
 
-_FEEDTHROUGH = ("rope.tension", "brake.lever_force", "motor.command")
-
-
-def _parameters():
-    return (
-        parameter(
-            "effects",
-            "",
-            "",
-            "Effects to include, comma separated: " + ", ".join(WINCH_EFFECTS.names),
-            type=str,
-        ),
-        *solver_parameters(
-            "rk4",
-            1e-3,
-            also=ENERGY_SOLVERS,
-            note="energy, energy1: paper 004's energy form, rigid drive train only",
-        ),
-        parameter(
-            "drive_train",
-            json.dumps(default_drive_train()),
-            "",
-            "Drive train as JSON: masses (motor rotor .. drum) and shafts, each with its "
-            "speed ratio to the drum (estimated 1500-2000 hp drawworks by default)",
-            type=str,
-        ),
-        parameter(
-            "drive_train_masses",
-            0,
-            "",
-            "Masses kept with elastic_drive_train: 0 the "
-            "full chain, 1 rigid, 2.. reduced by delta-star elimination",
-            type=int,
-        ),
-        parameter(
-            "drum_radius",
-            0.42,
-            "m",
-            "Rope centreline radius on the first layer (32 in "
-            "barrel with 1-3/8 in line, typical 1500-2000 hp drawworks; estimate)",
-            min=0.0,
-        ),
-        parameter(
-            "rope_diameter",
-            0.0349,
-            "m",
-            "Rope diameter: 1-3/8 in drilling line "
-            "(API 9A size); the radius grows by one diameter per layer",
-            min=0.0,
-        ),
-        parameter(
-            "rope_linear_mass",
-            5.06,
-            "kg/m",
-            "Rope mass per metre (1-3/8 in 6x19 IWRC, about 3.4 lb/ft)",
-            min=0.0,
-        ),
-        parameter(
-            "drum_wraps_per_layer",
-            40,
-            "",
-            "Turns per layer (about 1.4 m barrel / rope diameter)",
-            type=int,
-        ),
-        parameter("drum_layers", 4, "", "Layers the drum flanges allow", type=int),
-        parameter(
-            "rope_on_drum", 150.0, "m", "Rope on the drum at the start (rope_layers)", min=0.0
-        ),
-        parameter(
-            "brake_rim_radius",
-            0.62,
-            "m",
-            "Brake-rim radius r_f (about 49 in rims; estimate)",
-            min=0.0,
-        ),
-        parameter(
-            "brake_lever_ratio",
-            15.0,
-            "1",
-            "Lever ratio L/l of the brake handle linkage (estimate)",
-            min=0.0,
-        ),
-        parameter(
-            "brake_efficiency", 0.9, "1", "Efficiency eta of the brake linkage", min=0.0, max=1.0
-        ),
-        parameter(
-            "brake_friction",
-            0.4,
-            "1",
-            "Band friction coefficient mu (moulded lining on steel, 0.35-0.45)",
-            min=0.0,
-        ),
-        parameter(
-            "brake_wrap_angle", 5.24, "rad", "Band wrap angle alpha (about 300 deg)", min=0.0
-        ),
-        parameter(
-            "motor_slope",
-            3.6e3,
-            "N.m.s/rad",
-            "Slope b of the motor characteristic at "
-            "the motor shaft (1150 hp AC motor, 1.5 % slip at 1200 rpm; estimate)",
-            min=0.0,
-        ),
-        parameter("initial_drum_speed", 0.0, "rad/s", "Drum speed at the start (drum_inertia)"),
-    )
-
-
-def _inputs():
-    return (
-        input_("rope.tension", 0.0, "N", "Rope tension at the drum"),
-        input_("brake.lever_force", 0.0, "N", "Force on the brake lever (<= 0: released)"),
-        input_(
-            "motor.command",
-            0.0,
-            "N.m",
-            "Motor torque at the motor shaft, positive paying "
-            "out; with motor_characteristic the zero-speed torque a of a - b omega",
-        ),
-        input_(
-            "drum.speed_command",
-            0.0,
-            "rad/s",
-            "Drum speed the drive imposes without "
-            "drum_inertia (kinetostatic mode), positive paying out",
-        ),
-    )
-
-
-def _outputs():
-    deps = _FEEDTHROUGH
-    return (
-        output("rope.payout", "m", "Rope paid out since the start (unstretched)"),
-        output("rope.payout_rate", "m/s", "Rate of rope paid out"),
-        output("drum.speed", "rad/s", "Drum speed, positive paying out"),
-        output("drum.angle", "rad", "Drum angle since the start, positive paying out"),
-        output(
-            "drum.layer",
-            "",
-            "Rope layer the rope leaves from (1 = on the barrel)",
-            type=int,
-            start=1,
-        ),
-        output("drum.radius", "m", "Winding radius where the rope leaves the drum"),
-        output("motor.speed", "rad/s", "Motor shaft speed"),
-        output("motor.torque", "N.m", "Motor torque at the motor shaft", depends_on=deps),
-        output("brake.torque", "N.m", "Torque of the band brake on the drum", depends_on=deps),
-        output(
-            "brake.capacity",
-            "N.m",
-            "Brake capacity against paying out (eq. 34)",
-            depends_on=("brake.lever_force",),
-        ),
-        output(
-            "brake.state",
-            "",
-            "Band brake: 0 released, 1 slipping, 2 holding",
-            type=int,
-            depends_on=deps,
-        ),
-        output(
-            "stored_energy",
-            "J",
-            "Kinetic energy of the drive train and drum plus shaft strain energy",
-        ),
-        output("dissipated_energy", "J", "Energy dissipated by the brake and dampers"),
-        output("external_work", "J", "Work done on the winch by the rope and the motor"),
-        output(
-            "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
-        ),
-        output(
-            "mode_changes", "", "Number of mode events so far (stick/slip, layer changes)", type=int
-        ),
-    )
-
-
 _REPORTED = ReportOutputs.of(
-    _outputs(),
+    winch_outputs(),
     finite=(
         "rope.payout",
         "rope.payout_rate",
@@ -264,7 +90,7 @@ class WinchUnit(HeldInputsUnit):
 
     NAME = "Winch"
     DESCRIPTION = "Winch (drawworks): drum, band brake, motor, drive train, wire_fmu"
-    VARIABLES = _parameters() + _inputs() + _outputs()
+    VARIABLES = winch_parameters() + winch_inputs() + winch_outputs()
     PORTS = (
         Port(
             "rope",
@@ -334,7 +160,13 @@ class WinchUnit(HeldInputsUnit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state from :meth:`get_state`.
+        """
         model = self._require_model()
         model.set_state(dict(state))
         self.time = float(state["time"])
@@ -461,11 +293,25 @@ class _WinchOde(ModelOdeView):
         self._kinetostatic = isinstance(self.model, KinetostaticWinch)
 
     def bind_inputs(self, t: float) -> None:
-        """Inputs in ``values`` are the values at ``t``."""
+        """Inputs in ``values`` are the values at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time the inputs belong to, s.
+        """
         self.model.set_inputs(self.unit._inputs())
 
     def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State of the winch's ODE.
+        """
         model = self.model
         x = np.array(x, dtype=float)
         if self._kinetostatic:
@@ -478,7 +324,20 @@ class _WinchOde(ModelOdeView):
             model.state, self.unit.time = saved, saved_time
 
     def reconcile(self, t, x):
-        """Inputs jumped: settle the brake's modes for them."""
+        """Inputs jumped: settle the brake's modes for them.
+
+        Parameters
+        ----------
+        t : float
+            Time of the jump, s.
+        x : ndarray
+            State of the winch's ODE.
+
+        Returns
+        -------
+        ndarray
+            The state with the brake's modes settled.
+        """
         model = self.model
         self.bind_inputs(t)
         if self._kinetostatic:
