@@ -59,7 +59,13 @@ class JackConfig:
         return self.friction in REGULARISATIONS
 
     def static_force(self, travel: float) -> float:
-        """Axial force holding the load at rest, ``W cot(theta)``, N."""
+        """Axial force holding the load at rest, ``W cot(theta)``, N.
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
+        """
         _, slope, _ = self.geometry.slopes(travel)
         return self.load_weight * slope
 
@@ -69,6 +75,11 @@ class JackConfig:
         ``(h + r mu) F0`` and ``(h - r mu) F0`` with ``F0 = W cot(theta)``;
         a negative second value means the jack is self-locking (it holds the
         load with no handle torque and must be driven down).
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
         """
         force = self.static_force(travel)
         lead = self.thread.lead_torque(force)
@@ -76,7 +87,15 @@ class JackConfig:
         return lead + capacity, lead - capacity
 
     def effective_inertia(self, travel: float, direction: float) -> float:
-        """``J_s + q m h^2 cot^2(theta)`` while sliding in ``direction``, kg m^2."""
+        """``J_s + q m h^2 cot^2(theta)`` while sliding in ``direction``, kg m^2.
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
+        direction : float
+            Sliding direction of the handle, +1 lifting or -1 lowering.
+        """
         _, slope, _ = self.geometry.slopes(travel)
         h = self.thread.lead_per_radian
         q = h + direction * self.thread.mean_radius * self.thread.friction

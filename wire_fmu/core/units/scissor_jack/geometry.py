@@ -38,23 +38,47 @@ class JackGeometry:
         return math.sqrt(4.0 * self.rod_length**2 - self.initial_height**2)
 
     def height(self, travel: float) -> float:
-        """``y(s)``, m (nan outside the rhombus)."""
+        """``y(s)``, m (nan outside the rhombus).
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
+        """
         width = self.initial_width - travel
         square = 4.0 * self.rod_length**2 - width * width
         return math.sqrt(square) if square > 0.0 and width > 0.0 else math.nan
 
     def slopes(self, travel: float) -> tuple[float, float, float]:
-        """``(y, dy/ds, d2y/ds2)`` at screw travel ``s`` (m, 1, 1/m)."""
+        """``(y, dy/ds, d2y/ds2)`` at screw travel ``s`` (m, 1, 1/m).
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
+        """
         width = self.initial_width - travel
         y = self.height(travel)
         return y, width / y, -4.0 * self.rod_length**2 / y**3
 
     def rod_angle(self, travel: float) -> float:
-        """``theta``, rad."""
+        """``theta``, rad.
+
+        Parameters
+        ----------
+        travel : float
+            Screw travel through the nut since the start, m.
+        """
         return math.atan2(self.height(travel), self.initial_width - travel)
 
     def travel_at_height(self, height: float) -> float:
-        """Screw travel that puts the shoe at ``height`` (m), m."""
+        """Screw travel that puts the shoe at ``height`` (m), m.
+
+        Parameters
+        ----------
+        height : float
+            Shoe height above the base joint, m.
+        """
         return self.initial_width - math.sqrt(4.0 * self.rod_length**2 - height * height)
 
     def problems(self) -> list[str]:

@@ -46,16 +46,34 @@ class JackMechanics:
 
     # ---------------------------------------------------------- kinematics
     def travel(self, psi: float) -> float:
-        """Screw travel ``s = h psi``, m."""
+        """Screw travel ``s = h psi``, m.
+
+        Parameters
+        ----------
+        psi : float
+            Handle angle relative to the nut since the start, rad.
+        """
         return self.h * psi
 
     def inertia(self, psi: float) -> float:
-        """``I(psi) = J_s + m (h cot theta)^2``, kg m^2."""
+        """``I(psi) = J_s + m (h cot theta)^2``, kg m^2.
+
+        Parameters
+        ----------
+        psi : float
+            Handle angle relative to the nut since the start, rad.
+        """
         _, slope, _ = self.config.geometry.slopes(self.travel(psi))
         return self.config.handle_inertia + self.config.load_mass * (self.h * slope) ** 2
 
     def height(self, psi: float) -> float:
-        """Shoe height, m."""
+        """Shoe height, m.
+
+        Parameters
+        ----------
+        psi : float
+            Handle angle relative to the nut since the start, rad.
+        """
         return self.config.geometry.height(self.travel(psi))
 
     # ---------------------------------------------------------- forces
@@ -125,7 +143,13 @@ class JackMechanics:
         return _Forces(0.0, force, resist, self.h * force - resist)
 
     def forces(self, x: np.ndarray) -> _Forces:
-        """Acceleration, axial force, friction and handle torque at state ``x``."""
+        """Acceleration, axial force, friction and handle torque at state ``x``.
+
+        Parameters
+        ----------
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), ...]``.
+        """
         if self.config.drive == "speed":
             return self._speed_driven(x)
         return self._torque_driven(x)

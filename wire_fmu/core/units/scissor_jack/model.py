@@ -152,7 +152,15 @@ class ScissorJackModel(JackMechanics):
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """``[psi', psi'', dissipated', external work']``."""
+        """``[psi', psi'', dissipated', external work']``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), dissipated (J), external work (J)]``.
+        """
         f = self.forces(x)
         omega = float(x[1])
         if self._stuck():
@@ -166,7 +174,15 @@ class ScissorJackModel(JackMechanics):
         return -np.ones(1 if self._has_modes() else 0)
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Holding margin (stuck) or direction times speed (sliding)."""
+        """Holding margin (stuck) or direction times speed (sliding).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), dissipated (J), external work (J)]``.
+        """
         if not self._has_modes():
             return np.zeros(0)
         f = self.forces(x)
@@ -175,11 +191,27 @@ class ScissorJackModel(JackMechanics):
         )
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """The thread sticks or breaks away."""
+        """The thread sticks or breaks away.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), dissipated (J), external work (J)]``.
+        fired : list of int
+            Indices of the guards that crossed.
+        """
         return self._settle(t, x, fired)
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """A stuck thread stays exactly where it stuck, at rest."""
+        """A stuck thread stays exactly where it stuck, at rest.
+
+        Parameters
+        ----------
+        x : ndarray
+            State, changed in place and returned.
+        """
         if self._stuck():
             x[0] = self._held_angle
             x[1] = 0.0
@@ -193,7 +225,13 @@ class ScissorJackModel(JackMechanics):
         return self._has_modes() and int(self.friction.mode[0]) == 0
 
     def thread_state(self, x: np.ndarray | None = None) -> int:
-        """0 frictionless, 1 sliding, 2 stuck, 3 creeping (regularised)."""
+        """0 frictionless, 1 sliding, 2 stuck, 3 creeping (regularised).
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State ``[psi (rad), psi' (rad/s), ...]`` (default: the current one).
+        """
         x = self.state if x is None else x
         if self.config.friction == "none":
             return THREAD_FREE
@@ -229,7 +267,15 @@ class ScissorJackModel(JackMechanics):
 
     # ---------------------------------------------------------- life cycle
     def initialize(self, t0: float, inputs: JackInputs) -> None:
-        """Start at ``psi = 0``: at rest (or ``initial_speed``), or at the commanded speed."""
+        """Start at ``psi = 0``: at rest (or ``initial_speed``), or at the commanded speed.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time, s.
+        inputs : JackInputs
+            Handle commands at the start.
+        """
         self.inputs = inputs
         speed = inputs.speed_command if self.config.drive == "speed" else self.config.initial_speed
         x = np.array([0.0, speed, 0.0, 0.0])
@@ -245,6 +291,15 @@ class ScissorJackModel(JackMechanics):
 
     def advance(self, t: float, h: float, inputs: JackInputs) -> int:
         """Advance by ``h`` with ``inputs`` held; return the number of events.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        inputs : JackInputs
+            Handle commands held over the step.
 
         Raises
         ------
@@ -278,13 +333,25 @@ class ScissorJackModel(JackMechanics):
 
     # ---------------------------------------------------------- outputs
     def stored_energy(self, x: np.ndarray | None = None) -> float:
-        """Kinetic energy of handle and load plus ``W y``, J."""
+        """Kinetic energy of handle and load plus ``W y``, J.
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State ``[psi (rad), psi' (rad/s), ...]`` (default: the current one).
+        """
         x = self.state if x is None else x
         psi, omega = float(x[0]), float(x[1])
         return 0.5 * self.inertia(psi) * omega**2 + self.config.load_weight * self.height(psi)
 
     def report(self, x: np.ndarray | None = None) -> JackReport:
-        """Outputs at state ``x`` (default: the current one) for the held inputs."""
+        """Outputs at state ``x`` (default: the current one) for the held inputs.
+
+        Parameters
+        ----------
+        x : ndarray, optional
+            State ``[psi (rad), psi' (rad/s), ...]`` (default: the current one).
+        """
         x = self.state if x is None else np.asarray(x, dtype=float)
         psi, omega = float(x[0]), float(x[1])
         f = self.forces(x)
@@ -310,7 +377,13 @@ class ScissorJackModel(JackMechanics):
 
     @contextmanager
     def trial(self, inputs: JackInputs) -> Iterator[np.ndarray]:
-        """The state as it would start a step with ``inputs``; undone on exit."""
+        """The state as it would start a step with ``inputs``; undone on exit.
+
+        Parameters
+        ----------
+        inputs : JackInputs
+            The handle commands to read the outputs for.
+        """
         saved = (
             self.inputs,
             self.friction.get_mode(),
@@ -350,7 +423,13 @@ class ScissorJackModel(JackMechanics):
         }
 
     def set_state(self, data: dict[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        data : dict
+            A state from :meth:`get_state`.
+        """
         self.state = np.array(data["x"], dtype=float)
         self.friction.set_mode(list(data["friction_mode"]))
         self._held_angle = float(data["held_angle"])

@@ -285,7 +285,13 @@ class ScissorJackUnit(HeldInputsUnit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state from :meth:`get_state`.
+        """
         self._require_model().set_state(dict(state))
         self.time = float(state["time"])
         self.initial_energy = float(state["initial_energy"])
@@ -384,7 +390,13 @@ class _JackOde(ModelOdeView):
         self._speed_drive = self.model.config.drive == "speed"
 
     def bind_inputs(self, t: float) -> None:
-        """Inputs in ``values`` are the values at ``t``."""
+        """Inputs in ``values`` are the values at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time the inputs belong to, s.
+        """
         self.model.inputs = self.unit._inputs()
 
     def _driven(self, x: np.ndarray) -> np.ndarray:
@@ -394,34 +406,47 @@ class _JackOde(ModelOdeView):
         return x
 
     def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), dissipated (J), external work (J)]``.
+        """
         self.unit._update_outputs(self._driven(x))
 
     def rhs(self, t, x):
-        """See :meth:`ScissorJackModel.rhs`."""
+        """See :meth:`ScissorJackModel.rhs`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[psi (rad), psi' (rad/s), dissipated (J), external work (J)]``.
+        """
         out = self.model.rhs(t, self._driven(x))
         if self._speed_drive:
             out[1] = 0.0
         return out
 
-    def guards(self, t, x):
-        """The thread's stick/slip guard."""
-        return self.model.guards(t, x)
-
-    def guard_directions(self):
-        """Fires on a downward crossing."""
-        return self.model.guard_directions()
-
-    def handle_events(self, t, x, fired):
-        """The thread sticks or breaks away."""
-        return self.model.handle_events(t, x, fired)
-
-    def project(self, x):
-        """A stuck thread stays where it stuck."""
-        return self.model.project(x)
-
     def reconcile(self, t, x):
-        """Inputs jumped: book a speed jump, or settle the thread's mode."""
+        """Inputs jumped: book a speed jump, or settle the thread's mode.
+
+        Parameters
+        ----------
+        t : float
+            Time of the jump, s.
+        x : ndarray
+            State of the jack's ODE.
+
+        Returns
+        -------
+        ndarray
+            The state after the jump.
+        """
         self.bind_inputs(t)
         x = np.array(x, dtype=float)
         if self._speed_drive:
