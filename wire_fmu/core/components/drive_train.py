@@ -256,7 +256,7 @@ class DriveChain:
         Parameters
         ----------
         k : int
-            The mass.
+            The mass, from 0 (the motor rotor) to ``n - 1`` (the drum).
         omega : float
             Angular frequency, rad/s.
         """

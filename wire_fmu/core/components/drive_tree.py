@@ -206,7 +206,7 @@ class DriveTree:
         Parameters
         ----------
         k : int
-            The mass.
+            The mass (an index into :attr:`inertias`).
         omega : float
             Angular frequency, rad/s.
         """
