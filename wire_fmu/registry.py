@@ -94,6 +94,11 @@ BY_NAME = MappingProxyType({u.name: u for u in UNIT_TYPES})
 def unit_type(name: str) -> UnitType:
     """The unit type a scene names ``name``.
 
+    Parameters
+    ----------
+    name : str
+        Model name of a unit type, e.g. ``"BlockTrain"``.
+
     Raises
     ------
     KeyError

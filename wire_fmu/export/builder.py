@@ -59,6 +59,13 @@ def unique_module_name(script: Path, core_fingerprint: str) -> str:
 
     The hash covers the script and the core fingerprint, so FMUs built from
     different sources never share a module name in one interpreter.
+
+    Parameters
+    ----------
+    script : pathlib.Path
+        The facade script.
+    core_fingerprint : str
+        Fingerprint of the bundled ``wire_fmu`` package.
     """
     stem = re.sub(r"\W", "_", script.stem).lower()
     digest = hashlib.sha256(script.read_bytes() + core_fingerprint.encode()).hexdigest()
@@ -94,6 +101,13 @@ def find_facade_class(module: ModuleType, script: Path) -> type[CoreFacade]:
     pythonfmu's builder and its C++ loader both pick the most derived slave
     class in the script's namespace, so exactly one facade class must be
     visible there (defined or imported).
+
+    Parameters
+    ----------
+    module : types.ModuleType
+        The facade script, imported.
+    script : pathlib.Path
+        Its path, for the messages.
 
     Raises
     ------
@@ -150,7 +164,13 @@ class _Staging:
     extras: tuple[Path, ...]  # extra modules, beside the script
 
     def project_files(self, build_info: Path) -> list[Path]:
-        """What pythonfmu copies into the FMU's resources."""
+        """What pythonfmu copies into the FMU's resources.
+
+        Parameters
+        ----------
+        build_info : pathlib.Path
+            The build record written for the FMU (:class:`~wire_fmu.export.guard.BuildInfo`).
+        """
         return [self.core, build_info, *self.extras]
 
 

@@ -112,8 +112,23 @@ def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
     """
 
     def decorate(method: _F) -> _F:
+        """``method`` wrapped so that a failure is logged, then re-raised.
+
+        Parameters
+        ----------
+        method : callable
+            A facade method the FMU binary calls.
+        """
+
         @functools.wraps(method)
         def guarded(self: CoreFacade, *args: Any, **kwargs: Any) -> Any:
+            """Call the method; on failure report it through the facade and re-raise.
+
+            Parameters
+            ----------
+            *args, **kwargs : Any
+                Arguments of the method.
+            """
             try:
                 return method(self, *args, **kwargs)
             except ConfigurationError as exc:  # its problems, without the "where" we say already
@@ -288,34 +303,118 @@ class CoreFacade(Fmi2Slave):
 
     @fmi_entry("fmi2GetReal")
     def get_real(self, vrs: list[int]) -> list[float]:  # noqa: D102
+        """fmi2GetReal: values of the Real variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+
+        Returns
+        -------
+        list of float
+            Their values, in the order of ``vrs`` (in their declared units).
+        """
         return super().get_real(vrs)
 
     @fmi_entry("fmi2GetInteger")
     def get_integer(self, vrs: list[int]) -> list[int]:  # noqa: D102
+        """fmi2GetInteger: values of the Integer variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+
+        Returns
+        -------
+        list of int
+            Their values, in the order of ``vrs``.
+        """
         return super().get_integer(vrs)
 
     @fmi_entry("fmi2GetBoolean")
     def get_boolean(self, vrs: list[int]) -> list[bool]:  # noqa: D102
+        """fmi2GetBoolean: values of the Boolean variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+
+        Returns
+        -------
+        list of bool
+            Their values, in the order of ``vrs``.
+        """
         return super().get_boolean(vrs)
 
     @fmi_entry("fmi2GetString")
     def get_string(self, vrs: list[int]) -> list[str]:  # noqa: D102
+        """fmi2GetString: values of the String variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+
+        Returns
+        -------
+        list of str
+            Their values, in the order of ``vrs``.
+        """
         return super().get_string(vrs)
 
     @fmi_entry("fmi2SetReal")
     def set_real(self, vrs: list[int], values: list[float]) -> None:  # noqa: D102
+        """fmi2SetReal: set the Real variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        values : list of float
+            Their new values, in the order of ``vrs`` (in their declared units).
+        """
         super().set_real(vrs, values)
 
     @fmi_entry("fmi2SetInteger")
     def set_integer(self, vrs: list[int], values: list[int]) -> None:  # noqa: D102
+        """fmi2SetInteger: set the Integer variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        values : list of int
+            Their new values, in the order of ``vrs``.
+        """
         super().set_integer(vrs, values)
 
     @fmi_entry("fmi2SetBoolean")
     def set_boolean(self, vrs: list[int], values: list[bool]) -> None:  # noqa: D102
+        """fmi2SetBoolean: set the Boolean variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        values : list of bool
+            Their new values, in the order of ``vrs``.
+        """
         super().set_boolean(vrs, values)
 
     @fmi_entry("fmi2SetString")
     def set_string(self, vrs: list[int], values: list[str]) -> None:  # noqa: D102
+        """fmi2SetString: set the String variables ``vrs`` (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        values : list of str
+            Their new values, in the order of ``vrs``.
+        """
         super().set_string(vrs, values)
 
     # -- life cycle ---------------------------------------------------------------
@@ -323,7 +422,17 @@ class CoreFacade(Fmi2Slave):
     def setup_experiment(
         self, start_time: float, stop_time: float | None = None, tolerance: float | None = None
     ) -> None:
-        """Remember the start time (before initialisation only; it must be finite)."""
+        """Remember the start time (before initialisation only; it must be finite).
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        stop_time : float or None
+            Stop time, s (not used).
+        tolerance : float or None
+            Relative tolerance, 1 (not used).
+        """
         self._require("fmi2SetupExperiment", Phase.instantiated)
         if not math.isfinite(start_time):
             raise FacadeError(f"start time {start_time!r} s: must be finite")
@@ -349,7 +458,20 @@ class CoreFacade(Fmi2Slave):
 
     @fmi_entry("fmi2DoStep")
     def do_step(self, current_time: float, step_size: float) -> bool:
-        """Advance the unit; log and return ``False`` if it refuses the step."""
+        """Advance the unit; log and return ``False`` if it refuses the step.
+
+        Parameters
+        ----------
+        current_time : float
+            Communication point the step starts at, s.
+        step_size : float
+            Communication step, s.
+
+        Returns
+        -------
+        bool
+            True if the step was taken; False if refused (fmi2Discard).
+        """
         self._require("fmi2DoStep", Phase.step)
         self._check_step(current_time, step_size)
         result = self.unit.timed_advance(current_time, step_size)

@@ -50,12 +50,24 @@ class BuildInfo:
     fingerprint: str
 
     def write(self, path: Path) -> None:
-        """Write as JSON to ``path``."""
+        """Write as JSON to ``path``.
+
+        Parameters
+        ----------
+        path : pathlib.Path
+            File to write.
+        """
         path.write_text(json.dumps(asdict(self), indent=2) + "\n", encoding="utf-8")
 
     @classmethod
     def read(cls, path: Path) -> BuildInfo:
-        """Read a record written by :meth:`write`."""
+        """Read a record written by :meth:`write`.
+
+        Parameters
+        ----------
+        path : pathlib.Path
+            A file written by :meth:`write`.
+        """
         data = json.loads(path.read_text(encoding="utf-8"))
         return cls(**{k: str(data[k]) for k in ("fmu", "module", "version", "fingerprint")})
 

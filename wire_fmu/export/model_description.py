@@ -63,7 +63,13 @@ _TIMING_UNIT = output(PHYSICS_SECONDS, "s", _TIMING_DESCRIPTION)  # its unit is 
 
 
 def check_units(unit_class: type[Unit]) -> list[str]:
-    """Problems with the units of ``unit_class``'s Reals (empty when all known)."""
+    """Problems with the units of ``unit_class``'s Reals (empty when all known).
+
+    Parameters
+    ----------
+    unit_class : type of Unit
+        The unit class whose Real variables are checked.
+    """
     return [
         f"{unit_class.NAME}.{v.name}: unit {v.unit!r} is not defined in "
         "wire_fmu.export.units.UNITS; use a listed unit or add it to the table"

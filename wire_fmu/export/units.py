@@ -114,6 +114,11 @@ UNITS: dict[str, UnitDefinition] = {
 def unit_definition(name: str) -> UnitDefinition:
     """The definition of unit ``name``.
 
+    Parameters
+    ----------
+    name : str
+        FMI unit name, e.g. ``"N.m"``.
+
     Raises
     ------
     KeyError

@@ -64,7 +64,13 @@ class EndStopSpec:
     restitution: float
 
     def problems(self, stroke: float) -> list[str]:
-        """Every problem with the parameters, as sentences."""
+        """Every problem with the parameters, as sentences.
+
+        Parameters
+        ----------
+        stroke : float
+            Cylinder stroke, m.
+        """
         out: list[str] = []
         check_positive("cushion_length", self.cushion_length, out, "m", zero_ok=True)
         check_positive(
@@ -81,7 +87,13 @@ class EndStopSpec:
         return out
 
     def damping(self, mass: float) -> float:
-        """Stop dashpot ``2 zeta sqrt(k m)`` giving the set restitution for ``mass`` (kg), N s/m."""
+        """Stop dashpot ``2 zeta sqrt(k m)`` giving the set restitution for ``mass`` (kg), N s/m.
+
+        Parameters
+        ----------
+        mass : float
+            Moving mass that meets the stop, kg.
+        """
         zeta = damping_ratio_for_restitution(self.restitution)
         return 2.0 * zeta * math.sqrt(self.stiffness * mass)
 
@@ -106,7 +118,13 @@ def restitution_of_damping_ratio(zeta: float) -> float:
 
 
 def damping_ratio_for_restitution(restitution: float) -> float:
-    """Damping ratio whose force-release contact has ``restitution`` (0 < e <= 1), 1."""
+    """Damping ratio whose force-release contact has ``restitution`` (0 < e <= 1), 1.
+
+    Parameters
+    ----------
+    restitution : float
+        Coefficient of restitution, 1.
+    """
     if restitution >= 1.0:
         return 0.0
     upper = 1.0

@@ -61,7 +61,13 @@ class SealSpec:
         return out
 
     def sliding(self, velocity: float) -> float:
-        """Sliding friction magnitude at ``velocity`` (m/s), N (viscous part excluded)."""
+        """Sliding friction magnitude at ``velocity`` (m/s), N (viscous part excluded).
+
+        Parameters
+        ----------
+        velocity : float
+            Rod sliding velocity, m/s.
+        """
         if self.stribeck_velocity <= 0.0:
             return self.coulomb
         decay = math.exp(-((velocity / self.stribeck_velocity) ** 2))

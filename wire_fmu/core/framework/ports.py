@@ -119,6 +119,13 @@ def port(
     """
 
     def full(variable: str | None) -> str | None:
+        """``variable`` under the port's name unless it has a dot (None stays None).
+
+        Parameters
+        ----------
+        variable : str or None
+            Short or full variable name.
+        """
         return variable if variable is None or "." in variable else f"{name}.{variable}"
 
     return Port(name, kind, side, full(effort), full(flow), full(position), description)

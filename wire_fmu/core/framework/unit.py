@@ -143,7 +143,30 @@ def parameter(
     min: float | None = None,  # noqa: A002
     max: float | None = None,  # noqa: A002
 ) -> Variable:
-    """Declare a parameter (``fixed`` unless ``fixed=False``)."""
+    """Declare a parameter (``fixed`` unless ``fixed=False``).
+
+    Parameters
+    ----------
+    name : str
+        Variable name (``port.quantity`` for a port's variables).
+    start : Any
+        Start value, in ``unit`` for a Real.
+    unit : str
+        Unit symbol in FMI form (``"N"``, ``"m/s"``, ``"1"``); ignored for non-Reals.
+    description : str
+        One sentence, for humans.
+    type : type
+        ``float``, ``int``, ``bool`` or ``str``.
+    fixed : bool
+        True: settable only before initialisation; False: tunable.
+    min, max : float or None
+        Bounds of a Real, in ``unit``; None for none.
+
+    Returns
+    -------
+    Variable
+        The declaration.
+    """
     return Variable(
         name,
         Causality.parameter,
@@ -165,7 +188,26 @@ def input_(
     *,
     type: type = float,  # noqa: A002
 ) -> Variable:
-    """Declare an input."""
+    """Declare an input.
+
+    Parameters
+    ----------
+    name : str
+        Variable name (``port.quantity`` for a port's variables).
+    start : Any
+        Start value, in ``unit`` for a Real.
+    unit : str
+        Unit symbol in FMI form (``"N"``, ``"m/s"``, ``"1"``); ignored for non-Reals.
+    description : str
+        One sentence, for humans.
+    type : type
+        ``float`` (continuous), or ``int``, ``bool``, ``str`` (discrete).
+
+    Returns
+    -------
+    Variable
+        The declaration.
+    """
     variability = Variability.continuous if type is float else Variability.discrete
     return Variable(
         name,
@@ -187,7 +229,28 @@ def output(
     type: type = float,  # noqa: A002
     start: Any = None,
 ) -> Variable:
-    """Declare an output and the inputs it depends on directly."""
+    """Declare an output and the inputs it depends on directly.
+
+    Parameters
+    ----------
+    name : str
+        Variable name (``port.quantity`` for a port's variables).
+    unit : str
+        Unit symbol in FMI form (``"N"``, ``"m/s"``, ``"1"``); ignored for non-Reals.
+    description : str
+        One sentence, for humans.
+    depends_on : tuple of str
+        The inputs this output depends on directly within one step (direct feedthrough).
+    type : type
+        ``float`` (continuous), or ``int``, ``bool``, ``str`` (discrete).
+    start : Any
+        Start value; None for the type's zero value (``type()``).
+
+    Returns
+    -------
+    Variable
+        The declaration.
+    """
     variability = Variability.continuous if type is float else Variability.discrete
     if start is None:
         start = type()
@@ -251,7 +314,18 @@ class Unit(ABC):
 
     @classmethod
     def variable(cls, name: str) -> Variable:
-        """The declared variable called ``name``."""
+        """The declared variable called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Variable name.
+
+        Raises
+        ------
+        KeyError
+            If the unit declares no such variable; the message lists the known ones.
+        """
         for var in cls.VARIABLES:
             if var.name == name:
                 return var
@@ -294,7 +368,13 @@ class Unit(ABC):
 
     @abstractmethod
     def initialize(self, start_time: float) -> None:
-        """Set the initial state from parameters and inputs; fill outputs."""
+        """Set the initial state from parameters and inputs; fill outputs.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
 
     def advance(self, time: float, step: float) -> StepResult:
         """Advance from ``time`` by ``step`` (s) with the inputs held: the life cycle all share.
@@ -355,7 +435,13 @@ class Unit(ABC):
         raise NotImplementedError(f"{type(self).__name__} fills no outputs")
 
     def non_finite_inputs(self, names: Sequence[str]) -> list[str]:
-        """A problem naming the inputs among ``names`` that are not finite (or none)."""
+        """A problem naming the inputs among ``names`` that are not finite (or none).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Names of the inputs to check (their values in :attr:`values`).
+        """
         bad = [n for n in names if not math.isfinite(float(self.values[n]))]
         return [f"inputs {bad} are not finite"] if bad else []
 
@@ -377,7 +463,13 @@ class Unit(ABC):
 
     @abstractmethod
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state returned by :meth:`get_state`."""
+        """Restore a state returned by :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state returned by :meth:`get_state` of this unit.
+        """
 
     def evaluate_outputs(self) -> None:
         """Recompute direct-feedthrough outputs for the inputs now in :attr:`values`.
@@ -424,7 +516,15 @@ class HeldInputsUnit(Unit):
     """
 
     def initialize(self, start_time: float) -> None:
-        """Initial state for the parameters and inputs set; outputs filled."""
+        """Initial state for the parameters and inputs set; outputs filled.
+
+        Implements :meth:`Unit.initialize`.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
         model = self._require_model()
         model.initialize(start_time, self._inputs())
         self.time = start_time
@@ -464,23 +564,72 @@ class OdeView(ABC):
 
     @abstractmethod
     def set_state(self, x: Any, t: float) -> None:
-        """Adopt ``x`` at time ``t`` (and refresh the outputs)."""
+        """Adopt ``x`` at time ``t`` (and refresh the outputs).
+
+        Parameters
+        ----------
+        x : array_like
+            Continuous state (see :attr:`state`).
+        t : float
+            Time, s.
+        """
 
     @abstractmethod
     def bind_inputs(self, t: float) -> None:
-        """Take the inputs now in ``values`` as their values at ``t``."""
+        """Take the inputs now in ``values`` as their values at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time the inputs hold at, s.
+        """
 
     @abstractmethod
     def publish(self, t: float, x: Any) -> None:
-        """Write the outputs of state ``x`` at ``t`` into ``values``."""
+        """Write the outputs of state ``x`` at ``t`` into ``values``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            Continuous state (see :attr:`state`).
+        """
 
     @abstractmethod
     def rhs(self, t: float, x: Any) -> Any:
-        """State derivative."""
+        """State derivative.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            Continuous state (see :attr:`state`).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``dx/dt``, in the layout of ``x``.
+        """
 
     @abstractmethod
     def guards(self, t: float, x: Any) -> Any:
-        """Guard values."""
+        """Guard values.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            Continuous state (see :attr:`state`).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per guard; a guard fires when it crosses zero in its direction
+            (:meth:`guard_directions`).
+        """
 
     @abstractmethod
     def guard_directions(self) -> Any:
@@ -488,16 +637,54 @@ class OdeView(ABC):
 
     @abstractmethod
     def handle_events(self, t: float, x: Any, fired: list[int]) -> Any:
-        """Switch modes; return the projected state."""
+        """Switch modes; return the projected state.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            Continuous state (see :attr:`state`).
+        fired : list of int
+            Indices of the guards that fired at ``t``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state after the switches, projected.
+        """
 
     @abstractmethod
     def project(self, x: Any) -> Any:
-        """Enforce the mode's invariants."""
+        """Enforce the mode's invariants.
+
+        Parameters
+        ----------
+        x : array_like
+            Continuous state (see :attr:`state`).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state satisfying the invariants (it may be ``x``, changed in place).
+        """
 
     def reconcile(self, t: float, x: Any) -> Any:
         """Inputs jumped at ``t`` (an event): settle modes, act on commands; return the state.
 
         The default changes nothing.
+
+        Parameters
+        ----------
+        t : float
+            Time of the input jump, s.
+        x : array_like
+            Continuous state at ``t`` (see :attr:`state`).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state to continue from.
         """
         return x
 
@@ -522,14 +709,34 @@ class ModelOdeView(OdeView):
         return self.model.state.copy()
 
     def set_state(self, x: Any, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        """Adopt ``x`` at ``t`` and refresh the outputs.
+
+        Implements :meth:`OdeView.set_state`.
+
+        Parameters
+        ----------
+        x : array_like
+            The model's state vector.
+        t : float
+            Time, s.
+        """
         self.model.state = np.array(x, dtype=float)
         self.unit.time = t
         self.bind_inputs(t)
         self.unit._update_outputs()
 
     def publish(self, t: float, x: Any) -> None:
-        """Outputs of ``x`` at ``t`` into ``values``; the state is left alone."""
+        """Outputs of ``x`` at ``t`` into ``values``; the state is left alone.
+
+        Implements :meth:`OdeView.publish`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            The model's state vector.
+        """
         saved, self.model.state = self.model.state, np.asarray(x, dtype=float)
         saved_time, self.unit.time = self.unit.time, t
         try:
@@ -538,11 +745,31 @@ class ModelOdeView(OdeView):
             self.model.state, self.unit.time = saved, saved_time
 
     def rhs(self, t: float, x: Any) -> Any:
-        """The model's state derivative."""
+        """The model's state derivative.
+
+        Implements :meth:`OdeView.rhs`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            The model's state vector.
+        """
         return self.model.rhs(t, x)
 
     def guards(self, t: float, x: Any) -> Any:
-        """The model's guards."""
+        """The model's guards.
+
+        Implements :meth:`OdeView.guards`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            The model's state vector.
+        """
         return self.model.guards(t, x)
 
     def guard_directions(self) -> Any:
@@ -550,14 +777,40 @@ class ModelOdeView(OdeView):
         return self.model.guard_directions()
 
     def handle_events(self, t: float, x: Any, fired: list[int]) -> Any:
-        """The model's mode switches."""
+        """The model's mode switches.
+
+        Implements :meth:`OdeView.handle_events`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : array_like
+            The model's state vector.
+        fired : list of int
+            Indices of the guards that fired at ``t``.
+        """
         return self.model.handle_events(t, x, fired)
 
     def project(self, x: Any) -> Any:
-        """The model's invariants."""
+        """The model's invariants.
+
+        Implements :meth:`OdeView.project`.
+
+        Parameters
+        ----------
+        x : array_like
+            The model's state vector.
+        """
         return self.model.project(x)
 
 
 def is_finite(value: float) -> bool:
-    """True for a finite float (helper for output checks)."""
+    """True for a finite float (helper for output checks).
+
+    Parameters
+    ----------
+    value : float
+        The value to check.
+    """
     return math.isfinite(value)

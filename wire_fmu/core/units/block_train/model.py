@@ -174,6 +174,13 @@ class BlockTrainModel(ReevedPath):
 
     @broken.setter
     def broken(self, value: list[bool]) -> None:
+        """Set which rope spans have broken.
+
+        Parameters
+        ----------
+        value : list of bool
+            One flag per rope span, True if broken.
+        """
         self.broken_mask = np.array(value, dtype=bool)
 
     # ---------------------------------------------------------- state layout
@@ -213,7 +220,15 @@ class BlockTrainModel(ReevedPath):
         )
 
     def set_inputs(self, t: float, inputs: BlockTrainInputs) -> None:
-        """Hold ``inputs`` from time ``t`` on (positions advance with their rates)."""
+        """Hold ``inputs`` from time ``t`` on (positions advance with their rates).
+
+        Parameters
+        ----------
+        t : float
+            Time from which the inputs hold, s.
+        inputs : BlockTrainInputs
+            Line payouts and mover positions at ``t``, with their rates.
+        """
         self.inputs = inputs
         self._t_step = t
         self._line_s0 = self.line_sign * np.array([inputs.payout.get(p, 0.0) for p in LINE_PORTS])
@@ -224,7 +239,20 @@ class BlockTrainModel(ReevedPath):
         self._mover_v = np.array([inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports])
 
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Geometric span lengths (m) and their Jacobian w.r.t. body motion."""
+        """Geometric span lengths (m) and their Jacobian w.r.t. body motion.
+
+        Parameters
+        ----------
+        y : numpy.ndarray
+            Body displacements along their directions, m: the blocks, then the driven bodies.
+
+        Returns
+        -------
+        lengths : numpy.ndarray
+            Geometric length of each span, m.
+        jacobian : numpy.ndarray
+            ``d lengths / d y``, one row per span and one column per body, 1.
+        """
         if not self.moving:
             seg = self.segment_length0 + self.length_jacobian0 @ y
             return self.span_matrix @ seg, self.span_matrix @ self.length_jacobian0
@@ -243,7 +271,25 @@ class BlockTrainModel(ReevedPath):
 
     # -------------------------------------------------------------- physics
     def evaluate(self, t: float, x: np.ndarray) -> dict:
-        """Everything the model knows at (t, x): forces, tensions, energies."""
+        """Everything the model knows at (t, x): forces, tensions, energies.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+
+        Returns
+        -------
+        dict
+            By name: generalised ``forces`` on the coordinates (N), span ``tension`` (N)
+            and ``stretch`` (m), ``line_force`` at the line ends (N), ``body_force`` on
+            the bodies (N), floor ``depth`` (m) and ``contact``/``trial_contact`` forces
+            (N), ``rope_energy``/``span_energy``/``potential`` (J), ``loss`` power (W),
+            the rope forces ``rope``, body displacements ``y`` (m) and velocities
+            ``ydot`` (m/s).
+        """
         n, nb = self.n_coords, len(self.blocks)
         q, v = x[:n], x[n : 2 * n]
         dt = t - self._t_step
@@ -326,7 +372,15 @@ class BlockTrainModel(ReevedPath):
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """State derivative: [q', v', dissipated', external work']."""
+        """State derivative: [q', v', dissipated', external work'].
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+        """
         n = self.n_coords
         ev = self.evaluate(t, x)
         v = x[n : 2 * n]
@@ -352,7 +406,21 @@ class BlockTrainModel(ReevedPath):
         return self._guard_dirs
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Friction links, slack/taut ropes, floor contact, rope break (all fire below 0)."""
+        """Friction links, slack/taut ropes, floor contact, rope break (all fire below 0).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+
+        Returns
+        -------
+        numpy.ndarray
+            Guard values: friction links, then rope spans (slack/taut), floors and
+            breaking loads (N).
+        """
         n = self.n_coords
         ev = self.evaluate(t, x)
         caps = self._capacities(ev["tension"])
@@ -373,7 +441,23 @@ class BlockTrainModel(ReevedPath):
         return np.concatenate([g_links, g_rope, g_floor, breaking])
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Switch friction, slack/taut and contact modes; break ropes."""
+        """Switch friction, slack/taut and contact modes; break ropes.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+        fired : list of int
+            Indices of the guards that fired at ``t`` (order of :meth:`guards`).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state after the switches, projected; a broken span's strain energy is
+            booked as dissipated.
+        """
         n_links = len(self.friction.links)
         n_spans = len(self.spans)
         x = np.array(x, dtype=float)
@@ -441,7 +525,18 @@ class BlockTrainModel(ReevedPath):
         self.last_events.append(f"rope span {i} broke")
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """Hold coordinates stuck to the ground exactly where they stuck, at rest."""
+        """Hold coordinates stuck to the ground exactly where they stuck, at rest.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]``, changed in place.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x``.
+        """
         if self.friction.links:
             held = self.friction.stuck_to_ground()
             if held.size:
@@ -458,6 +553,22 @@ class BlockTrainModel(ReevedPath):
         With ``equilibrium`` and at least one block, the rope is stretched so
         that every block hangs at rest where the reeving puts it; otherwise
         every span starts at ``pretension`` (N). Returns the initial tension.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time, s.
+        inputs : BlockTrainInputs
+            Inputs at ``t0``.
+        equilibrium : bool
+            Stretch the rope so that the blocks hang at rest.
+        pretension : float
+            Tension of every span without ``equilibrium`` (or without blocks), N.
+
+        Returns
+        -------
+        float
+            The initial rope tension, N.
 
         Raises
         ------
@@ -523,6 +634,22 @@ class BlockTrainModel(ReevedPath):
         """Advance the state from ``t`` by ``h`` with ``inputs`` held; return events.
 
         ``break_segment`` (0-based), if given, breaks that segment's span at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        inputs : BlockTrainInputs
+            Inputs at ``t``, held over the step (positions advance with their rates).
+        break_segment : int or None
+            Segment (0-based) whose span breaks at ``t``; None for none.
+
+        Returns
+        -------
+        int
+            Number of events the solver located in the step.
         """
         self.last_events = []
         before = self._input_energy(t)
@@ -555,7 +682,13 @@ class BlockTrainModel(ReevedPath):
         }
 
     def restore_held_inputs(self, data: dict) -> None:
-        """Restore inputs saved by :meth:`held_inputs`."""
+        """Restore inputs saved by :meth:`held_inputs`.
+
+        Parameters
+        ----------
+        data : dict
+            Inputs as returned by :meth:`held_inputs`.
+        """
         inputs = BlockTrainInputs(
             {k: float(v) for k, v in data["payout"].items()},
             {k: float(v) for k, v in data["payout_rate"].items()},
@@ -566,7 +699,13 @@ class BlockTrainModel(ReevedPath):
 
     # ----------------------------------------------------------- energy
     def stored_energy(self, t: float | None = None) -> float:
-        """Kinetic + strain + gravitational + contact energy, J."""
+        """Kinetic + strain + gravitational + contact energy, J.
+
+        Parameters
+        ----------
+        t : float or None
+            Time the held inputs are evaluated at, s; None for the start of the held step.
+        """
         t = self._t_step if t is None else t
         ev = self.evaluate(t, self.state)
         kinetic = 0.5 * float(self.masses @ self.v**2)

@@ -102,7 +102,13 @@ class ReevedPath:
         return Circle(f"{node.kind} {node.name!r}", tuple(np.array(point) + shift), axis, 0.0), 0
 
     def path_nodes(self, displacement: dict[str, float]) -> list[PathNode]:
-        """Geometric path nodes for given body displacements (m)."""
+        """Geometric path nodes for given body displacements (m).
+
+        Parameters
+        ----------
+        displacement : dict of str to float
+            Displacement of each body along its direction, m (absent bodies: 0).
+        """
         return [PathNode(*self._node_circle(k, displacement)) for k in range(self.n_nodes)]
 
     def _segment_lengths(self, displacement: dict[str, float], validate: bool = False):

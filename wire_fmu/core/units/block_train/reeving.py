@@ -164,7 +164,18 @@ class Reeving:
     source: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def node_body(self, element: PathElement) -> str:
-        """The body a path node is fixed to."""
+        """The body a path node is fixed to.
+
+        Parameters
+        ----------
+        element : PathElement
+            A node of :attr:`path`.
+
+        Returns
+        -------
+        str
+            The body's name (``"ground"`` if fixed).
+        """
         if element.kind == "sheave":
             return self.sheaves[element.name].body
         if element.kind == "anchor":
@@ -172,7 +183,13 @@ class Reeving:
         return element.body
 
     def carriers(self, body: str) -> list[str]:
-        """``body`` and the bodies it rides on, innermost first (ground excluded)."""
+        """``body`` and the bodies it rides on, innermost first (ground excluded).
+
+        Parameters
+        ----------
+        body : str
+            Body name (``"ground"`` gives none).
+        """
         chain = []
         while body != "ground":
             chain.append(body)
@@ -180,7 +197,13 @@ class Reeving:
         return chain
 
     def bodies_of_kind(self, kind: str) -> list[Body]:
-        """Bodies of one kind, in declaration order."""
+        """Bodies of one kind, in declaration order.
+
+        Parameters
+        ----------
+        kind : str
+            ``"block"`` or ``"driven"``.
+        """
         return [b for b in self.bodies.values() if b.kind == kind]
 
 
@@ -191,6 +214,15 @@ class _Problems:
         self.items: list[str] = []
 
     def add(self, where: str, text: str) -> None:
+        """Record ``text`` as a problem at ``where``.
+
+        Parameters
+        ----------
+        where : str
+            The element at fault, e.g. ``"sheave 'crown_0'"``.
+        text : str
+            The problem.
+        """
         self.items.append(f"{where}: {text}")
 
     def number(
@@ -205,6 +237,30 @@ class _Problems:
         at_most: float | None = None,
         finite: bool = True,
     ) -> float:
+        """A number ``data[key]``; a problem recorded if missing, not a number or out of range.
+
+        Parameters
+        ----------
+        data : mapping
+            The description holding the number.
+        key : str
+            Its key.
+        where : str
+            The element, for the problem's text.
+        default : Any
+            Value when ``key`` is absent; None makes it required.
+        positive, nonnegative : bool
+            Require ``> 0``, ``>= 0``.
+        at_most : float or None
+            Upper bound; None for none.
+        finite : bool
+            Require a finite value.
+
+        Returns
+        -------
+        float
+            The value (NaN if missing or not a number).
+        """
         value = data.get(key, default)
         if value is None:
             self.add(where, f"'{key}' is required")
@@ -232,6 +288,26 @@ class _Problems:
     def vector(
         self, data: Mapping, key: str, where: str, default: Any = None, *, unit: bool = False
     ) -> Vector:
+        """Three finite numbers ``data[key]`` as a vector; a problem recorded otherwise.
+
+        Parameters
+        ----------
+        data : mapping
+            The description holding the vector.
+        key : str
+            Its key.
+        where : str
+            The element, for the problem's text.
+        default : Any
+            Value when ``key`` is absent.
+        unit : bool
+            Normalise to unit length (the zero vector is a problem).
+
+        Returns
+        -------
+        Vector
+            The vector (NaNs if invalid).
+        """
         value = data.get(key, default)
         try:
             if any(isinstance(c, bool) or not isinstance(c, int | float) for c in value):
@@ -253,6 +329,13 @@ class _Problems:
 
 def parse_reeving(data: Mapping[str, Any]) -> Reeving:
     """Validate a reeving description and build a :class:`Reeving`.
+
+    Parameters
+    ----------
+    data : mapping
+        The description: ``rope``, ``gravity`` (m/s^2), ``bodies``, ``sheaves``,
+        ``anchors``, ``path``, optional ``max_fleet_angle_deg`` (deg), ``name``,
+        ``description`` (lengths in m, masses in kg, forces in N).
 
     Raises
     ------
@@ -406,6 +489,19 @@ def _parse_on_bodies(
 
 def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, SheaveSpec]:
     def sheave(name: str, body: str, spec: Mapping, where: str) -> SheaveSpec:
+        """A :class:`SheaveSpec` from its description.
+
+        Parameters
+        ----------
+        name : str
+            Sheave name.
+        body : str
+            Body it is fixed to.
+        spec : mapping
+            Its description (centre and radius in m, inertia in kg m^2, bearing torque in N m).
+        where : str
+            The sheave, for the problems' text.
+        """
         return SheaveSpec(
             name,
             body,
@@ -428,6 +524,19 @@ def _efficiency(spec: Mapping, where: str, p: _Problems) -> float:
 
 def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, AnchorSpec]:
     def anchor(name: str, body: str, spec: Mapping, where: str) -> AnchorSpec:
+        """An :class:`AnchorSpec` from its description.
+
+        Parameters
+        ----------
+        name : str
+            Anchor name.
+        body : str
+            Body it is fixed to.
+        spec : mapping
+            Its description (``point``, m).
+        where : str
+            The anchor, for the problems' text.
+        """
         return AnchorSpec(name, body, p.vector(spec, "point", where))
 
     return _parse_on_bodies(data, "anchor", bodies, p, anchor)

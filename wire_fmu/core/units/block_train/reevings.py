@@ -30,7 +30,13 @@ GRAVITY = (0.0, -9.81, 0.0)
 
 
 def drilling_line(damping: float = 1.2e5) -> dict[str, float]:
-    """A 1-1/2 in 6x19 IWRC drilling line (see module docstring)."""
+    """A 1-1/2 in 6x19 IWRC drilling line (see module docstring).
+
+    Parameters
+    ----------
+    damping : float
+        Kelvin-Voigt coefficient of the rope, N s.
+    """
     return {
         "axial_stiffness": 5.8e7,
         "damping": damping,
@@ -122,6 +128,13 @@ def heave_compensated_block_train(n_lines: int = 10, **kwargs: Any) -> dict[str,
     ``mover_a`` (rod displacement relative to the deck, up); the travelling
     block with the hook load hangs in the rope. Keyword arguments go to
     :func:`drilling_block_train`.
+
+    Parameters
+    ----------
+    n_lines : int
+        Even number of lines between crown and travelling block.
+    **kwargs : Any
+        Further arguments of :func:`drilling_block_train` (masses in kg, lengths in m).
     """
     reeving = drilling_block_train(n_lines, **kwargs)
     reeving["name"] = f"{n_lines}-line block train with crown-mounted heave compensator"
@@ -236,6 +249,19 @@ def single_fall(
 
     The simplest reeving: a mass ``mass`` (kg) hangs ``length`` (m) below
     the top on a rope of stiffness ``axial_stiffness`` (N).
+
+    Parameters
+    ----------
+    mass : float
+        Hanging mass, kg.
+    length : float
+        Rope length from the top down to the block, m.
+    axial_stiffness : float
+        Rope axial stiffness ``EA``, N.
+    damping : float
+        Kelvin-Voigt coefficient of the rope, N s.
+    line_end : bool
+        True: the top is the line end ``line_a``; False: the anchor ``top``.
     """
     top = {"line_end": "line_a", "point": [0.0, length, 0.0]} if line_end else {"anchor": "top"}
     return {

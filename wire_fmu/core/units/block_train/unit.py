@@ -210,7 +210,15 @@ class BlockTrainUnit(Unit):
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
 
     def initialize(self, start_time: float) -> None:
-        """Rope stretched for equilibrium (or pretension); outputs filled."""
+        """Rope stretched for equilibrium (or pretension); outputs filled.
+
+        Implements :meth:`Unit.initialize`.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
         model = self._require_model()
         segment = self.values["break_segment"]
         if not 0 <= segment <= model.n_segments:
@@ -303,7 +311,13 @@ class BlockTrainUnit(Unit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state returned by :meth:`get_state` of this unit.
+        """
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.offsets = np.array(state["offsets"], dtype=float)
@@ -368,11 +382,32 @@ class _BlockTrainOde(ModelOdeView):
     """:class:`BlockTrainUnit` as a piece of a monolithic ODE."""
 
     def bind_inputs(self, t: float) -> None:
-        """Inputs in ``values`` are the values at ``t``."""
+        """Inputs in ``values`` are the values at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        """
         self.model.set_inputs(t, self.unit._inputs())
 
     def reconcile(self, t, x):
-        """Break a commanded segment, then settle contact and friction modes."""
+        """Break a commanded segment, then settle contact and friction modes.
+
+        Implements :meth:`OdeView.reconcile`.
+
+        Parameters
+        ----------
+        t : float
+            Time of the input jump, s.
+        x : numpy.ndarray
+            The model's state at ``t``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state to continue from.
+        """
         m = self.model
         m.state = np.array(x, dtype=float)
         self.bind_inputs(t)

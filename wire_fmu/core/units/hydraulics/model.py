@@ -207,13 +207,34 @@ class HydraulicsModel(RefinedStepping):
 
     # ------------------------------------------------------------ evaluation
     def gas_volume(self, x: np.ndarray) -> float:
-        """Gas volume at state ``x``, m^3."""
+        """Gas volume at state ``x``, m^3.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        """
         if self.layout.gas_volume >= 0:
             return float(x[self.layout.gas_volume])
         return self.oil_constant + self.sa * float(x[0])
 
     def evaluate(self, x: np.ndarray, energy: bool = False) -> _Point:
-        """Pressures, flow, forces, losses (and stored energy if ``energy``) at state ``x``."""
+        """Pressures, flow, forces, losses (and stored energy if ``energy``) at state ``x``.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        energy : bool
+            Also compute the stored energy (J).
+
+        Returns
+        -------
+        _Point
+            Rod position (m) and velocity (m/s), gas volume (m^3) and pressure (Pa),
+            chamber pressure (Pa), line flow (m^3/s), forces on the rod (N), stop
+            depths (m), loss power (W) and stored energy (J, 0 without ``energy``).
+        """
         pos, vel = float(x[0]), float(x[1])
         v_gas = self.gas_volume(x)
         dead = self.spec.accumulator.dead_volume
@@ -298,14 +319,30 @@ class HydraulicsModel(RefinedStepping):
         return self.seal.accelerate(point.force, point.v)
 
     def chamber_pressure(self, point: _Point, acceleration: float) -> float:
-        """Pressure at the cylinder port, Pa (includes ``-L dq/dt`` of an incompressible column)."""
+        """Pressure at the cylinder port, Pa (includes ``-L dq/dt`` of an incompressible column).
+
+        Parameters
+        ----------
+        point : _Point
+            The model at a state (:meth:`evaluate`).
+        acceleration : float
+            Rod acceleration, m/s^2.
+        """
         if self.has_inertance and not self.compressible:
             return point.chamber_pressure - self.inertance * self.sa * acceleration
         return point.chamber_pressure
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        """State derivative: ``[x', v', (V_g', p_c', q'), dissipated']``."""
+        """State derivative: ``[x', v', (V_g', p_c', q'), dissipated']``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        """
         point = self.evaluate(x)
         acc, _, friction_loss = self._accelerate(point)
         lay = self.layout
@@ -328,7 +365,21 @@ class HydraulicsModel(RefinedStepping):
         return self._directions
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Seal stick/slip, limits, stop contact and cushion zones (see :meth:`_guard`)."""
+        """Seal stick/slip, limits, stop contact and cushion zones (see :meth:`_guard`).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per guard (seal, gas, cavitation, stroke or stops); see
+            :meth:`guard_directions`.
+        """
         point = self.evaluate(x)
         acc, link, _ = self._accelerate(point)
         return np.array(
@@ -350,7 +401,27 @@ class HydraulicsModel(RefinedStepping):
         return self.stops.guard(kind, end, point.x, point.depth, point.trial)
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Refuse at a limit; otherwise switch contact, cushion and seal modes."""
+        """Refuse at a limit; otherwise switch contact, cushion and seal modes.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        fired : list of int
+            Indices of the guards that fired at ``t``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state after the switches, projected.
+
+        Raises
+        ------
+        HydraulicLimitError
+            If a limit guard fired.
+        """
         x = np.array(x, dtype=float)
         seal_fired = []
         kinks_only = True
@@ -375,7 +446,19 @@ class HydraulicsModel(RefinedStepping):
         return x
 
     def project(self, x: np.ndarray) -> np.ndarray:
-        """Hold a stuck rod exactly where it stuck, at rest."""
+        """Hold a stuck rod exactly where it stuck, at rest.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J),
+            changed in place.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x``.
+        """
         if self.seal is not None and self.seal.stuck:
             x[0] = self.seal.held_position
             x[1] = 0.0
@@ -393,7 +476,15 @@ class HydraulicsModel(RefinedStepping):
         return x
 
     def check_limits(self, t: float, x: np.ndarray) -> None:
-        """Raise :class:`HydraulicLimitError` if a limit guard is already violated at ``x``."""
+        """Raise :class:`HydraulicLimitError` if a limit guard is already violated at ``x``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        """
         point = self.evaluate(x)
         acc, link, _ = self._accelerate(point)
         for kind, end in self._guard_kinds:
@@ -403,7 +494,13 @@ class HydraulicsModel(RefinedStepping):
 
     # ---------------------------------------------------------- initial state
     def equilibrium_pressure(self, force: float) -> float:
-        """Absolute chamber pressure holding the rod at rest against ``force`` (N), Pa."""
+        """Absolute chamber pressure holding the rod at rest against ``force`` (N), Pa.
+
+        Parameters
+        ----------
+        force : float
+            External force on the rod along extension (positive pushes it out), N.
+        """
         weight = self.cyl.moving_mass * self.cyl.gravity_along_rod
         return self.cyl.ambient_pressure - (force + weight) / self.sa
 
@@ -414,6 +511,17 @@ class HydraulicsModel(RefinedStepping):
 
         The gas was charged slowly (isothermally) from the pre-charge to the
         initial pressure; from there on it follows ``p V^n = p0 V0^n``.
+
+        Parameters
+        ----------
+        force : float
+            External force on the rod along extension (positive pushes it out), N.
+        position : float
+            Rod extension, m.
+        velocity : float
+            Rod velocity along extension, m/s.
+        gas_pressure : float or None
+            Initial absolute gas pressure, Pa; None for static equilibrium with ``force``.
 
         Raises
         ------

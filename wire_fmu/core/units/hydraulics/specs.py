@@ -98,7 +98,13 @@ class CylinderSpec:
         return 1.0 if self.pressurised_side == "bore" else -1.0
 
     def chamber_volume(self, x: float) -> float:
-        """Oil volume of the pressurised chamber at extension ``x`` (m), m^3."""
+        """Oil volume of the pressurised chamber at extension ``x`` (m), m^3.
+
+        Parameters
+        ----------
+        x : float
+            Rod extension, m.
+        """
         length = x if self.pressurised_side == "bore" else self.stroke - x
         return self.chamber_dead_volume + self.working_area * length
 

@@ -87,6 +87,20 @@ class RefinedStepping:
     def advance(self, t: float, h: float, force: float) -> int:
         """Advance from ``t`` by ``h`` (s) with the rod ``force`` (N) held; return events.
 
+        Parameters
+        ----------
+        t : float
+            Start of the step, s.
+        h : float
+            Step length, s.
+        force : float
+            External force on the rod along extension (positive pushes it out), N.
+
+        Returns
+        -------
+        int
+            Number of events located in the step.
+
         Raises
         ------
         HydraulicLimitError
@@ -103,7 +117,13 @@ class RefinedStepping:
         return events
 
     def settle(self, x: np.ndarray) -> np.ndarray:
-        """Seal mode consistent with the force now held (it may have jumped); the new state."""
+        """Seal mode consistent with the force now held (it may have jumped); the new state.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The model's state (see :class:`HydraulicsModel`).
+        """
         before = self._seal_mode()
         x = self._settle_friction(np.array(x, dtype=float), [])
         self.mode_changes += int(self._seal_mode() != before)

@@ -379,7 +379,15 @@ class HydraulicsUnit(Unit):
         return out
 
     def initialize(self, start_time: float) -> None:
-        """Initial state (equilibrium or as given); outputs filled."""
+        """Initial state (equilibrium or as given); outputs filled.
+
+        Implements :meth:`Unit.initialize`.
+
+        Parameters
+        ----------
+        start_time : float
+            Start time, s.
+        """
         model = self._require_model()
         v = self.values
         pressure = None if bool(v["initial_equilibrium"]) else float(v["initial_gas_pressure"])
@@ -438,7 +446,13 @@ class HydraulicsUnit(Unit):
         }
 
     def set_state(self, state: Mapping[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`."""
+        """Restore a state from :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : mapping
+            A state returned by :meth:`get_state` of this unit.
+        """
         from wire_fmu.core.components.gas import PolytropicGas
 
         m = self._require_model()
@@ -515,7 +529,17 @@ class _HydraulicsOde(OdeView):
         return np.append(self.model.state, self.model.external_work)
 
     def set_state(self, x: np.ndarray, t: float) -> None:
-        """Adopt ``x`` at ``t`` and refresh the outputs."""
+        """Adopt ``x`` at ``t`` and refresh the outputs.
+
+        Implements :meth:`OdeView.set_state`.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        t : float
+            Time, s.
+        """
         self.model.state = np.array(x[:-1], dtype=float)
         self.model.external_work = float(x[-1])
         self.unit.time = t
@@ -523,11 +547,27 @@ class _HydraulicsOde(OdeView):
         self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
-        """``rod.force`` in ``values`` is the force at ``t``."""
+        """``rod.force`` in ``values`` is the force at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        """
         self.model.force = float(self.unit.values["rod.force"])
 
     def publish(self, t: float, x: np.ndarray) -> None:
-        """Outputs of ``x`` at ``t`` into ``values`` (state left alone)."""
+        """Outputs of ``x`` at ``t`` into ``values`` (state left alone).
+
+        Implements :meth:`OdeView.publish`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        """
         m = self.model
         saved = m.state, m.external_work, self.unit.time
         m.state, m.external_work, self.unit.time = np.asarray(x[:-1], dtype=float), float(x[-1]), t
@@ -537,12 +577,32 @@ class _HydraulicsOde(OdeView):
             m.state, m.external_work, self.unit.time = saved
 
     def rhs(self, t, x):
-        """Model derivative, then the power ``force * dx/dt`` into the rod port."""
+        """Model derivative, then the power ``force * dx/dt`` into the rod port.
+
+        Implements :meth:`OdeView.rhs`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        """
         derivative = self.model.rhs(t, x[:-1])
         return np.append(derivative, self.model.force * derivative[0])
 
     def guards(self, t, x):
-        """See :meth:`HydraulicsModel.guards`."""
+        """See :meth:`HydraulicsModel.guards`.
+
+        Implements :meth:`OdeView.guards`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        """
         return self.model.guards(t, x[:-1])
 
     def guard_directions(self):
@@ -550,15 +610,50 @@ class _HydraulicsOde(OdeView):
         return self.model.guard_directions()
 
     def handle_events(self, t, x, fired):
-        """See :meth:`HydraulicsModel.handle_events`."""
+        """See :meth:`HydraulicsModel.handle_events`.
+
+        Implements :meth:`OdeView.handle_events`.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        fired : list of int
+            Indices of the guards that fired at ``t``.
+        """
         return np.append(self.model.handle_events(t, x[:-1], fired), x[-1])
 
     def project(self, x):
-        """See :meth:`HydraulicsModel.project`."""
+        """See :meth:`HydraulicsModel.project`.
+
+        Implements :meth:`OdeView.project`.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+        """
         return np.append(self.model.project(np.array(x[:-1], dtype=float)), x[-1])
 
     def reconcile(self, t, x):
-        """The force jumped at ``t``: settle the seal's mode."""
+        """The force jumped at ``t``: settle the seal's mode.
+
+        Implements :meth:`OdeView.reconcile`.
+
+        Parameters
+        ----------
+        t : float
+            Time of the force jump, s.
+        x : numpy.ndarray
+            State ``[model state, external work]`` (see the class docstring).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state to continue from.
+        """
         self.bind_inputs(t)
         self.model.state = self.model.settle(x[:-1])
         return self.state
