@@ -89,6 +89,28 @@ _INITIAL = {
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
+def _fmi_access(fmi_name: str, access: Callable[..., Any]) -> Callable[..., Any]:
+    """Make pythonfmu's variable access ``access`` a facade method whose failures are logged.
+
+    Parameters
+    ----------
+    fmi_name : str
+        The FMI function (``"fmi2GetReal"``), for messages.
+    access : callable
+        The :class:`pythonfmu.Fmi2Slave` method: ``(self, vrs)`` for a get, ``(self, vrs,
+        values)`` for a set (value references and values in the variables' declared units).
+    """
+
+    def method(self: CoreFacade, *args: Any) -> Any:
+        return access(self, *args)
+
+    method.__name__ = access.__name__
+    method.__doc__ = (
+        f"{fmi_name}, as :meth:`pythonfmu.Fmi2Slave.{access.__name__}` (failures logged)."
+    )
+    return fmi_entry(fmi_name)(method)
+
+
 class FacadeError(WireFmuError, RuntimeError):
     """An FMI call the facade cannot honour (wrong phase, bad state, ...)."""
 
@@ -301,121 +323,15 @@ class CoreFacade(Fmi2Slave):
         elif self._phase is Phase.initialization:
             self._reconfigure = True
 
-    @fmi_entry("fmi2GetReal")
-    def get_real(self, vrs: list[int]) -> list[float]:  # noqa: D102
-        """fmi2GetReal: values of the Real variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-
-        Returns
-        -------
-        list of float
-            Their values, in the order of ``vrs`` (in their declared units).
-        """
-        return super().get_real(vrs)
-
-    @fmi_entry("fmi2GetInteger")
-    def get_integer(self, vrs: list[int]) -> list[int]:  # noqa: D102
-        """fmi2GetInteger: values of the Integer variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-
-        Returns
-        -------
-        list of int
-            Their values, in the order of ``vrs``.
-        """
-        return super().get_integer(vrs)
-
-    @fmi_entry("fmi2GetBoolean")
-    def get_boolean(self, vrs: list[int]) -> list[bool]:  # noqa: D102
-        """fmi2GetBoolean: values of the Boolean variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-
-        Returns
-        -------
-        list of bool
-            Their values, in the order of ``vrs``.
-        """
-        return super().get_boolean(vrs)
-
-    @fmi_entry("fmi2GetString")
-    def get_string(self, vrs: list[int]) -> list[str]:  # noqa: D102
-        """fmi2GetString: values of the String variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-
-        Returns
-        -------
-        list of str
-            Their values, in the order of ``vrs``.
-        """
-        return super().get_string(vrs)
-
-    @fmi_entry("fmi2SetReal")
-    def set_real(self, vrs: list[int], values: list[float]) -> None:  # noqa: D102
-        """fmi2SetReal: set the Real variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-        values : list of float
-            Their new values, in the order of ``vrs`` (in their declared units).
-        """
-        super().set_real(vrs, values)
-
-    @fmi_entry("fmi2SetInteger")
-    def set_integer(self, vrs: list[int], values: list[int]) -> None:  # noqa: D102
-        """fmi2SetInteger: set the Integer variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-        values : list of int
-            Their new values, in the order of ``vrs``.
-        """
-        super().set_integer(vrs, values)
-
-    @fmi_entry("fmi2SetBoolean")
-    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:  # noqa: D102
-        """fmi2SetBoolean: set the Boolean variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-        values : list of bool
-            Their new values, in the order of ``vrs``.
-        """
-        super().set_boolean(vrs, values)
-
-    @fmi_entry("fmi2SetString")
-    def set_string(self, vrs: list[int], values: list[str]) -> None:  # noqa: D102
-        """fmi2SetString: set the String variables ``vrs`` (failures logged).
-
-        Parameters
-        ----------
-        vrs : list of int
-            Value references.
-        values : list of str
-            Their new values, in the order of ``vrs``.
-        """
-        super().set_string(vrs, values)
+    # The FMU binary's variable access, each failure logged (fmi2GetReal ... fmi2SetString).
+    get_real = _fmi_access("fmi2GetReal", Fmi2Slave.get_real)
+    get_integer = _fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
+    get_boolean = _fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
+    get_string = _fmi_access("fmi2GetString", Fmi2Slave.get_string)
+    set_real = _fmi_access("fmi2SetReal", Fmi2Slave.set_real)
+    set_integer = _fmi_access("fmi2SetInteger", Fmi2Slave.set_integer)
+    set_boolean = _fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean)
+    set_string = _fmi_access("fmi2SetString", Fmi2Slave.set_string)
 
     # -- life cycle ---------------------------------------------------------------
     @fmi_entry("fmi2SetupExperiment")
