@@ -40,12 +40,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
-from wire_fmu.core.components.rope import rope_forces, slack_guard, taut_guard
+from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.units.block_train.modes import ModeSwitching
 from wire_fmu.core.units.block_train.path import ReevedPath
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
+from wire_fmu.core.units.block_train.start import StartingState
 
 __all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
 
@@ -84,7 +86,7 @@ class BlockTrainInputs:
     mover_velocity: dict[str, float]
 
 
-class BlockTrainModel(ReevedPath):
+class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
     """Hybrid ODE of a block train; see the module docstring.
 
     Parameters
@@ -394,238 +396,6 @@ class BlockTrainModel(ReevedPath):
         out[2 * n] = ev["loss"] + self.friction.loss_power(v, link_force)
         out[2 * n + 1] = self._external_power(ev)
         return out
-
-    def _guard_directions(self) -> np.ndarray:
-        n_links = len(self.friction.links)
-        dirs = [-1] * n_links + [0] * len(self.spans) + [0] * len(self.blocks)
-        dirs += [-1] * len(self.spans)
-        return np.array(dirs, dtype=float)
-
-    def guard_directions(self) -> np.ndarray:
-        """See :class:`~wire_fmu.core.framework.hybrid.HybridSystem`."""
-        return self._guard_dirs
-
-    def guards(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Friction links, slack/taut ropes, floor contact, rope break (all fire below 0).
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
-
-        Returns
-        -------
-        numpy.ndarray
-            Guard values: friction links, then rope spans (slack/taut), floors and
-            breaking loads (N).
-        """
-        n = self.n_coords
-        ev = self.evaluate(t, x)
-        caps = self._capacities(ev["tension"])
-        _, link_force = self.friction.accelerations(ev["forces"], caps)
-        g_links = self.friction.guards(x[n : 2 * n], link_force, caps)
-        rf = ev["rope"]
-        g_rope = np.where(self.taut_mask, taut_guard(rf), slack_guard(rf))
-        g_rope = np.where(self.broken_mask, 1.0, g_rope)
-        stiffness = np.array([b.floor.stiffness if b.floor else 0.0 for b in self.blocks])
-        g_floor = np.where(
-            self.contact_mask,
-            ev["trial_contact"],
-            np.maximum(-stiffness * ev["depth"], -ev["trial_contact"]),
-        )
-        g_floor = np.where(stiffness > 0.0, g_floor, 1.0)
-        breaking = self.rope.breaking_load - ev["tension"]
-        breaking = np.where(np.isfinite(breaking), breaking, 1.0)
-        return np.concatenate([g_links, g_rope, g_floor, breaking])
-
-    def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Switch friction, slack/taut and contact modes; break ropes.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
-        fired : list of int
-            Indices of the guards that fired at ``t`` (order of :meth:`guards`).
-
-        Returns
-        -------
-        numpy.ndarray
-            The state after the switches, projected; a broken span's strain energy is
-            booked as dissipated.
-        """
-        n_links = len(self.friction.links)
-        n_spans = len(self.spans)
-        x = np.array(x, dtype=float)
-        link_fired = [i for i in fired if i < n_links]
-        first_break = n_links + n_spans + len(self.blocks)
-        for i in fired:
-            if i >= first_break:
-                self._break_span(i - first_break, x, t)
-            elif i >= n_links + n_spans:
-                j = i - n_links - n_spans
-                self.contact_mask[j] = not self.contact_mask[j]
-                what = "lands on" if self.contact_mask[j] else "lifts off"
-                self.last_events.append(f"block {self.blocks[j].name!r} {what} its floor")
-            elif i >= n_links:
-                k = i - n_links
-                self.taut_mask[k] = not self.taut_mask[k]
-                what = "taut" if self.taut_mask[k] else "slack"
-                self.last_events.append(f"rope span {k} {what}")
-        x = self._settle_modes(t, x, link_fired)
-        self.mode_changes += 1
-        return self.project(x)
-
-    def _settle_contact_modes(self, t: float, x: np.ndarray) -> bool:
-        """After inputs jump: make slack/taut and floor modes fit (t, x); True if any changed."""
-        changed = False
-        for _ in range(len(self.spans) + len(self.blocks) + 1):
-            g = self.guards(t, x)
-            n_links = len(self.friction.links)
-            g_modes = g[n_links : n_links + len(self.spans) + len(self.blocks)]
-            wrong = np.flatnonzero(g_modes < 0.0)
-            if wrong.size == 0:
-                break
-            self.handle_events(t, x, [int(i) + n_links for i in wrong[:1]])
-            self.mode_changes -= 1  # counted once by the caller
-            changed = True
-        return changed
-
-    def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
-        """Make the friction modes consistent with the forces at (t, x)."""
-        if not self.friction.links:
-            return x
-        n = self.n_coords
-        x = np.array(x, dtype=float)
-        ev = self.evaluate(t, x)
-        caps = self._capacities(ev["tension"])
-        before = self.friction.get_mode()
-        x[n : 2 * n] = self.friction.switch(x[n : 2 * n], ev["forces"], caps, fired or [])
-        changed = False
-        for k, (old, new) in enumerate(zip(before, self.friction.get_mode(), strict=True)):
-            if old != new:
-                changed = True
-                state = "stuck" if new == 0 else "sliding"
-                self.last_events.append(f"{self.friction.links[k].name} {state}")
-        if changed and fired is None:
-            self.mode_changes += 1
-        self._held_positions = x[:n].copy()
-        return self.project(x)
-
-    def _break_span(self, i: int, x: np.ndarray, t: float) -> None:
-        if self.broken[i]:
-            return
-        released = self.evaluate(t, x)["span_energy"][i]
-        self.broken_mask[i] = True
-        x[2 * self.n_coords] += released  # the strain energy is released and lost
-        self.last_events.append(f"rope span {i} broke")
-
-    def project(self, x: np.ndarray) -> np.ndarray:
-        """Hold coordinates stuck to the ground exactly where they stuck, at rest.
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            State ``[q, v, dissipated, external work]``, changed in place.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``x``.
-        """
-        if self.friction.links:
-            held = self.friction.stuck_to_ground()
-            if held.size:
-                x[held] = self._held_positions[held]
-                x[self.n_coords + held] = 0.0
-        return x
-
-    # -------------------------------------------------------- initial state
-    def initialize(
-        self, t0: float, inputs: BlockTrainInputs, *, equilibrium: bool, pretension: float
-    ) -> float:
-        """Set the rope's unstretched lengths and the state at rest.
-
-        With ``equilibrium`` and at least one block, the rope is stretched so
-        that every block hangs at rest where the reeving puts it; otherwise
-        every span starts at ``pretension`` (N). Returns the initial tension.
-
-        Parameters
-        ----------
-        t0 : float
-            Start time, s.
-        inputs : BlockTrainInputs
-            Inputs at ``t0``.
-        equilibrium : bool
-            Stretch the rope so that the blocks hang at rest.
-        pretension : float
-            Tension of every span without ``equilibrium`` (or without blocks), N.
-
-        Returns
-        -------
-        float
-            The initial rope tension, N.
-
-        Raises
-        ------
-        ConfigurationError
-            If no single rope tension holds every block at rest.
-        """
-        self.set_inputs(t0, inputs)
-        self.state = np.zeros(2 * self.n_coords + 2)
-        self.broken = [False] * len(self.spans)
-        nb = len(self.blocks)
-        y = np.concatenate((np.zeros(nb), self._mover_y0))
-        big_l, dl_dy = self.span_lengths(y)
-        tension = pretension
-        if equilibrium and self.blocks:
-            tension = self._equilibrium_tension(dl_dy)
-        ea = self.rope.axial_stiffness
-        flow = np.concatenate((self.q, self._line_s0))
-        self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
-        self.taut_mask = np.full(len(self.spans), tension > 0.0)
-        self.contact_mask = np.array(
-            [b.floor is not None and b.position < b.floor.position for b in self.blocks], dtype=bool
-        )
-        self.friction.set_mode([0] * len(self.friction.links))
-        self.state = self._settle_modes(t0, self.state, [])
-        return tension
-
-    def _equilibrium_tension(self, dl_dy: np.ndarray) -> float:
-        gravity = np.array(self.reeving.gravity)
-        needed = []
-        for j, block in enumerate(self.blocks):
-            lift = -float(dl_dy[:, j].sum())  # rope force on the block per newton of tension
-            weight = block.mass * float(gravity @ np.array(block.direction))
-            if lift <= 0.0:
-                raise ConfigurationError(
-                    "block train",
-                    [f"block {block.name!r} hangs on no rope: it cannot start in equilibrium"],
-                )
-            needed.append((block.name, -weight / lift))
-        tensions = [t for _, t in needed]
-        if max(tensions) - min(tensions) > 1e-9 * max(1.0, max(abs(t) for t in tensions)):
-            listed = ", ".join(f"{n!r} needs {t:.6g} N" for n, t in needed)
-            raise ConfigurationError(
-                "block train",
-                [
-                    f"initial_equilibrium: no single rope tension holds every block ({listed}); "
-                    "set initial_equilibrium false or change the masses"
-                ],
-            )
-        if tensions[0] < 0.0:
-            raise ConfigurationError(
-                "block train",
-                [
-                    f"initial_equilibrium: block {needed[0][0]!r} would need the rope to push "
-                    f"({tensions[0]:.6g} N)"
-                ],
-            )
-        return tensions[0]
 
     # -------------------------------------------------------------- stepping
     def advance(
