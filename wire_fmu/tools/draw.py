@@ -5,7 +5,7 @@ steps: :func:`~wire_fmu.tools.draw_geometry.reeving_drawing` turns a reeving
 description into drawing primitives (:mod:`~wire_fmu.tools.draw_primitives`,
 pure data: sheave outlines, rope spans and wrapped arcs, anchors, line ends,
 body boxes, floors, in 2-D plane coordinates, m) using the core's own
-geometry (:func:`~wire_fmu.core.units.block_train.reeving.parse_reeving`,
+geometry (:func:`~wire_fmu.core.units.block_train.reeving_parse.parse_reeving`,
 :func:`~wire_fmu.core.components.sheave_geometry.path.path_geometry`,
 :func:`~wire_fmu.core.components.sheave_geometry.planar_path.planar_frame`) -- no tangent is
 re-derived there -- and a renderer (this module) draws those with matplotlib's Agg canvas on a

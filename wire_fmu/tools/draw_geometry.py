@@ -18,7 +18,8 @@ from wire_fmu.core.components.sheave_geometry.circles import Circle, PathNode
 from wire_fmu.core.components.sheave_geometry.path import PathGeometry, path_geometry
 from wire_fmu.core.components.sheave_geometry.planar_path import planar_frame
 from wire_fmu.core.errors import GeometryError
-from wire_fmu.core.units.block_train.reeving import Reeving, parse_reeving
+from wire_fmu.core.units.block_train.reeving import Reeving
+from wire_fmu.core.units.block_train.reeving_parse import parse_reeving
 
 from .draw_primitives import (
     AnchorMark,
@@ -306,7 +307,7 @@ def reeving_drawing(reeving: Mapping[str, Any]) -> ReevingDrawing:
     Raises
     ------
     ConfigurationError
-        From :func:`~wire_fmu.core.units.block_train.reeving.parse_reeving` (every problem of
+        From :func:`~wire_fmu.core.units.block_train.reeving_parse.parse_reeving` (every problem of
         the description) or :func:`~wire_fmu.core.components.sheave_geometry.path.path_geometry`
         (a :class:`~wire_fmu.core.errors.GeometryError` with every geometric
         problem).

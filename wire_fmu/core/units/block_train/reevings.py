@@ -1,4 +1,4 @@
-"""Ready-made reevings, as plain data for :func:`~.block_train.reeving.parse_reeving`.
+"""Ready-made reevings, as plain data for :func:`~.block_train.reeving_parse.parse_reeving`.
 
 Parameter sources
 -----------------

@@ -49,8 +49,8 @@ from wire_fmu.core.units.block_train.reeving import (
     BLOCK_PORTS,
     LINE_PORTS,
     MOVER_PORTS,
-    parse_reeving,
 )
+from wire_fmu.core.units.block_train.reeving_parse import parse_reeving
 from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
 __all__ = ["BlockTrainUnit"]
