@@ -25,6 +25,7 @@ from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 from wire_fmu.core.units.hydraulics.limits import check_start, limit_message
+from wire_fmu.core.units.hydraulics.oil_side import OilSide
 from wire_fmu.core.units.hydraulics.specs import (
     AccumulatorSpec,
     CylinderSpec,
@@ -115,7 +116,7 @@ class _Point:
     stored: float
 
 
-class HydraulicsModel(RefinedStepping):
+class HydraulicsModel(OilSide, RefinedStepping):
     """Hybrid ODE of a cylinder with gas accumulator; see the module docstring.
 
     Parameters
@@ -270,47 +271,6 @@ class HydraulicsModel(RefinedStepping):
             loss,
             stored,
         )
-
-    def _choose_oil_side(self):
-        """The oil side's equations for the effects chosen (chosen once, at build).
-
-        Each gives, at a state, the chamber pressure (Pa), the line flow (m^3/s), the line's
-        loss (W) and the energy stored in oil and line (J).
-        """
-        if not self.compressible:
-            return self._rigid_column if self.losses else self._lossless_rigid_column
-        if self.layout.chamber_pressure < 0:
-            return self._one_pressure_node
-        return self._two_pressure_nodes
-
-    def _lossless_rigid_column(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
-        """Incompressible oil, lossless line: the chamber is at the gas pressure."""
-        return p_g, self.sa * vel, 0.0, 0.0
-
-    def _rigid_column(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
-        """Incompressible oil: the line's drop at the rod's flow."""
-        flow = self.sa * vel
-        drop = (self.r_l + self.r_t * abs(flow)) * flow
-        return p_g - drop, flow, drop * flow, 0.0
-
-    def _one_pressure_node(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
-        """Compressible oil with a lossless, massless line: oil and gas in parallel."""
-        c_gas = v_gas / (self.exponent * p_g)
-        flow = self.sa * vel * c_gas / (c_gas + self.compliance)
-        return p_g, flow, 0.0, 0.5 * self.compliance * p_g * p_g
-
-    def _two_pressure_nodes(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
-        """Compressible oil in the chamber, the line between it and the gas (losses, mass)."""
-        lay = self.layout
-        p_c = float(x[lay.chamber_pressure])
-        stored = 0.5 * self.compliance * p_c * p_c
-        if lay.flow >= 0:
-            flow = float(x[lay.flow])
-            stored += 0.5 * self.inertance * flow * flow
-        else:
-            flow = self.line.flow(p_g - p_c)
-        drop = (self.r_l + self.r_t * abs(flow)) * flow
-        return p_c, flow, drop * flow, stored
 
     def _accelerate(self, point: _Point) -> tuple[float, float, float]:
         """Acceleration (m/s^2), seal friction force on the rod (N) and its loss (W)."""

@@ -54,7 +54,7 @@ from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.report_outputs import ReportOutputs
 from wire_fmu.core.framework.solver_options import solver_settings
 from wire_fmu.core.framework.unit import (
@@ -92,15 +92,7 @@ class WinchUnit(HeldInputsUnit):
     DESCRIPTION = "Winch (drawworks): drum, band brake, motor, drive train, wire_fmu"
     VARIABLES = winch_parameters() + winch_inputs() + winch_outputs()
     PORTS = (
-        Port(
-            "rope",
-            "rope",
-            PortSide.flow,
-            "rope.tension",
-            "rope.payout_rate",
-            "rope.payout",
-            "the rope leaving the drum",
-        ),
+        port("rope", "rope", PortSide.flow, "tension", "payout_rate", "payout", "the fast line"),
     )
 
     def __init__(self, instance_name: str = "winch") -> None:
