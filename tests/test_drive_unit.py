@@ -317,7 +317,7 @@ def test_facade_steps_like_the_core():
     spec.loader.exec_module(module)
     facade = module.MultiMassDrive(instance_name="drive", resources=None)
     refs = {v.name: v.value_reference for v in facade.vars.values()}
-    assert list(refs) == [v.name for v in DriveUnit.VARIABLES]
+    assert list(refs) == [v.name for v in DriveUnit.VARIABLES] + ["physics_seconds"]
     facade.setup_experiment(0.0, None, None)
     facade.enter_initialization_mode()
     facade.exit_initialization_mode()

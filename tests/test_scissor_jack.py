@@ -314,7 +314,7 @@ def load_facade_class():
 def test_facade_steps_like_the_core():
     facade = load_facade_class()(instance_name="jack", resources=None)
     refs = {v.name: v.value_reference for v in facade.vars.values()}
-    assert list(refs) == [v.name for v in ScissorJackUnit.VARIABLES]
+    assert list(refs) == [v.name for v in ScissorJackUnit.VARIABLES] + ["physics_seconds"]
     facade.set_string([refs["effects"], refs["handle_drive"]], ["thread_friction", "torque"])
     facade.setup_experiment(0.0, None, None)
     facade.enter_initialization_mode()
