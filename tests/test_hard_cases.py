@@ -139,7 +139,7 @@ def test_stiff_rope_inside_one_unit_is_stable_with_the_right_frequency_and_energ
     numerical damping: within 10 % / 1.5 % of the oscillation energy), both errors
     shrinking as the step is refined.
 
-    Mutation: ros2 made explicit (hybrid._finite_difference_jacobian returning zeros);
+    Mutation: ros2 made explicit (fixed_step.finite_difference_jacobian returning zeros);
     the fast mode blew up within two macro steps, the unit refused ("rope span 0 has no
     unstretched rope left") and the run stopped at t = 0.004 s: the status assertion failed.
     """
