@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import logging
 
-from wire_fmu.bench.common import Case, command_line, run_cases
+from wire_fmu.bench.common import Case, unit_benchmark
 from wire_fmu.core.units.block_train.model import BLOCK_TRAIN_EFFECTS
 from wire_fmu.core.units.block_train.reevings import drilling_block_train
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
@@ -78,15 +78,8 @@ def main(argv: list[str] | None = None) -> None:
     argv : list of str, optional
         The arguments; None reads the command line.
     """
-    args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases(
-        "BlockTrain",
-        cases(),
-        args.steps,
-        f"10-line block train, ros2, max internal step 1 ms, communication step {STEP:g} s",
-    )
-    if args.out:
-        args.out.write_text(text + "\n")
+    title = f"10-line block train, ros2, max internal step 1 ms, communication step {STEP:g} s"
+    unit_benchmark(__doc__.splitlines()[0], "BlockTrain", cases(), title, argv)
 
 
 if __name__ == "__main__":

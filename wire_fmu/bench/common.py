@@ -314,3 +314,27 @@ def run_cases(unit: str, cases: Sequence[Case], steps: int, title: str) -> str:
     text = table(rows)
     logger.info("\n%s:\n%s", title, text)
     return text
+
+
+def unit_benchmark(
+    description: str, unit: str, cases: Sequence[Case], title: str, argv: list[str] | None
+) -> None:
+    """Run a unit benchmark from its command line: measure, log, and write ``--out``.
+
+    Parameters
+    ----------
+    description : str
+        The benchmark's description for ``--help``.
+    unit : str
+        Name of our unit type, e.g. ``"Hydraulics"``.
+    cases : sequence of Case
+        The manoeuvres.
+    title : str
+        Heading of the table.
+    argv : list of str or None
+        The arguments; None reads the command line.
+    """
+    args = command_line(description, argv)
+    text = run_cases(unit, cases, args.steps, title)
+    if args.out:
+        args.out.write_text(text + "\n")

@@ -14,7 +14,7 @@ from __future__ import annotations
 import logging
 import math
 
-from wire_fmu.bench.common import Case, command_line, run_cases
+from wire_fmu.bench.common import Case, unit_benchmark
 from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 from wire_fmu.core.units.hydraulics.unit import DEFAULT_ROD_FORCE, HydraulicsUnit
 
@@ -106,15 +106,8 @@ def main(argv: list[str] | None = None) -> None:
     argv : list of str, optional
         The arguments; None reads the command line.
     """
-    args = command_line(__doc__.splitlines()[0], argv)
-    text = run_cases(
-        "Hydraulics",
-        cases(),
-        args.steps,
-        f"Riser-tensioner cylinder, ros2, max internal step 1 ms, communication step {STEP:g} s",
-    )
-    if args.out:
-        args.out.write_text(text + "\n")
+    title = f"Riser-tensioner cylinder, ros2, max internal step 1 ms, communication step {STEP:g} s"
+    unit_benchmark(__doc__.splitlines()[0], "Hydraulics", cases(), title, argv)
 
 
 if __name__ == "__main__":
