@@ -31,7 +31,7 @@ from xml.etree import ElementTree as ET
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.ports import Port
-from wire_fmu.core.framework.unit import Causality, Unit, Variable, output
+from wire_fmu.core.framework.unit import Causality, Unit, Variable
 from wire_fmu.export.facade import PHYSICS_SECONDS
 from wire_fmu.export.units import UNITS
 
@@ -59,7 +59,6 @@ CAPABILITIES = {
 
 _INITIAL = {Causality.parameter: "exact", Causality.output: "calculated"}
 _TIMING_DESCRIPTION = "wall-clock time spent in the unit's physics since instantiation"
-_TIMING_UNIT = output(PHYSICS_SECONDS, "s", _TIMING_DESCRIPTION)  # its unit is defined
 
 
 def check_units(unit_class: type[Unit]) -> list[str]:
@@ -90,9 +89,9 @@ def _dependency_attrs(indices: list[int], with_kind: bool) -> dict[str, str]:
     return attrs
 
 
-def _unit_definitions(variables: Iterable[Variable]) -> ET.Element:
+def _unit_definitions(units: Iterable[str]) -> ET.Element:
     section = ET.Element("UnitDefinitions")
-    for name in sorted({v.unit for v in variables if v.type is float}):
+    for name in sorted(set(units)):
         definition = UNITS[name]
         unit = ET.SubElement(section, "Unit", name=name)
         ET.SubElement(unit, "BaseUnit", definition.base_unit_attributes())
@@ -251,7 +250,7 @@ def patch_model_description(xml: bytes, unit_class: type[Unit], generation_tool:
         for old in root.findall(tag):
             root.remove(old)
     successors = ("TypeDefinitions", "LogCategories", "DefaultExperiment", "ModelVariables")
-    used = (*unit_class.variables(), _TIMING_UNIT)
+    used = [v.unit for v in unit_class.variables() if v.type is float] + ["s"]  # s: the timing
     _insert_before(root, _unit_definitions(used), successors)
     for old in root.findall("VendorAnnotations"):
         root.remove(old)

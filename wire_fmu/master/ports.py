@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from wire_fmu.export.model_description import PORTS_TOOL
 from wire_fmu.master.archive import check_member_size
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR, resolve_fmu
 
@@ -35,8 +36,6 @@ __all__ = [
     "unit_ports",
 ]
 
-PORTS_TOOL = "wire_fmu"
-"""``Tool`` name of the vendor annotation that declares ports."""
 MAX_MODEL_DESCRIPTION_BYTES = 64 * 2**20
 """The largest ``modelDescription.xml`` read for its ports."""
 PORT_BOND_PATTERN = re.compile(

@@ -163,13 +163,10 @@ class BlockTrainUnit(Unit):
     DESCRIPTION = "Rope reeved over sheaves and anchors (block train), wire_fmu"
     VARIABLES = _variables()
     PORTS = (
+        *(port(n, "rope", PortSide.effort, "tension", "payout_rate", "payout") for n in LINE_PORTS),
         *(
-            port(f"line_{e}", "rope", PortSide.effort, "tension", "payout_rate", "payout")
-            for e in "ab"
-        ),
-        *(
-            port(f"mover_{e}", "translational", PortSide.effort, "force", "velocity", "position")
-            for e in "ab"
+            port(n, "translational", PortSide.effort, "force", "velocity", "position")
+            for n in MOVER_PORTS
         ),
     )
 
@@ -213,11 +210,6 @@ class BlockTrainUnit(Unit):
         """Rope stretched for equilibrium (or pretension); outputs filled.
 
         Implements :meth:`Unit.initialize`.
-
-        Parameters
-        ----------
-        start_time : float
-            Start time, s.
         """
         model = self._require_model()
         segment = self.values["break_segment"]
@@ -395,18 +387,6 @@ class _BlockTrainOde(ModelOdeView):
         """Break a commanded segment, then settle contact and friction modes.
 
         Implements :meth:`OdeView.reconcile`.
-
-        Parameters
-        ----------
-        t : float
-            Time of the input jump, s.
-        x : numpy.ndarray
-            The model's state at ``t``.
-
-        Returns
-        -------
-        numpy.ndarray
-            The state to continue from.
         """
         m = self.model
         m.state = np.array(x, dtype=float)

@@ -149,9 +149,10 @@ class HydraulicsModel(OilSide, RefinedStepping):
         self.exponent = spec.accumulator.polytropic_exponent if self.polytropic else ISOTHERMAL
         self.layout = self._build_layout()
         self._oil_side = self._choose_oil_side()
-        self.seal = RodSeal(spec.seal, self.mass) if self.friction_on else None
+        self.seal = RodSeal(spec.seal, self.mass) if "seal_friction" in effects else None
         self._viscous = self.seal.viscous if self.seal is not None else 0.0
-        self.stops = EndStops(spec.stops, self.cyl.stroke, self.mass) if self.stops_on else None
+        stops_on = "end_stops" in effects
+        self.stops = EndStops(spec.stops, self.cyl.stroke, self.mass) if stops_on else None
         self._guard_kinds = self._build_guards()
         self._directions = np.array(
             [0.0 if kind == "pad" else -1.0 for kind, _ in self._guard_kinds]
@@ -178,8 +179,6 @@ class HydraulicsModel(OilSide, RefinedStepping):
         self.losses = "line_losses" in effects
         self.has_inertance = "line_inertance" in effects
         self.compressible = "oil_compressibility" in effects
-        self.friction_on = "seal_friction" in effects
-        self.stops_on = "end_stops" in effects
 
     def _build_layout(self) -> _Layout:
         index = 2
