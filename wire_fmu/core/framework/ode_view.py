@@ -177,13 +177,6 @@ class ModelOdeView(OdeView):
         """Adopt ``x`` at ``t`` and refresh the outputs.
 
         Implements :meth:`OdeView.set_state`.
-
-        Parameters
-        ----------
-        x : array_like
-            The model's state vector.
-        t : float
-            Time, s.
         """
         self.model.state = np.array(x, dtype=float)
         self.unit.time = t
@@ -194,13 +187,6 @@ class ModelOdeView(OdeView):
         """Outputs of ``x`` at ``t`` into ``values``; the state is left alone.
 
         Implements :meth:`OdeView.publish`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : array_like
-            The model's state vector.
         """
         saved, self.model.state = self.model.state, np.asarray(x, dtype=float)
         saved_time, self.unit.time = self.unit.time, t
@@ -213,13 +199,6 @@ class ModelOdeView(OdeView):
         """The model's state derivative.
 
         Implements :meth:`OdeView.rhs`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : array_like
-            The model's state vector.
         """
         return self.model.rhs(t, x)
 
@@ -227,13 +206,6 @@ class ModelOdeView(OdeView):
         """The model's guards.
 
         Implements :meth:`OdeView.guards`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : array_like
-            The model's state vector.
         """
         return self.model.guards(t, x)
 
@@ -245,15 +217,6 @@ class ModelOdeView(OdeView):
         """The model's mode switches.
 
         Implements :meth:`OdeView.handle_events`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : array_like
-            The model's state vector.
-        fired : list of int
-            Indices of the guards that fired at ``t``.
         """
         return self.model.handle_events(t, x, fired)
 
@@ -261,10 +224,5 @@ class ModelOdeView(OdeView):
         """The model's invariants.
 
         Implements :meth:`OdeView.project`.
-
-        Parameters
-        ----------
-        x : array_like
-            The model's state vector.
         """
         return self.model.project(x)

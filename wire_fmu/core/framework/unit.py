@@ -321,11 +321,6 @@ class HeldInputsUnit(Unit):
         """Initial state for the parameters and inputs set; outputs filled.
 
         Implements :meth:`Unit.initialize`.
-
-        Parameters
-        ----------
-        start_time : float
-            Start time, s.
         """
         model = self._require_model()
         model.initialize(start_time, self._inputs())

@@ -224,11 +224,6 @@ class HydraulicsUnit(Unit):
         """Initial state (equilibrium or as given); outputs filled.
 
         Implements :meth:`Unit.initialize`.
-
-        Parameters
-        ----------
-        start_time : float
-            Start time, s.
         """
         model = self._require_model()
         v = self.values
@@ -374,13 +369,6 @@ class _HydraulicsOde(OdeView):
         """Adopt ``x`` at ``t`` and refresh the outputs.
 
         Implements :meth:`OdeView.set_state`.
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
-        t : float
-            Time, s.
         """
         self.model.state = np.array(x[:-1], dtype=float)
         self.model.external_work = float(x[-1])
@@ -402,13 +390,6 @@ class _HydraulicsOde(OdeView):
         """Outputs of ``x`` at ``t`` into ``values`` (state left alone).
 
         Implements :meth:`OdeView.publish`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
         """
         m = self.model
         saved = m.state, m.external_work, self.unit.time
@@ -422,13 +403,6 @@ class _HydraulicsOde(OdeView):
         """Model derivative, then the power ``force * dx/dt`` into the rod port.
 
         Implements :meth:`OdeView.rhs`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
         """
         derivative = self.model.rhs(t, x[:-1])
         return np.append(derivative, self.model.force * derivative[0])
@@ -437,13 +411,6 @@ class _HydraulicsOde(OdeView):
         """See :meth:`HydraulicsModel.guards`.
 
         Implements :meth:`OdeView.guards`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
         """
         return self.model.guards(t, x[:-1])
 
@@ -455,15 +422,6 @@ class _HydraulicsOde(OdeView):
         """See :meth:`HydraulicsModel.handle_events`.
 
         Implements :meth:`OdeView.handle_events`.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
-        fired : list of int
-            Indices of the guards that fired at ``t``.
         """
         return np.append(self.model.handle_events(t, x[:-1], fired), x[-1])
 
@@ -471,11 +429,6 @@ class _HydraulicsOde(OdeView):
         """See :meth:`HydraulicsModel.project`.
 
         Implements :meth:`OdeView.project`.
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
         """
         return np.append(self.model.project(np.array(x[:-1], dtype=float)), x[-1])
 
@@ -483,18 +436,6 @@ class _HydraulicsOde(OdeView):
         """The force jumped at ``t``: settle the seal's mode.
 
         Implements :meth:`OdeView.reconcile`.
-
-        Parameters
-        ----------
-        t : float
-            Time of the force jump, s.
-        x : numpy.ndarray
-            State ``[model state, external work]`` (see the class docstring).
-
-        Returns
-        -------
-        numpy.ndarray
-            The state to continue from.
         """
         self.bind_inputs(t)
         self.model.state = self.model.settle(x[:-1])
