@@ -35,6 +35,8 @@ The equations of motion are Lagrange's with the rope strain energy of
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,8 +44,11 @@ import numpy as np
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.compiled import use_compiled
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.units.block_train import kernel
 from wire_fmu.core.units.block_train.modes import ModeSwitching
 from wire_fmu.core.units.block_train.path import ReevedPath
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
@@ -126,7 +131,6 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         self._build_flow_map()
         self._floored = [j for j, b in enumerate(self.blocks) if b.floor is not None]
         self._guard_dirs = self._guard_directions()
-        self.solver = make_solver(solver)
         self.broken = [False] * len(self.spans)
         self.offsets = np.zeros(len(self.spans))  # l_span(0) - s(start) + s(end)
         self.state = np.zeros(2 * self.n_coords + 2)
@@ -136,6 +140,47 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         self._held_positions = np.zeros(self.n_coords)
         self.taut_mask = np.ones(len(self.spans), dtype=bool)
         self.contact_mask = np.zeros(len(self.blocks), dtype=bool)
+        self._build_kernel_arrays()
+        self.compiled = self.kernel_applies() and use_compiled("block train")
+        if self.compiled and solver.method in COMPILED_METHODS:
+            self.solver = CompiledFixedStep(solver, kernel.advance)
+        else:
+            self.solver = make_solver(solver)
+
+    # ------------------------------------------------------------- kernels
+    def kernel_applies(self) -> bool:
+        """Whether the compiled kernel covers this block train's effects.
+
+        It does without friction links and with lengths linear in the body motion
+        (see :mod:`~wire_fmu.core.units.block_train.kernel`).
+        """
+        return not self.friction.links and not self.moving
+
+    def _build_kernel_arrays(self) -> None:
+        """The parameters of :mod:`~wire_fmu.core.units.block_train.kernel` as flat arrays."""
+        self.kernel_sizes = np.array([self.n_coords, len(self.blocks), len(self.drivers)])
+        self.kernel_rope = np.array(
+            [self.rope.axial_stiffness, self.rope.damping, self.rope.breaking_load]
+        )
+        blocks = np.zeros((len(self.blocks), 5))
+        for j, b in enumerate(self.blocks):
+            blocks[j, :2] = self.block_weight[j], b.position
+            if b.floor is not None:
+                blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
+        self.kernel_blocks = blocks
+
+    def kernel_data(self) -> tuple:
+        """The tuple of arrays the compiled kernel takes, for the present modes and inputs."""
+        return kernel.kernel_data(self)
+
+    @contextmanager
+    def python_kernel(self) -> Iterator[None]:
+        """Evaluate with the Python kernel inside the ``with`` block."""
+        compiled, self.compiled = self.compiled, False
+        try:
+            yield
+        finally:
+            self.compiled = compiled
 
     # ------------------------------------------------------------------ build
     def _build_friction(self) -> None:
@@ -239,6 +284,9 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         )
         self._mover_y0 = np.array([inputs.mover_position.get(p, 0.0) for p in self.driver_ports])
         self._mover_v = np.array([inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports])
+        self.held_vector = np.concatenate(
+            ([t], self._line_s0, self._line_rate, self._mover_y0, self._mover_v)
+        )
 
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Geometric span lengths (m) and their Jacobian w.r.t. body motion.
@@ -256,8 +304,7 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
             ``d lengths / d y``, one row per span and one column per body, 1.
         """
         if not self.moving:
-            seg = self.segment_length0 + self.length_jacobian0 @ y
-            return self.span_matrix @ seg, self.span_matrix @ self.length_jacobian0
+            return self.span_length0 + self.span_jacobian @ y, self.span_jacobian
         lengths = self._planar_segment_lengths if self._planar else self._spatial_segment_lengths
         seg = lengths(y)
         jac = np.zeros((self.n_segments, len(y)))
@@ -289,9 +336,11 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
             and ``stretch`` (m), ``line_force`` at the line ends (N), ``body_force`` on
             the bodies (N), floor ``depth`` (m) and ``contact``/``trial_contact`` forces
             (N), ``rope_energy``/``span_energy``/``potential`` (J), ``loss`` power (W),
-            the rope forces ``rope``, body displacements ``y`` (m) and velocities
-            ``ydot`` (m/s).
+            the rope forces ``rope`` (Python kernel only), body displacements ``y`` (m) and
+            velocities ``ydot`` (m/s).
         """
+        if self.compiled:
+            return self._evaluate_compiled(t, x)
         n, nb = self.n_coords, len(self.blocks)
         q, v = x[:n], x[n : 2 * n]
         dt = t - self._t_step
@@ -357,6 +406,32 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
             "ydot": ydot,
         }
 
+    def _evaluate_compiled(self, t: float, x: np.ndarray) -> dict:
+        """:meth:`evaluate` by the compiled kernel (the Python one names a span run out)."""
+        result = kernel.evaluate(t, x, self.kernel_data())
+        forces, tension, stretch, line_force, body_force = (result[i] for i in (0, 1, 4, 5, 6))
+        depth, trial_contact, span_energy, potential, loss = (result[i] for i in (7, 8, 9, 10, 11))
+        if not result[13]:  # the Python kernel raises the error that names the span
+            return self._python_evaluate(t, x)
+        n, nb = self.n_coords, len(self.blocks)
+        dt = t - self._t_step
+        return {
+            "forces": forces,
+            "tension": tension,
+            "stretch": stretch,
+            "line_force": line_force,
+            "depth": depth,
+            "trial_contact": trial_contact,
+            "body_force": body_force,
+            "contact": np.where(self.contact_mask, trial_contact, 0.0),
+            "rope_energy": float(span_energy.sum()),
+            "span_energy": span_energy,
+            "potential": potential,
+            "loss": loss,
+            "y": np.concatenate((x[:nb], self._mover_y0 + self._mover_v * dt)),
+            "ydot": np.concatenate((x[n : n + nb], self._mover_v)),
+        }
+
     def _capacities(self, tension: np.ndarray) -> np.ndarray:
         t_in, t_out = tension[self._link_span_in], tension[self._link_span_out]
         return (
@@ -383,6 +458,8 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         x : numpy.ndarray
             State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
         """
+        if self.compiled:
+            return kernel.rhs(t, x, self.kernel_data())
         n = self.n_coords
         ev = self.evaluate(t, x)
         v = x[n : 2 * n]
@@ -438,7 +515,41 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
 
     def _input_energy(self, t: float) -> float:
         """The part of the stored energy that inputs can change at once (rope strain), J."""
-        return self.evaluate(t, self.state)["rope_energy"]
+        return self.summary(t, self.state)[0]
+
+    def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """What the outputs need at ``(t, x)``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+
+        Returns
+        -------
+        rope_energy : float
+            Strain energy of the rope, J.
+        potential : float
+            Gravitational and floor-contact energy, J.
+        tension : numpy.ndarray
+            Tension of each span, N.
+        body_force : numpy.ndarray
+            Force of the rope on each body along its direction (blocks, then driven), N.
+        """
+        if self.compiled:
+            values = kernel.summary(t, x, self.kernel_data())
+            if math.isfinite(values[0]):
+                n_spans = len(self.spans)
+                return values[0], values[1], values[2 : 2 + n_spans], values[2 + n_spans :]
+        ev = self.evaluate(t, x) if not self.compiled else self._python_evaluate(t, x)
+        return ev["rope_energy"], ev["potential"], ev["tension"], ev["body_force"]
+
+    def _python_evaluate(self, t: float, x: np.ndarray) -> dict:
+        """:meth:`evaluate` by the Python kernel."""
+        with self.python_kernel():
+            return self.evaluate(t, x)
 
     def held_inputs(self) -> dict:
         """The inputs held since the last step started, as plain data."""
@@ -477,9 +588,9 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
             Time the held inputs are evaluated at, s; None for the start of the held step.
         """
         t = self._t_step if t is None else t
-        ev = self.evaluate(t, self.state)
+        rope_energy, potential, _, _ = self.summary(t, self.state)
         kinetic = 0.5 * float(self.masses @ self.v**2)
-        return kinetic + ev["rope_energy"] + ev["potential"]
+        return kinetic + rope_energy + potential
 
 
 def _floor_contact(floor, position: float, velocity: float):

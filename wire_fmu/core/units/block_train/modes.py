@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.components.rope import slack_guard, taut_guard
+from wire_fmu.core.units.block_train import kernel
 
 __all__ = ["ModeSwitching"]
 
@@ -44,6 +45,8 @@ class ModeSwitching:
             Guard values: friction links, then rope spans (slack/taut), floors and
             breaking loads (N).
         """
+        if self.compiled:
+            return kernel.guards(t, x, self.kernel_data())
         n = self.n_coords
         ev = self.evaluate(t, x)
         caps = self._capacities(ev["tension"])

@@ -149,6 +149,9 @@ class ReevedPath:
         self.span_matrix = np.zeros((len(self.spans), self.n_segments))
         for i, sp in enumerate(self.spans):
             self.span_matrix[i, list(sp.segments)] = 1.0
+        # fixed line directions: span lengths linear in the body displacements
+        self.span_length0 = self.span_matrix @ self.segment_length0
+        self.span_jacobian = self.span_matrix @ self.length_jacobian0
         self.moving = "moving_geometry" in self.effects
         self._planar = None
         if self.moving and "spatial_geometry" not in self.effects:

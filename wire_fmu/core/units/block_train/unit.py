@@ -336,9 +336,9 @@ class BlockTrainUnit(Unit):
 
     def _update_outputs(self) -> None:
         m = self._require_model()
-        ev = m.evaluate(self.time, m.state)  # inputs as they evolved over the last step
+        # inputs as they evolved over the last step
+        rope_energy, potential, tension, body_force = m.summary(self.time, m.state)
         out = self.values
-        tension = ev["tension"]
         for k, _port in ((0, None), (m.n_nodes - 1, None)):
             node = m.nodes[k]
             if node.kind == "line_end":
@@ -346,7 +346,7 @@ class BlockTrainUnit(Unit):
                 out[f"{node.name}.tension"] = float(tension[span])
         nb = len(m.blocks)
         for j, body in enumerate(m.drivers):
-            out[f"{body.port}.force"] = float(ev["body_force"][nb + j])
+            out[f"{body.port}.force"] = float(body_force[nb + j])
         for j, body in enumerate(m.blocks):
             if body.port:
                 out[f"{body.port}.position"] = float(body.position + m.q[j])
@@ -357,7 +357,7 @@ class BlockTrainUnit(Unit):
         out["slack_spans"] = int(np.count_nonzero(~m.taut_mask & ~m.broken_mask))
         out["broken"] = any(m.broken)
         kinetic = 0.5 * float(m.masses @ m.v**2)
-        stored = kinetic + ev["rope_energy"] + ev["potential"]
+        stored = kinetic + rope_energy + potential
         n = m.n_coords
         out["stored_energy"] = float(stored)
         out["dissipated_energy"] = float(m.state[2 * n])

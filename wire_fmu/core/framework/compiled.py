@@ -1,0 +1,184 @@
+"""Compiled physics kernels: which kernel runs, the ``jit`` decorator and its disk cache.
+
+A unit's inner loop (stages, guards, event location, Jacobian, linear solves)
+runs in functions compiled by numba when it is installed; the readable numpy
+implementation of the same physics stays the reference. The environment
+variable ``WIRE_FMU_KERNEL`` chooses:
+
+``compiled`` (default)
+    numba kernels where a unit has them; the Python kernel where numba is
+    missing (one log line per unit built says so).
+``python``
+    the Python kernel everywhere.
+
+Compiled code is cached on disk so that compiling is paid once per machine:
+by content, not by file path, in ``WIRE_FMU_CACHE_DIR`` (default
+``~/.cache/wire_fmu/numba``). Every copy of the ``wire_fmu`` sources with the
+same text shares one cache, so FMUs extracted to new temporary folders and FMUs
+loaded by a C++ host start warm. The cache locator is registered with numba
+when this module is imported, before any kernel is decorated.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "KERNEL_ENV",
+    "CACHE_ENV",
+    "KernelChoiceError",
+    "cache_directory",
+    "jit",
+    "jit_inline",
+    "kernel_choice",
+    "numba_available",
+    "use_compiled",
+]
+
+logger = logging.getLogger(__name__)
+
+KERNEL_ENV = "WIRE_FMU_KERNEL"
+"""Environment variable choosing the kernel: ``compiled`` or ``python``."""
+CACHE_ENV = "WIRE_FMU_CACHE_DIR"
+"""Environment variable naming the folder of the compiled-code cache."""
+_CHOICES = ("compiled", "python")
+
+try:  # numba is a declared dependency; without it every unit runs its Python kernel
+    import numba
+    from numba.core import caching as _numba_caching
+except ImportError:  # pragma: no cover - exercised on machines without numba
+    numba = None
+    _numba_caching = None
+
+
+class KernelChoiceError(ValueError):
+    """``WIRE_FMU_KERNEL`` holds something other than ``compiled`` or ``python``."""
+
+
+def numba_available() -> bool:
+    """Whether numba can be imported in this interpreter."""
+    return numba is not None
+
+
+def kernel_choice() -> str:
+    """The kernel ``WIRE_FMU_KERNEL`` asks for: ``"compiled"`` (default) or ``"python"``.
+
+    Raises
+    ------
+    KernelChoiceError
+        If the variable holds anything else, naming the variable and the choices.
+    """
+    value = os.environ.get(KERNEL_ENV, "compiled").strip().lower() or "compiled"
+    if value not in _CHOICES:
+        raise KernelChoiceError(
+            f"environment variable {KERNEL_ENV}={os.environ[KERNEL_ENV]!r}: expected one of "
+            f"{', '.join(_CHOICES)}"
+        )
+    return value
+
+
+def use_compiled(unit: str) -> bool:
+    """Whether ``unit`` should run compiled kernels now; logs once when it cannot.
+
+    Parameters
+    ----------
+    unit : str
+        The unit being built, for the log line (e.g. ``"block train"``).
+    """
+    if kernel_choice() == "python":
+        return False
+    if numba is None:
+        logger.info("%s: numba is not installed; running the Python kernel", unit)
+        return False
+    return True
+
+
+def cache_directory() -> Path:
+    """The folder compiled kernels are cached in (``WIRE_FMU_CACHE_DIR`` or the user cache)."""
+    explicit = os.environ.get(CACHE_ENV)
+    if explicit:
+        return Path(explicit)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "wire_fmu" / "numba"
+
+
+def _package_relative(py_file: str) -> str | None:
+    """``wire_fmu/...`` part of a source path inside some copy of the package, or None."""
+    parts = Path(py_file).resolve().parts
+    if "wire_fmu" not in parts:
+        return None
+    start = len(parts) - 1 - parts[::-1].index("wire_fmu")
+    return "/".join(parts[start:])
+
+
+if _numba_caching is not None:
+
+    class _ContentCacheLocator(
+        _numba_caching._SourceFileBackedLocatorMixin, _numba_caching._CacheLocator
+    ):
+        """Cache a ``wire_fmu`` kernel by its package-relative path and source text.
+
+        numba's own locators key the cache on the file's folder, so every
+        temporary extraction of an FMU would compile afresh.
+        """
+
+        def __init__(self, py_func: Callable[..., Any], py_file: str) -> None:
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            relative = _package_relative(py_file) or Path(py_file).name
+            text = Path(py_file).read_bytes()
+            digest = hashlib.sha256(relative.encode() + b"\0" + text).hexdigest()[:16]
+            folder = relative.replace("/", "_").removesuffix(".py")
+            self._cache_path = str(cache_directory() / f"{folder}-{digest}")
+
+        def get_cache_path(self) -> str:
+            return self._cache_path
+
+        @classmethod
+        def from_function(cls, py_func: Callable[..., Any], py_file: str):
+            if _package_relative(py_file) is None or not os.path.exists(py_file):
+                return None
+            return super().from_function(py_func, py_file)
+
+    _locators = _numba_caching.CacheImpl._locator_classes
+    if not any(c.__name__ == _ContentCacheLocator.__name__ for c in _locators):
+        _locators.insert(0, _ContentCacheLocator)
+
+
+def jit(function: Callable[..., Any]) -> Callable[..., Any]:
+    """Compile ``function`` with numba (nopython, cached, IEEE arithmetic) when it is installed.
+
+    Without numba the plain function is returned; the units then never call
+    it on their hot path (:func:`use_compiled` is False).
+
+    Parameters
+    ----------
+    function : callable
+        A function over numbers and numpy arrays in numba's supported subset.
+    """
+    if numba is None:
+        return function
+    return numba.njit(cache=True, error_model="numpy")(function)
+
+
+def jit_inline(function: Callable[..., Any]) -> Callable[..., Any]:
+    """:func:`jit`, inlined into its callers at numba's IR level.
+
+    For the generic loops that take a unit's kernel functions as arguments: once
+    inlined into the unit's entry point, the kernel functions are called there as
+    globals, which keeps the entry point cacheable (a function passed on as a value
+    would be a process address, which numba refuses to cache).
+
+    Parameters
+    ----------
+    function : callable
+        A function over numbers, numpy arrays and compiled functions.
+    """
+    if numba is None:
+        return function
+    return numba.njit(cache=True, error_model="numpy", inline="always")(function)

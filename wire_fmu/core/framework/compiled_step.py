@@ -1,0 +1,295 @@
+"""The fixed-step solvers of :mod:`~wire_fmu.core.framework.fixed_step`, compiled.
+
+The same algorithm, step for step: ``ceil(H / max_step)`` equal steps of RK4 or
+ROS2 (finite-difference Jacobian at the start of every interval, the
+``(I - g h J)`` inverse kept while the step length stays), every guard crossing
+located by Illinois regula falsi. What changes is where it runs: a unit's
+compiled kernel gives plain functions
+
+``rhs(t, x, data) -> x'``, ``guards(t, x, data) -> g`` and ``project(x, data) -> x``
+
+over a tuple ``data`` of arrays (parameters, modes, held inputs), and a cached
+entry point of its own that calls :func:`advance_to_event` with them. The
+compiled loop returns at the end of the step or at the first located event;
+:class:`CompiledFixedStep` then lets the Python model switch its mode (and say
+so in words) and calls the loop again. Nothing here allocates per step beyond
+numpy temporaries inside the compiled code.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled import jit, jit_inline
+from wire_fmu.core.framework.fixed_step import RK4, ROS2, FixedStepSolver
+from wire_fmu.core.framework.step_limits import (
+    MAX_EVENTS_PER_STEP,
+    IntegrationError,
+    internal_steps,
+)
+
+if TYPE_CHECKING:
+    from wire_fmu.core.framework.hybrid import SolverSettings
+
+__all__ = [
+    "COMPILED_METHODS",
+    "CompiledFixedStep",
+    "STATUS_DONE",
+    "STATUS_EVENT",
+    "STATUS_NONFINITE",
+    "advance_to_event",
+]
+
+COMPILED_METHODS = {"rk4": 0, "ros2": 1}
+"""Fixed-step methods the compiled loop offers, by name: their codes."""
+_RK4, _ROS2 = COMPILED_METHODS["rk4"], COMPILED_METHODS["ros2"]
+_GAMMA = ROS2.GAMMA
+_MAX_LOCATE_ITERATIONS = 60
+
+STATUS_DONE = 0
+"""The loop reached the end of the communication step."""
+STATUS_EVENT = 1
+"""The loop stopped just after the first guard crossing it located."""
+STATUS_NONFINITE = 2
+"""A step gave a non-finite state; the loop returns the state it started that step from."""
+
+
+@jit
+def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """Guards that crossed between two evaluations (see ``fixed_step._fired``)."""
+    out = np.zeros(g0.size, dtype=np.bool_)
+    for i in range(g0.size):
+        if directions[i] < 0:
+            out[i] = g0[i] >= 0.0 and g1[i] < 0.0
+        else:
+            out[i] = np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0
+    return out
+
+
+@jit_inline
+def _jacobian(rhs, t: float, x: np.ndarray, data) -> np.ndarray:
+    """Forward-difference Jacobian (see ``fixed_step.finite_difference_jacobian``)."""
+    n = x.size
+    jac = np.zeros((n, n))
+    if n == 0:
+        return jac
+    f0 = rhs(t, x, data)
+    for j in range(n):
+        dx = 1e-7 * max(1.0, abs(x[j]))
+        xp = x.copy()
+        xp[j] += dx
+        fj = rhs(t, xp, data)
+        for i in range(n):
+            jac[i, j] = (fj[i] - f0[i]) / dx
+    return jac
+
+
+@jit_inline
+def _step(rhs, method: int, t: float, x: np.ndarray, h: float, w_inv: np.ndarray, data):
+    """One RK4 step, or one ROS2 step with ``w_inv = (I - g h J)^-1``."""
+    if method == _RK4:
+        k1 = rhs(t, x, data)
+        k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1, data)
+        k3 = rhs(t + 0.5 * h, x + 0.5 * h * k2, data)
+        k4 = rhs(t + h, x + h * k3, data)
+        return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    if x.size == 0:
+        return x
+    k1 = w_inv @ rhs(t, x, data)
+    k2 = w_inv @ (rhs(t + h, x + h * k1, data) - 2.0 * k1)
+    return x + h * (1.5 * k1 + 0.5 * k2)
+
+
+@jit
+def _w_inverse(method: int, jac: np.ndarray, h: float, w_h: float, w_inv: np.ndarray):
+    """``(I - g h J)^-1`` for ``h``, reusing ``w_inv`` if it was made for the same ``h``."""
+    if method != _ROS2 or h == w_h:
+        return w_inv, w_h
+    n = jac.shape[0]
+    return np.linalg.inv(np.eye(n) - _GAMMA * h * jac), h
+
+
+@jit
+def _all_finite(x: np.ndarray) -> bool:
+    for value in x:
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+@jit
+def _stage_calls(method: int, x: np.ndarray) -> int:
+    """Right-hand-side evaluations one step makes (as the Python solvers count them)."""
+    if method == _RK4:
+        return 4
+    return 0 if x.size == 0 else 2
+
+
+@jit_inline
+def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data):
+    """Integrate from ``(t, x)`` on interval ``k`` of ``n`` equal steps of ``[t0, t1]``.
+
+    Parameters
+    ----------
+    rhs, guards, project : compiled functions
+        The unit's kernel (see the module docstring).
+    method : int
+        A value of :data:`COMPILED_METHODS`.
+    t0, t1 : float
+        The communication step, s.
+    n : int
+        Number of equal internal steps over ``[t0, t1]``.
+    k : int
+        Index of the internal step ``t`` lies in (``t`` may be an event time inside it).
+    t : float
+        Time to start from, s.
+    x : numpy.ndarray
+        State at ``t``.
+    directions : numpy.ndarray
+        Guard directions (-1 fires downwards, 0 on any crossing).
+    tol : float
+        Event time tolerance, s.
+    data : tuple
+        The unit's parameters, modes and held inputs.
+
+    Returns
+    -------
+    tuple
+        ``(status, x, t, k, fired, steps, rhs_calls, h)``: a ``STATUS_*`` code; the
+        state and time reached (just after the event, or where a non-finite step
+        started); the interval index; the fired guards (bool mask); the steps taken
+        and right-hand sides evaluated; the length of the last step tried, s.
+    """
+    steps = 0
+    calls = 0
+    jac = np.zeros((0, 0))
+    if method == _ROS2:
+        jac = _jacobian(rhs, t, x, data)
+        calls += x.size + 1
+    w_inv = np.zeros((0, 0))
+    w_h = math.nan
+    g0 = guards(t, x, data)
+    no_fire = np.zeros(g0.size, dtype=np.bool_)
+    while k < n:
+        t_next = t0 + (t1 - t0) * (k + 1) / n
+        h = t_next - t
+        w_inv, w_h = _w_inverse(method, jac, h, w_h, w_inv)
+        x1 = project(_step(rhs, method, t, x, h, w_inv, data), data)
+        steps += 1
+        calls += _stage_calls(method, x)
+        if not _all_finite(x1):
+            return STATUS_NONFINITE, x, t, k, no_fire, steps, calls, h
+        if g0.size == 0:
+            t, x = t_next, x1
+            k += 1
+            continue
+        g1 = guards(t + h, x1, data)
+        mask = _fired(g0, g1, directions)
+        if not mask.any():
+            t, x, g0 = t_next, x1, g1
+            k += 1
+            continue
+        # Illinois regula falsi on the step fraction, for the earliest crossing
+        lo, hi = 0.0, 1.0
+        x_hi = x1
+        g_lo, g_hi = g0, guards(t + h, x1, data)
+        frac_tol = tol / h
+        side = 0
+        for _ in range(_MAX_LOCATE_ITERATIONS):
+            if hi - lo <= frac_tol:
+                break
+            theta = math.inf
+            for i in range(mask.size):
+                if mask[i]:
+                    a, b = g_lo[i], g_hi[i]
+                    est = lo + (hi - lo) * a / (a - b) if a != b else 0.5 * (lo + hi)
+                    theta = min(theta, est)
+            theta = min(max(theta, lo + 0.05 * frac_tol), hi - 0.05 * frac_tol)
+            w_inv, w_h = _w_inverse(method, jac, theta * h, w_h, w_inv)
+            x_mid = project(_step(rhs, method, t, x, theta * h, w_inv, data), data)
+            steps += 1
+            calls += _stage_calls(method, x)
+            if not _all_finite(x_mid):
+                return STATUS_NONFINITE, x, t, k, no_fire, steps, calls, theta * h
+            g_mid = guards(t + theta * h, x_mid, data)
+            crossed = _fired(g0, g_mid, directions)
+            if crossed.any():
+                hi, x_hi, g_hi, mask = theta, x_mid, g_mid, crossed
+                if side == 1:
+                    g_lo = g_lo.copy()
+                    for i in range(mask.size):
+                        if mask[i]:
+                            g_lo[i] *= 0.5
+                side = 1
+            else:
+                lo, g_lo = theta, g_mid
+                if side == -1:
+                    g_hi = g_hi.copy()
+                    for i in range(mask.size):
+                        if mask[i]:
+                            g_hi[i] *= 0.5
+                side = -1
+        return STATUS_EVENT, x_hi, t + hi * h, k, mask, steps, calls, hi * h
+    return STATUS_DONE, x, t, k, no_fire, steps, calls, 0.0
+
+
+class CompiledFixedStep(FixedStepSolver):
+    """RK4 or ROS2 over a unit's compiled kernel, with events handled by the Python model.
+
+    Parameters
+    ----------
+    settings : SolverSettings
+        ``method`` a key of :data:`COMPILED_METHODS`.
+    entry : callable
+        The unit's compiled entry point: :func:`advance_to_event` with its kernel
+        bound, called as ``entry(method, t0, t1, n, k, t, x, directions, tol, data)``.
+    """
+
+    def __init__(self, settings: SolverSettings, entry: Callable[..., Any]) -> None:
+        super().__init__(settings)
+        self.entry = entry
+        self.method = COMPILED_METHODS[settings.method]
+        self._python = RK4(settings) if settings.method == "rk4" else ROS2(settings)
+
+    def advance(self, system, t0: float, x0: np.ndarray, t1: float) -> tuple[np.ndarray, int]:
+        """Integrate from ``t0`` to ``t1``; return the state and the number of events.
+
+        Implements :meth:`FixedStepSolver.advance`; ``system`` also offers
+        ``kernel_data()``, the tuple its compiled functions take.
+        """
+        n = max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
+        tol = self.settings.event_time_tolerance
+        t, x, k, events = t0, np.array(x0, dtype=float), 0, 0
+        directions = np.asarray(system.guard_directions(), dtype=float)
+        while k < n:
+            status, x, t_hit, k, mask, steps, calls, h = self.entry(
+                self.method, t0, t1, n, k, t, x, directions, tol, system.kernel_data()
+            )
+            self.steps += steps
+            self.rhs_calls += calls
+            if status == STATUS_DONE:
+                break
+            if status == STATUS_NONFINITE:
+                self._explain_nonfinite(system, t_hit, x, h)
+            events += 1
+            if events > MAX_EVENTS_PER_STEP:
+                raise IntegrationError(f"more than {MAX_EVENTS_PER_STEP} events in one step")
+            x = system.handle_events(t_hit, x, [int(i) for i in np.flatnonzero(mask)])
+            directions = np.asarray(system.guard_directions(), dtype=float)
+            t_next = t0 + (t1 - t0) * (k + 1) / n
+            t = t_hit
+            if t >= t_next - tol:
+                t, k = t_next, k + 1
+            if k >= n and self.method == COMPILED_METHODS["ros2"]:
+                self.rhs_calls += x.size + 1  # the Python solver's Jacobian after the last event
+        return x, events
+
+    def _explain_nonfinite(self, system, t: float, x: np.ndarray, h: float) -> None:
+        """Re-take the failed step with the Python kernel, which raises the error it names."""
+        with system.python_kernel():
+            self._python._checked_step(system, t, x, h)
+        raise IntegrationError(f"non-finite state after a step of {h:.3g} s at t = {t:.6g} s")

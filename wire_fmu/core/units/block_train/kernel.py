@@ -1,0 +1,344 @@
+"""The block train's compiled kernel: its equations as plain functions over flat arrays.
+
+The same physics as :meth:`BlockTrainModel.evaluate
+<wire_fmu.core.units.block_train.model.BlockTrainModel.evaluate>` (the readable
+numpy reference), for block trains whose segment lengths are linear in the body
+motion (no ``moving_geometry``) and that have no friction links (no
+``bearing_friction``, no ``rope_slip``); other block trains run the Python
+kernel. Everything a step needs is in one tuple of arrays, built by
+:func:`kernel_data`:
+
+=====  ==================  ==================================================
+index  name                contents
+=====  ==================  ==================================================
+0      ``sizes``           int: coordinates ``n``, blocks ``nb``, driven bodies
+1      ``rope``            float: ``EA`` (N), damping ``c`` (N s), breaking load (N)
+2      ``masses``          per coordinate, kg
+3      ``span_length0``    geometric span lengths with every body at 0, m
+4      ``span_jacobian``   ``dL/dy`` (spans x bodies), 1
+5      ``flow``            unstretched lengths ``l = offsets + flow @ [q, s_a, s_b]``
+6      ``blocks``          per block: weight along its direction (N), position (m),
+                           floor position (m), stiffness (N/m), damping (N s/m)
+7      ``offsets``         per span, m
+8      ``taut``            per span: mode
+9      ``broken``          per span: mode
+10     ``contact``         per block: on its floor
+11     ``held``            time the inputs hold from (s), line rope positions
+                           ``s`` (m) and rates (m/s), mover positions (m) and
+                           velocities (m/s)
+=====  ==================  ==================================================
+
+The guards are in the order of :meth:`ModeSwitching.guards
+<wire_fmu.core.units.block_train.modes.ModeSwitching.guards>` (friction links
+first: none here).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled_step import advance_to_event
+
+__all__ = ["advance", "evaluate", "guards", "kernel_data", "project", "rhs", "summary"]
+
+N_LINES = 2
+
+
+def kernel_data(model) -> tuple:
+    """The tuple of arrays the kernel functions take, from ``model``'s present values.
+
+    Parameters
+    ----------
+    model : BlockTrainModel
+        A model whose kernel is compiled (see the module docstring).
+    """
+    return (
+        model.kernel_sizes,
+        model.kernel_rope,
+        model.masses,
+        model.span_length0,
+        model.span_jacobian,
+        model.flow_matrix,
+        model.kernel_blocks,
+        model.offsets,
+        model.taut_mask,
+        model.broken_mask,
+        model.contact_mask,
+        model.held_vector,
+    )
+
+
+@jit
+def _matvec(a: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``a @ v`` by loops (sizes of a few; no BLAS call for empty shapes)."""
+    out = np.zeros(a.shape[0])
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[i] += a[i, j] * v[j]
+    return out
+
+
+@jit
+def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """``v @ a`` by loops."""
+    out = np.zeros(a.shape[1])
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[j] += v[i] * a[i, j]
+    return out
+
+
+@jit
+def evaluate(t: float, x: np.ndarray, data):
+    """Forces, tensions, energies and guard inputs at ``(t, x)``.
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+    data : tuple
+        See the module docstring.
+
+    Returns
+    -------
+    tuple
+        ``forces`` on the coordinates (N), span ``tension``, ``trial`` tension and
+        ``elastic`` tension (N), ``stretch`` (m), ``line_force`` (N), ``body_force`` (N),
+        floor ``depth`` (m) and ``trial_contact`` (N), ``span_energy`` (J), ``potential``
+        (J), ``loss`` (W), external ``power`` (W), and ``ok`` (False when a span has no
+        unstretched rope left).
+    """
+    sizes, rope, masses, len0, jac, flow, blocks, offsets, taut, broken, contact, held = data
+    n, nb, nd = sizes[0], sizes[1], sizes[2]
+    ea, damping = rope[0], rope[1]
+    n_spans = len0.size
+    dt = t - held[0]
+    line_rate = held[3 : 3 + N_LINES]
+    mover_v = held[3 + N_LINES + nd : 3 + N_LINES + 2 * nd]
+    y = np.empty(nb + nd)
+    ydot = np.empty(nb + nd)
+    for j in range(nb):
+        y[j] = x[j]
+        ydot[j] = x[n + j]
+    for j in range(nd):
+        y[nb + j] = held[3 + N_LINES + j] + mover_v[j] * dt
+        ydot[nb + j] = mover_v[j]
+    flow_q = np.empty(n + N_LINES)
+    flow_v = np.empty(n + N_LINES)
+    for i in range(n):
+        flow_q[i] = x[i]
+        flow_v[i] = x[n + i]
+    for i in range(N_LINES):
+        flow_q[n + i] = held[1 + i] + line_rate[i] * dt
+        flow_v[n + i] = line_rate[i]
+    big_l = len0 + _matvec(jac, y)
+    big_l_rate = _matvec(jac, ydot)
+    small_l = offsets + _matvec(flow, flow_q)
+    small_l_rate = _matvec(flow, flow_v)
+    ok = True
+    tension = np.zeros(n_spans)
+    trial = np.empty(n_spans)
+    elastic = np.empty(n_spans)
+    on_unstretched = np.zeros(n_spans)
+    energy = np.zeros(n_spans)
+    loss = 0.0
+    for i in range(n_spans):
+        if small_l[i] <= 0.0:
+            ok = False
+        stretch = big_l[i] - small_l[i]
+        eps = stretch / small_l[i]
+        t_el = ea * eps
+        eps_rate = 0.0
+        t_d = 0.0
+        if damping != 0.0:
+            eps_rate = (big_l_rate[i] - (1.0 + eps) * small_l_rate[i]) / small_l[i]
+            t_d = damping * eps_rate
+        trial[i] = t_el + t_d
+        elastic[i] = t_el
+        if broken[i]:
+            continue
+        if taut[i]:
+            tension[i] = t_el + t_d
+            on_unstretched[i] = t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps)
+            energy[i] = 0.5 * t_el * stretch
+            loss += t_d * small_l[i] * eps_rate
+        elif stretch > 0.0:  # slack but still stretched: its strain drains, never negative
+            energy[i] = 0.5 * t_el * stretch
+            strain_rate = t_el * big_l_rate[i] - t_el * (1.0 + 0.5 * eps) * small_l_rate[i]
+            loss += max(-strain_rate, 0.0)
+    body_force = -_vecmat(tension, jac)
+    generalised = _vecmat(on_unstretched, flow)
+    forces = generalised[:n].copy()
+    potential = 0.0
+    depth = np.zeros(nb)
+    trial_contact = np.zeros(nb)
+    for j in range(nb):
+        weight = blocks[j, 0]
+        forces[j] += body_force[j] + weight
+        potential -= weight * x[j]
+        stiffness = blocks[j, 3]
+        if stiffness > 0.0:
+            depth[j] = blocks[j, 2] - (blocks[j, 1] + x[j])
+            elastic_force = stiffness * depth[j]
+            damping_force = -blocks[j, 4] * x[n + j]
+            trial_contact[j] = elastic_force + damping_force
+            if contact[j]:
+                forces[j] += trial_contact[j]
+                potential += 0.5 * elastic_force * depth[j]
+                loss += -damping_force * x[n + j]
+            elif depth[j] > 0.0:  # lifting off faster than the pad recovers: it drains
+                potential += 0.5 * elastic_force * depth[j]
+                loss += stiffness * depth[j] * x[n + j]
+    line_force = generalised[n:]
+    power = -(line_force[0] * line_rate[0] + line_force[1] * line_rate[1])
+    for j in range(nd):
+        power -= body_force[nb + j] * ydot[nb + j]
+    return (
+        forces,
+        tension,
+        trial,
+        elastic,
+        big_l - small_l,
+        line_force,
+        body_force,
+        depth,
+        trial_contact,
+        energy,
+        potential,
+        loss,
+        power,
+        ok,
+    )
+
+
+@jit
+def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
+    """State derivative ``[q', v', dissipated', external work']``; NaN where a span runs out.
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see :func:`evaluate`).
+    data : tuple
+        See the module docstring.
+    """
+    n = data[0][0]
+    masses = data[2]
+    result = evaluate(t, x, data)
+    forces, loss, power = result[0], result[11], result[12]
+    out = np.empty_like(x)
+    for i in range(n):
+        out[i] = x[n + i]
+        out[n + i] = forces[i] / masses[i]
+    out[2 * n] = loss
+    out[2 * n + 1] = power
+    if not result[13]:
+        out[:] = math.nan
+    return out
+
+
+@jit
+def guards(t: float, x: np.ndarray, data) -> np.ndarray:
+    """Slack/taut ropes, floor contact and rope break, each firing below zero (N).
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see :func:`evaluate`).
+    data : tuple
+        See the module docstring.
+    """
+    breaking_load = data[1][2]
+    blocks, taut, broken, contact = data[6], data[8], data[9], data[10]
+    result = evaluate(t, x, data)
+    tension, trial, elastic, depth, trial_contact = (
+        result[1],
+        result[2],
+        result[3],
+        result[7],
+        result[8],
+    )
+    n_spans, nb = tension.size, depth.size
+    out = np.empty(2 * n_spans + nb)
+    for i in range(n_spans):
+        if broken[i]:
+            out[i] = 1.0
+        elif taut[i]:
+            out[i] = trial[i]
+        else:
+            out[i] = max(-elastic[i], -trial[i])
+        margin = breaking_load - tension[i]
+        out[n_spans + nb + i] = margin if math.isfinite(margin) else 1.0
+    for j in range(nb):
+        stiffness = blocks[j, 3]
+        if stiffness <= 0.0:
+            out[n_spans + j] = 1.0
+        elif contact[j]:
+            out[n_spans + j] = trial_contact[j]
+        else:
+            out[n_spans + j] = max(-stiffness * depth[j], -trial_contact[j])
+    return out
+
+
+@jit
+def summary(t: float, x: np.ndarray, data) -> np.ndarray:
+    """What the outputs need, in one array (one crossing back to Python).
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see :func:`evaluate`).
+    data : tuple
+        See the module docstring.
+
+    Returns
+    -------
+    numpy.ndarray
+        Rope strain energy (J), potential energy (J), span tensions (N), forces on the
+        bodies (N); the first entry is NaN when a span has no unstretched rope left.
+    """
+    result = evaluate(t, x, data)
+    tension, body_force, energy = result[1], result[6], result[9]
+    out = np.empty(2 + tension.size + body_force.size)
+    out[0] = energy.sum() if result[13] else math.nan
+    out[1] = result[10]
+    out[2 : 2 + tension.size] = tension
+    out[2 + tension.size :] = body_force
+    return out
+
+
+@jit
+def project(x: np.ndarray, data) -> np.ndarray:
+    """No invariants without friction links: ``x`` as it is.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State.
+    data : tuple
+        See the module docstring.
+    """
+    return x
+
+
+@jit
+def advance(method, t0, t1, n, k, t, x, directions, tol, data):
+    """:func:`~wire_fmu.core.framework.compiled_step.advance_to_event` over this kernel.
+
+    Parameters
+    ----------
+    method, t0, t1, n, k, t, x, directions, tol, data
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
+    """
+    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
