@@ -28,6 +28,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from wire_fmu.core.errors import ConfigurationError
+
 __all__ = [
     "KERNEL_ENV",
     "CACHE_ENV",
@@ -56,7 +58,7 @@ except ImportError:  # pragma: no cover - exercised on machines without numba
     _numba_caching = None
 
 
-class KernelChoiceError(ValueError):
+class KernelChoiceError(ConfigurationError):
     """``WIRE_FMU_KERNEL`` holds something other than ``compiled`` or ``python``."""
 
 
@@ -76,8 +78,8 @@ def kernel_choice() -> str:
     value = os.environ.get(KERNEL_ENV, "compiled").strip().lower() or "compiled"
     if value not in _CHOICES:
         raise KernelChoiceError(
-            f"environment variable {KERNEL_ENV}={os.environ[KERNEL_ENV]!r}: expected one of "
-            f"{', '.join(_CHOICES)}"
+            f"environment variable {KERNEL_ENV}",
+            [f"{os.environ[KERNEL_ENV]!r} is not a kernel: expected one of {', '.join(_CHOICES)}"],
         )
     return value
 
