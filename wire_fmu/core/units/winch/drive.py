@@ -12,9 +12,12 @@ from contextlib import contextmanager
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
+from wire_fmu.core.framework.compiled import use_compiled
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
+from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
 from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLDING, BRAKE_SLIPPING
 
@@ -57,12 +60,29 @@ class WinchModel(_WinchBase):
         self._n_brake_guards = 2 if config.has_brake else 0
         self._guard_dirs = -np.ones(self._n_brake_guards + 2 * int(self.drum.layered))
         self.settings = solver
+        self.compiled = solver.method in COMPILED_METHODS and use_compiled("winch")
         if solver.method in ENERGY_SOLVERS:
             if self.n != 1:
                 raise ValueError("the energy-form solver needs a rigid drive train (one mass)")
             self.solver = make_energy_solver(solver)
+        elif self.compiled:
+            self.solver = CompiledFixedStep(solver, kernel.advance)
         else:
             self.solver = make_solver(solver)
+
+    # ---------------------------------------------------------- kernels
+    def kernel_data(self) -> tuple:
+        """The tuple of arrays the compiled kernel takes, for the present inputs and modes."""
+        return kernel.kernel_data(self)
+
+    @contextmanager
+    def python_kernel(self) -> Iterator[None]:
+        """Evaluate with the Python kernel inside the ``with`` block."""
+        compiled, self.compiled = self.compiled, False
+        try:
+            yield
+        finally:
+            self.compiled = compiled
 
     # ---------------------------------------------------------- state views
     @property
@@ -131,6 +151,8 @@ class WinchModel(_WinchBase):
         x : ndarray
             State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
         """
+        if self.compiled:
+            return kernel.rhs(t, x, self.kernel_data())
         n = self.n
         omega = x[n : 2 * n]
         acc, link = self._dynamics(x)
@@ -169,6 +191,8 @@ class WinchModel(_WinchBase):
         x : ndarray
             State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
         """
+        if self.compiled:
+            return kernel.guards(t, x, self.kernel_data())
         out = []
         if self.config.has_brake:
             if self.engaged:

@@ -1,0 +1,215 @@
+"""The winch's compiled kernel: drum, drive train, motor and band brake over flat arrays.
+
+The same physics as :class:`~wire_fmu.core.units.winch.drive.WinchModel` (the
+readable numpy reference), for a winch with drum inertia solved by RK4 or ROS2
+(paper 004's energy-form solvers stay in Python). Everything a step needs is in
+one tuple, built by :func:`kernel_data`:
+
+=====  ===============  ====================================================
+index  name             contents
+=====  ===============  ====================================================
+0      ``modes``        int: brake modelled (0/1), brake engaged (0/1), its
+                        stick/slip mode (0 stuck, +1/-1 sliding), layers (0/1)
+1      ``inertia``      inertia of each mass reduced to the drum shaft, kg m^2
+2      ``stiffness``    chain stiffness matrix, N m/rad
+3      ``damping``      chain damping matrix, N m s/rad
+4      ``held``         see :data:`HELD`
+=====  ===============  ====================================================
+
+State ``[theta (n), omega (n), dissipated, external work]`` (rad, rad/s, J, J);
+mass 0 is the motor rotor, mass ``n - 1`` the drum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled_step import advance_to_event
+
+__all__ = ["HELD", "advance", "guards", "kernel_data", "project", "rhs"]
+
+HELD = (
+    "motor torque at zero speed reduced to the drum shaft (N m)",
+    "motor slope reduced to the drum shaft (N m s/rad)",
+    "rope tension (N)",
+    "brake lever force (N)",
+    "winding radius of the layer (m)",
+    "rope inertia on the drum at phi = 0 for the layer (kg m^2)",
+    "its slope d I / d phi (kg m^2/rad)",
+    "brake capacity against paying out (N m)",
+    "brake capacity against hauling in (N m)",
+    "lowest drum angle of the layer (rad)",
+    "highest drum angle of the layer (rad)",
+    "drum angle the brake holds (rad)",
+)
+"""What the ``held`` array holds, in order: inputs and the present layer's constants."""
+
+
+def kernel_data(model) -> tuple:
+    """The tuple the kernel functions take, from ``model``'s present inputs and modes.
+
+    Parameters
+    ----------
+    model : WinchModel
+        A winch with drum inertia.
+    """
+    drum, k, inputs = model.drum, model.layer, model.inputs
+    low, high = drum.phi_bounds(k)
+    offset = drum.rope_inertia(0.0, k)
+    mode = int(model.friction.mode[0]) if model.friction.links else 0
+    modes = np.array([int(model.config.has_brake), int(model.engaged), mode, int(drum.layered)])
+    held = np.array(
+        [
+            model.motor_ratio * inputs.motor_command,
+            model.motor_b,
+            inputs.tension,
+            inputs.lever_force,
+            drum.layer_radius(k),
+            offset,
+            drum.rope_inertia_slope(k),
+            model._caps[0, 0],
+            model._caps[0, 1],
+            low,
+            high,
+            model._held_angle,
+        ]
+    )
+    return modes, model.base_inertia, model.stiffness, model.damping, held
+
+
+@jit
+def _dynamics(x: np.ndarray, data):
+    """Accelerations (rad/s^2) and the brake torque on the drum (N m) in the present mode."""
+    modes, inertia, stiffness, damping, held = data
+    n = inertia.size
+    forces = np.empty(n)
+    if n > 1:
+        for i in range(n):
+            total = 0.0
+            for j in range(n):
+                total -= stiffness[i, j] * x[j]
+            for j in range(n):
+                total -= damping[i, j] * x[n + j]
+            forces[i] = total
+    else:
+        forces[0] = -damping[0, 0] * x[1]
+    forces[0] += held[0] - held[1] * x[n]
+    w = x[2 * n - 1]
+    forces[n - 1] += held[2] * held[4] - 0.5 * held[6] * w * w
+    masses = inertia.copy()
+    masses[n - 1] += held[5] + held[6] * x[n - 1]
+    brake = 0.0
+    engaged, mode = modes[1] == 1, modes[2]
+    if engaged and mode != 0:
+        brake = -mode * (held[7] if mode > 0 else held[8])
+        forces[n - 1] += brake
+    acc = forces / masses
+    if engaged and mode == 0:
+        acc[n - 1] = 0.0
+        brake = -forces[n - 1]
+    return acc, brake
+
+
+@jit
+def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
+    """``[theta', omega', dissipated', external work']``.
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see the module docstring).
+    data : tuple
+        See the module docstring.
+    """
+    modes, inertia, _, damping, held = data
+    n = inertia.size
+    acc, brake = _dynamics(x, data)
+    out = np.empty_like(x)
+    loss = 0.0
+    for i in range(n):
+        out[i] = x[n + i]
+        out[n + i] = acc[i]
+        row = 0.0
+        for j in range(n):
+            row += x[n + j] * damping[j, i]
+        loss += row * x[n + i]
+    if modes[1] == 1:
+        if modes[2] != 0:
+            loss -= brake * x[2 * n - 1]
+        else:
+            out[n - 1] = 0.0
+    out[2 * n] = loss
+    omega0 = x[n]
+    out[2 * n + 1] = (held[0] - held[1] * omega0) * omega0 + held[2] * held[4] * x[2 * n - 1]
+    return out
+
+
+@jit
+def guards(t: float, x: np.ndarray, data) -> np.ndarray:
+    """Brake stick/slip and engagement, then the layer's two edges (all fire downwards).
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see the module docstring).
+    data : tuple
+        See the module docstring.
+    """
+    modes, inertia, _, _, held = data
+    n = inertia.size
+    out = np.empty(2 * modes[0] + 2 * modes[3])
+    i = 0
+    if modes[0] == 1:
+        if modes[1] == 1:
+            if modes[2] == 0:
+                brake = _dynamics(x, data)[1]
+                against = held[7] if (-brake if brake != 0.0 else 1.0) > 0 else held[8]
+                out[0] = against - abs(brake)
+            else:
+                out[0] = modes[2] * x[2 * n - 1]
+            out[1] = held[3]
+        else:
+            out[0] = 1.0
+            out[1] = -held[3]
+        i = 2
+    if modes[3] == 1:
+        phi = x[n - 1]
+        out[i] = phi - held[9]
+        out[i + 1] = held[10] - phi
+    return out
+
+
+@jit
+def project(x: np.ndarray, data) -> np.ndarray:
+    """A held drum stays exactly where it stuck, at rest.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State, changed in place and returned.
+    data : tuple
+        See the module docstring.
+    """
+    modes, inertia, _, _, held = data
+    n = inertia.size
+    if modes[1] == 1 and modes[2] == 0:
+        x[n - 1] = held[11]
+        x[2 * n - 1] = 0.0
+    return x
+
+
+@jit
+def advance(method, t0, t1, n, k, t, x, directions, tol, data):
+    """:func:`~wire_fmu.core.framework.compiled_step.advance_to_event` over this kernel.
+
+    Parameters
+    ----------
+    method, t0, t1, n, k, t, x, directions, tol, data
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
+    """
+    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
