@@ -198,13 +198,13 @@ class Unit(ABC):
         bad = self.input_problems()
         if bad:
             return StepResult(False, f"{who}: step refused: " + "; ".join(bad))
-        saved = self.get_state()
+        saved = self._snapshot()
         try:
             events = self._advance(time, step)
             self.time = time + step
             self._update_outputs()
         except STEP_ERRORS as err:
-            self.set_state(saved)
+            self._restore_snapshot(saved)
             return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
         return StepResult(True, events=tuple(events))
 
@@ -258,6 +258,24 @@ class Unit(ABC):
         if model is None:
             raise RuntimeError(f"{self.who}: configure() first")
         return model
+
+    def _snapshot(self) -> Any:
+        """What :meth:`advance` keeps to undo a refused step (default :meth:`get_state`).
+
+        A unit may keep something cheaper than its full, serialisable state: this
+        is taken every step and never leaves the process.
+        """
+        return self.get_state()
+
+    def _restore_snapshot(self, saved: Any) -> None:
+        """Undo a refused step from what :meth:`_snapshot` kept.
+
+        Parameters
+        ----------
+        saved : object
+            What :meth:`_snapshot` returned before the step.
+        """
+        self.set_state(saved)
 
     @abstractmethod
     def get_state(self) -> dict[str, Any]:

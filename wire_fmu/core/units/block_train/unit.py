@@ -302,6 +302,35 @@ class BlockTrainUnit(Unit):
             "solver": {"rhs_calls": m.solver.rhs_calls, "steps": m.solver.steps},
         }
 
+    def _snapshot(self) -> tuple:
+        """The model's arrays, modes and held inputs, copied (cheaper than :meth:`get_state`)."""
+        m = self._require_model()
+        return (
+            m.state.copy(),
+            m.offsets.copy(),
+            m.broken_mask.copy(),
+            m.taut_mask.copy(),
+            m.contact_mask.copy(),
+            m.friction.get_mode(),
+            m.mode_changes,
+            m.inputs,
+            m._t_step,
+            m._held_positions.copy(),
+            m.solver.rhs_calls,
+            m.solver.steps,
+            self.time,
+        )
+
+    def _restore_snapshot(self, saved: tuple) -> None:
+        """Implements :meth:`Unit._restore_snapshot`."""
+        m = self._require_model()
+        (m.state, m.offsets, m.broken_mask, m.taut_mask, m.contact_mask, mode, m.mode_changes,
+         inputs, t_step, m._held_positions, m.solver.rhs_calls, m.solver.steps,
+         self.time) = saved  # fmt: skip
+        m.friction.set_mode(mode)
+        m.set_inputs(t_step, inputs)
+        self._update_outputs()
+
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`.
 
@@ -334,39 +363,56 @@ class BlockTrainUnit(Unit):
             mover_velocity={p: float(v[f"{p}.velocity"]) for p in MOVER_PORTS},
         )
 
+    def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
+        """Which span, body and coordinate feed each port output (built once per model)."""
+        plan = getattr(self, "_plan", None)
+        if plan is not None and plan[0] is m:
+            return plan[1]
+        nb = len(m.blocks)
+        lines = [
+            (f"{m.nodes[k].name}.tension", 0 if k == 0 else len(m.spans) - 1)
+            for k in (0, m.n_nodes - 1)
+            if m.nodes[k].kind == "line_end"
+        ]
+        drivers = [(f"{b.port}.force", nb + j) for j, b in enumerate(m.drivers)]
+        blocks = [
+            (f"{b.port}.position", f"{b.port}.velocity", j, b.position)
+            for j, b in enumerate(m.blocks)
+            if b.port
+        ]
+        self._plan = (m, (lines, drivers, blocks))
+        return lines, drivers, blocks
+
     def _update_outputs(self) -> None:
         m = self._require_model()
         # inputs as they evolved over the last step
         rope_energy, potential, tension, body_force = m.summary(self.time, m.state)
         out = self.values
-        for k, _port in ((0, None), (m.n_nodes - 1, None)):
-            node = m.nodes[k]
-            if node.kind == "line_end":
-                span = 0 if k == 0 else len(m.spans) - 1
-                out[f"{node.name}.tension"] = float(tension[span])
-        nb = len(m.blocks)
-        for j, body in enumerate(m.drivers):
-            out[f"{body.port}.force"] = float(body_force[nb + j])
-        for j, body in enumerate(m.blocks):
-            if body.port:
-                out[f"{body.port}.position"] = float(body.position + m.q[j])
-                out[f"{body.port}.velocity"] = float(m.v[j])
-        out["path_start.tension"] = float(tension[0])
-        out["path_end.tension"] = float(tension[-1])
-        out["tension_max"] = float(tension.max()) if tension.size else 0.0
-        out["slack_spans"] = int(np.count_nonzero(~m.taut_mask & ~m.broken_mask))
-        out["broken"] = any(m.broken)
-        kinetic = 0.5 * float(m.masses @ m.v**2)
-        stored = kinetic + rope_energy + potential
+        lines, drivers, blocks = self._output_plan(m)
+        tensions, forces, x = tension.tolist(), body_force.tolist(), m.state.tolist()
+        for name, span in lines:
+            out[name] = tensions[span]
+        for name, j in drivers:
+            out[name] = forces[j]
         n = m.n_coords
+        for position, velocity, j, start in blocks:
+            out[position] = start + x[j]
+            out[velocity] = x[n + j]
+        out["path_start.tension"] = tensions[0]
+        out["path_end.tension"] = tensions[-1]
+        out["tension_max"] = float(tension.max()) if tensions else 0.0
+        out["slack_spans"] = int(np.count_nonzero(~m.taut_mask & ~m.broken_mask))
+        out["broken"] = bool(m.broken_mask.any())
+        kinetic = 0.5 * float(m.masses @ m.v**2) if n else 0.0
+        stored = kinetic + rope_energy + potential
         out["stored_energy"] = float(stored)
-        out["dissipated_energy"] = float(m.state[2 * n])
-        out["external_work"] = float(m.state[2 * n + 1])
+        out["dissipated_energy"] = x[2 * n]
+        out["external_work"] = x[2 * n + 1]
         out["energy_balance"] = float(
             stored - self.initial_energy + out["dissipated_energy"] - out["external_work"]
         )
         out["mode_changes"] = int(m.mode_changes)
-        if not all(math.isfinite(out[k]) for k in ("stored_energy", "tension_max")):
+        if not (math.isfinite(out["stored_energy"]) and math.isfinite(out["tension_max"])):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
 
