@@ -2,8 +2,9 @@
 
 A benchmark describes one manoeuvre as a :class:`Case`: the unit class, its
 facade script, string and real parameters, and a function giving the real
-inputs at step ``i``. :func:`measure` steps it in the core and through the
-FMU (fmpy, in this process) and returns a :class:`Row`.
+inputs at step ``i``. :func:`measure` steps it in the core with the Python
+kernel and with the compiled one (``WIRE_FMU_KERNEL``), and through the FMU
+(fmpy, in this process, compiled kernel), and returns a :class:`Row`.
 
 The FMU runs in this process and uses the ``wire_fmu`` already imported
 here, so the time spent inside the unit's ``advance`` during the FMU run is
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import statistics
 import tempfile
 import time
@@ -23,6 +25,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from wire_fmu.core.framework.compiled import KERNEL_ENV
 from wire_fmu.core.framework.unit import Unit
 
 __all__ = ["Case", "Row", "measure", "table", "ROOT", "run_cases", "command_line"]
@@ -69,9 +72,15 @@ class Row:
 
     label: str
     states: int
+    python_ms: float
     core_ms: float
     fmu_ms: float
     overhead_ms: float
+
+    @property
+    def kernel_ratio(self) -> float:
+        """How many times faster the compiled kernel steps the core than the Python one."""
+        return self.python_ms / self.core_ms
 
     @property
     def overhead_share(self) -> float:
@@ -89,7 +98,7 @@ def _core_unit(case: Case) -> Unit:
     return unit
 
 
-def time_core(case: Case, steps: int) -> tuple[float, int]:
+def time_core(case: Case, steps: int, kernel: str = "compiled") -> tuple[float, int]:
     """Median ms per step of the core unit, and the size of its state.
 
     Parameters
@@ -98,6 +107,8 @@ def time_core(case: Case, steps: int) -> tuple[float, int]:
         The manoeuvre.
     steps : int
         Steps timed (the first ``WARM_UP`` do not count).
+    kernel : str
+        ``WIRE_FMU_KERNEL`` while the unit is built: ``"compiled"`` or ``"python"``.
 
     Returns
     -------
@@ -106,7 +117,15 @@ def time_core(case: Case, steps: int) -> tuple[float, int]:
     states : int
         Length of the unit's continuous state vector.
     """
-    unit = _core_unit(case)
+    before = os.environ.get(KERNEL_ENV)
+    os.environ[KERNEL_ENV] = kernel
+    try:
+        unit = _core_unit(case)
+    finally:
+        if before is None:
+            del os.environ[KERNEL_ENV]
+        else:
+            os.environ[KERNEL_ENV] = before
     samples = []
     for i in range(steps):
         unit.values.update(case.inputs(i))
@@ -230,9 +249,10 @@ def measure(fmu_path: Path, case: Case, steps: int) -> Row:
     -------
     Row
     """
-    core_ms, states = time_core(case, steps)
+    python_ms, states = time_core(case, steps, "python")
+    core_ms, _ = time_core(case, steps, "compiled")
     fmu_ms, overhead_ms = time_fmu(fmu_path, case, steps)
-    return Row(case.label, states, core_ms, fmu_ms, overhead_ms)
+    return Row(case.label, states, python_ms, core_ms, fmu_ms, overhead_ms)
 
 
 def table(rows: list[Row]) -> str:
@@ -244,12 +264,14 @@ def table(rows: list[Row]) -> str:
         One per case.
     """
     lines = [
-        "| effects | states | core ms/step | FMU ms/step | FMI overhead ms | share |",
-        "|---|---:|---:|---:|---:|---:|",
+        "| effects | states | Python kernel ms/step | compiled ms/step | ratio "
+        "| FMU ms/step | FMI overhead ms | share |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         lines.append(
-            f"| {r.label} | {r.states} | {r.core_ms:.3f} | {r.fmu_ms:.3f} | "
+            f"| {r.label} | {r.states} | {r.python_ms:.3f} | {r.core_ms:.3f} | "
+            f"{r.kernel_ratio:.1f} | {r.fmu_ms:.3f} | "
             f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |"
         )
     return "\n".join(lines)
@@ -308,8 +330,13 @@ def run_cases(unit: str, cases: Sequence[Case], steps: int, title: str) -> str:
         fmu = build_fmu(unit_type(unit).facade_path, Path(tmp))
         for case in cases:
             rows.append(measure(fmu, case, steps))
+            row = rows[-1]
             logger.info(
-                "%s: %.3f ms core, %.3f ms FMU", case.label, rows[-1].core_ms, rows[-1].fmu_ms
+                "%s: %.3f ms Python, %.3f ms compiled, %.3f ms FMU",
+                case.label,
+                row.python_ms,
+                row.core_ms,
+                row.fmu_ms,
             )
     text = table(rows)
     logger.info("\n%s:\n%s", title, text)
