@@ -110,7 +110,7 @@ def _w_inverse(method: int, jac: np.ndarray, h: float, w_h: float, w_inv: np.nda
     if method != _ROS2 or h == w_h:
         return w_inv, w_h
     n = jac.shape[0]
-    return np.linalg.inv(np.eye(n) - _GAMMA * h * jac), h
+    return np.ascontiguousarray(np.linalg.inv(np.eye(n) - _GAMMA * h * jac)), h
 
 
 @jit

@@ -320,6 +320,9 @@ class WinchModel(_WinchBase):
         if not self.config.has_brake:
             return x
         x = np.array(x, dtype=float)
+        if fired is None and self.compiled and self._brake_mode_holds(x):
+            self._held_angle = float(x[self.n - 1])
+            return self.project(x)
         before = self._mode_key()
         n = self.n
         if min(self.capacities) <= 0.0:
@@ -336,6 +339,20 @@ class WinchModel(_WinchBase):
                 self.mode_changes += 1
         self._held_angle = float(x[n - 1])
         return self.project(x)
+
+    def _brake_mode_holds(self, x: np.ndarray) -> bool:
+        """Whether the brake's present mode fits the inputs at ``x`` (nothing to settle).
+
+        Released and without capacity; or engaged with capacity, and sliding, or
+        stuck with a holding margin left (the compiled kernel's stick guard).
+        """
+        if min(self.capacities) <= 0.0:
+            return not self.engaged
+        if not self.engaged:
+            return False
+        if self.friction.mode[0] != 0:
+            return True
+        return bool(kernel.guards(0.0, x, self.kernel_data())[0] >= 0.0)
 
     # ---------------------------------------------------------- life cycle
     def initialize(self, t0: float, inputs: WinchInputs) -> None:
@@ -412,6 +429,8 @@ class WinchModel(_WinchBase):
             State (default: the current one).
         """
         x = self.state if x is None else x
+        if self.compiled:
+            return float(kernel.summary(x, self.kernel_data())[1])
         n = self.n
         theta, omega = x[:n], x[n : 2 * n]
         self._forces(x)
@@ -421,7 +440,10 @@ class WinchModel(_WinchBase):
         """Outputs at the current state for the held inputs (state untouched)."""
         x = self.state
         n = self.n
-        _, link = self._dynamics(x)
+        if self.compiled:
+            brake, stored = kernel.summary(x, self.kernel_data()).tolist()
+        else:
+            brake, stored = float(self._dynamics(x)[1][0]) if self.engaged else 0.0, None
         w, k = float(x[2 * n - 1]), self.layer
         radius = self.drum.layer_radius(k)
         motor_speed = self.motor_ratio * float(x[n])
@@ -434,10 +456,10 @@ class WinchModel(_WinchBase):
             drum_radius=radius,
             motor_speed=motor_speed,
             motor_torque=self.motor_torque(motor_speed),
-            brake_torque=float(link[0]) + 0.0 if self.engaged else 0.0,
+            brake_torque=brake + 0.0 if self.engaged else 0.0,
             brake_capacity=self.capacities[0],
             brake_state=self.brake_state(),
-            stored_energy=self.stored_energy(),
+            stored_energy=self.stored_energy() if stored is None else stored,
             dissipated_energy=float(x[2 * n]),
             external_work=float(x[2 * n + 1]),
         )

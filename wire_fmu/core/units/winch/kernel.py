@@ -27,7 +27,7 @@ import numpy as np
 from wire_fmu.core.framework.compiled import jit
 from wire_fmu.core.framework.compiled_step import advance_to_event
 
-__all__ = ["HELD", "advance", "guards", "kernel_data", "project", "rhs"]
+__all__ = ["HELD", "advance", "guards", "kernel_data", "project", "rhs", "summary"]
 
 HELD = (
     "motor torque at zero speed reduced to the drum shaft (N m)",
@@ -181,6 +181,35 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
         phi = x[n - 1]
         out[i] = phi - held[9]
         out[i + 1] = held[10] - phi
+    return out
+
+
+@jit
+def summary(x: np.ndarray, data) -> np.ndarray:
+    """What the outputs need beyond the state: brake torque (N m) and stored energy (J).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State (see the module docstring).
+    data : tuple
+        See the module docstring.
+    """
+    modes, inertia, stiffness, _, held = data
+    n = inertia.size
+    brake = _dynamics(x, data)[1] if modes[1] == 1 else 0.0
+    kinetic = 0.0
+    for i in range(n):
+        mass = inertia[i] + (held[5] + held[6] * x[n - 1] if i == n - 1 else 0.0)
+        kinetic += mass * x[n + i] * x[n + i]
+    strain = 0.0
+    if n > 1:
+        for i in range(n):
+            for j in range(n):
+                strain += x[i] * stiffness[i, j] * x[j]
+    out = np.empty(2)
+    out[0] = brake
+    out[1] = 0.5 * kinetic + 0.5 * strain
     return out
 
 
