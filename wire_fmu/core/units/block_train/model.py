@@ -258,6 +258,7 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
                 elif self.nodes[node].kind == "line_end":
                     flow[i, n + LINE_PORTS.index(self.nodes[node].name)] += sign
         self.flow_matrix = flow
+        self._line_signs = [float(c) for c in self.line_sign]
         self.driver_ports = [b.port for b in self.drivers]
         self.block_weight = np.array(
             [
@@ -278,15 +279,17 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         """
         self.inputs = inputs
         self._t_step = t
-        self._line_s0 = self.line_sign * np.array([inputs.payout.get(p, 0.0) for p in LINE_PORTS])
-        self._line_rate = self.line_sign * np.array(
-            [inputs.payout_rate.get(p, 0.0) for p in LINE_PORTS]
-        )
-        self._mover_y0 = np.array([inputs.mover_position.get(p, 0.0) for p in self.driver_ports])
-        self._mover_v = np.array([inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports])
-        self.held_vector = np.concatenate(
-            ([t], self._line_s0, self._line_rate, self._mover_y0, self._mover_v)
-        )
+        lines = list(zip(LINE_PORTS, self._line_signs, strict=True))
+        held = [t]
+        held += [sign * inputs.payout.get(p, 0.0) for p, sign in lines]
+        held += [sign * inputs.payout_rate.get(p, 0.0) for p, sign in lines]
+        held += [inputs.mover_position.get(p, 0.0) for p in self.driver_ports]
+        held += [inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports]
+        self.held_vector = vector = np.array(held)
+        lines, movers = 1 + len(LINE_PORTS), 1 + 2 * len(LINE_PORTS)
+        self._line_s0, self._line_rate = vector[1:lines], vector[lines:movers]
+        self._mover_y0 = vector[movers : movers + len(self.driver_ports)]
+        self._mover_v = vector[movers + len(self.driver_ports) :]
 
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Geometric span lengths (m) and their Jacobian w.r.t. body motion.
