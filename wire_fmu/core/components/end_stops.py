@@ -298,6 +298,21 @@ class EndStops:
         omega = math.sqrt(self.spec.stiffness / mass)
         return omega, damping_ratio_for_restitution(self.spec.restitution)
 
+    def snapshot(self) -> tuple:
+        """The modes, to :meth:`restore` in this process (cheaper than :meth:`get_state`)."""
+        return tuple(self.contact), tuple(self.in_cushion), self.contact_since
+
+    def restore(self, snapshot: tuple) -> None:
+        """Restore the modes from :meth:`snapshot`.
+
+        Parameters
+        ----------
+        snapshot : tuple
+            As :meth:`snapshot` returned it.
+        """
+        contact, in_cushion, self.contact_since = snapshot
+        self.contact, self.in_cushion = list(contact), list(in_cushion)
+
     def get_state(self) -> dict:
         """The modes, as JSON data."""
         since = self.contact_since

@@ -100,6 +100,11 @@ class RodSeal:
         """Whether the seals hold the rod."""
         return self.friction.mode[0] == 0
 
+    @property
+    def mode(self) -> int:
+        """0 while the seals hold the rod, +1 or -1 the direction it slides in."""
+        return int(self.friction.mode[0])
+
     def start(self, velocity: float) -> None:
         """Mode at the start: a moving rod slides.
 
@@ -154,12 +159,32 @@ class RodSeal:
         fired : list of int
             ``[0]`` when the seal's guard fired, else ``[]``.
         """
+        if not fired and not (self.stuck and abs(force) > self.spec.static):
+            # nothing fired and the seals can hold what they hold: no mode changes
+            self.held_position = float(position)
+            return float(velocity), None
         before = self.friction.get_mode()
         v = self.friction.switch(np.array([velocity]), np.array([force]), self.capacity, fired)
         self.held_position = float(position)
         if self.friction.get_mode() == before:
             return float(v[0]), None
         return float(v[0]), f"rod seals {'stuck' if self.stuck else 'sliding'}"
+
+    def snapshot(self) -> tuple[int, float]:
+        """Mode and held position, to :meth:`restore` in this process (cheaper than
+        :meth:`get_state`)."""
+        return self.mode, self.held_position
+
+    def restore(self, snapshot: tuple[int, float]) -> None:
+        """Restore from :meth:`snapshot`.
+
+        Parameters
+        ----------
+        snapshot : tuple
+            As :meth:`snapshot` returned it.
+        """
+        mode, self.held_position = snapshot
+        self.friction.set_mode([mode])
 
     def get_state(self) -> dict:
         """Mode and held position, as JSON data."""

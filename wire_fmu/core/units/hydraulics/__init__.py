@@ -113,6 +113,10 @@ and the communication step only (bit-reproducible). Restitution and the
 cushion law are then met to about 0.1 % whatever ``solver_max_step`` is.
 The adaptive SciPy solvers need none of this.
 
+The equations run compiled (:mod:`.kernel`, numba) for every effect set unless
+``WIRE_FMU_KERNEL=python``; the Python model stays the reference, and events,
+their messages and the refused steps' reasons stay in Python.
+
 Energy
 ------
 Stored: rod kinetic ``m_eff v^2/2``, line kinetic ``L q^2/2``, gas ``E(V_g)``

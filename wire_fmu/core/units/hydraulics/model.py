@@ -1,12 +1,17 @@
 """Hydraulic cylinder with a gas accumulator: the hydro-pneumatic spring (SPEC section 11).
 
 The physics, the effects and the numerics are described in the package
-(:mod:`wire_fmu.core.units.hydraulics`); this module holds the model.
+(:mod:`wire_fmu.core.units.hydraulics`); this module holds the model. Its
+equations here are the readable reference; :mod:`.kernel` has the same equations
+compiled, which the model evaluates instead when ``self.compiled`` (see
+:func:`~wire_fmu.core.framework.compiled.use_compiled`).
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,8 +27,10 @@ from wire_fmu.core.components.end_stops import (
 from wire_fmu.core.components.gas import ISOTHERMAL, PolytropicGas, isothermal_charge_volume
 from wire_fmu.core.components.rod_seal import RodSeal, SealSpec
 from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.compiled import use_compiled
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import SolverSettings
+from wire_fmu.core.units.hydraulics import kernel
 from wire_fmu.core.units.hydraulics.limits import check_start, limit_message
 from wire_fmu.core.units.hydraulics.oil_side import OilSide
 from wire_fmu.core.units.hydraulics.specs import (
@@ -81,6 +88,8 @@ class HydraulicLimitError(ModelError):
     """A physical limit the unit cannot step through (the step is refused)."""
 
 
+_LIMITS = ("gas_dead", "gas_empty", "cavitation", "stroke")
+"""The guards that refuse a step."""
 _NO_STOP = (0.0, (0.0, 0.0), (0.0, 0.0), 0.0, 0.0)
 """What :meth:`EndStops.forces` gives without the effect: no force, depth, loss or energy."""
 
@@ -157,7 +166,12 @@ class HydraulicsModel(OilSide, RefinedStepping):
         self._directions = np.array(
             [0.0 if kind == "pad" else -1.0 for kind, _ in self._guard_kinds]
         )
-        self.solver = make_solver(solver)
+        self.compiled = use_compiled("hydraulic cylinder")  # the kernel covers every effect set
+        self.kernel_parameters = kernel.kernel_parameters(self)
+        self.kernel_layout = kernel.kernel_layout(self)
+        self.step_report: tuple | None = None
+        """``(state, force, report values)`` of the state a quiet step ended in, or None."""
+        self.solver = self._make_solver(solver)
         self.contact_solver = self._make_contact_solver(solver)
         self._current_resolution = "coarse"
         self._integrating = False
@@ -204,6 +218,20 @@ class HydraulicsModel(OilSide, RefinedStepping):
     def n_states(self) -> int:
         """Number of continuous states, dissipated energy included."""
         return self.layout.size
+
+    # ------------------------------------------------------------- kernels
+    def kernel_data(self) -> tuple:
+        """The tuple of arrays the compiled kernel takes, for the present modes and force."""
+        return kernel.kernel_data(self)
+
+    @contextmanager
+    def python_kernel(self) -> Iterator[None]:
+        """Evaluate with the Python kernel inside the ``with`` block."""
+        compiled, self.compiled = self.compiled, False
+        try:
+            yield
+        finally:
+            self.compiled = compiled
 
     # ------------------------------------------------------------ evaluation
     def gas_volume(self, x: np.ndarray) -> float:
@@ -302,6 +330,8 @@ class HydraulicsModel(OilSide, RefinedStepping):
         x : numpy.ndarray
             State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
         """
+        if self.compiled:
+            return kernel.rhs(t, x, self.kernel_data())
         point = self.evaluate(x)
         acc, _, friction_loss = self._accelerate(point)
         lay = self.layout
@@ -339,6 +369,8 @@ class HydraulicsModel(OilSide, RefinedStepping):
             One value per guard (seal, gas, cavitation, stroke or stops); see
             :meth:`guard_directions`.
         """
+        if self.compiled:
+            return kernel.guards(t, x, self.kernel_data())
         point = self.evaluate(x)
         acc, link, _ = self._accelerate(point)
         return np.array(
@@ -424,12 +456,16 @@ class HydraulicsModel(OilSide, RefinedStepping):
         return x
 
     # ------------------------------------------------------------ modes
-    def _settle_friction(self, x: np.ndarray, fired: list[int]) -> np.ndarray:
-        """Make the seal's mode consistent with the forces at ``x``."""
+    def _settle_friction(
+        self, x: np.ndarray, fired: list[int], force: float | None = None
+    ) -> np.ndarray:
+        """Make the seal's mode consistent with the forces at ``x`` (``force``: on the rod, N,
+        if already known)."""
         if self.seal is None:
             return x
-        point = self.evaluate(x)
-        x[1], event = self.seal.settle(float(x[0]), float(x[1]), point.force, fired)
+        if force is None:
+            force = self._limits_and_force(x)[1]
+        x[1], event = self.seal.settle(float(x[0]), float(x[1]), force, fired)
         if event:
             self.last_events.append(event)
         return x
@@ -444,12 +480,36 @@ class HydraulicsModel(OilSide, RefinedStepping):
         x : numpy.ndarray
             State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
         """
+        self._refuse_at_limit(self._limits_and_force(x)[0], t, x)
+
+    def _refuse_at_limit(self, violated: int, t: float, x: np.ndarray) -> None:
+        """Raise :class:`HydraulicLimitError` for guard ``violated`` (nothing for -1)."""
+        if violated >= 0:
+            kind, end = self._guard_kinds[violated]
+            raise HydraulicLimitError(limit_message(self, kind, end, x, t))
+
+    def _limits_and_force(self, x: np.ndarray) -> tuple[int, float]:
+        """The first limit guard already violated at ``x`` (-1: none) and the force on the rod.
+
+        The force is every force but seal friction and the column's inertia, N (what the
+        seal must hold).
+        """
+        if self.compiled:
+            return kernel.limits_and_force(x, self.kernel_data())
         point = self.evaluate(x)
         acc, link, _ = self._accelerate(point)
-        for kind, end in self._guard_kinds:
-            if kind in ("gas_dead", "gas_empty", "cavitation", "stroke"):
-                if self._guard(kind, end, point, acc, link) < 0.0:
-                    raise HydraulicLimitError(limit_message(self, kind, end, x, t))
+        for i, (kind, end) in enumerate(self._guard_kinds):
+            if kind in _LIMITS and self._guard(kind, end, point, acc, link) < 0.0:
+                return i, point.force
+        return -1, point.force
+
+    def _report_values(self) -> list[float]:
+        """The compiled kernel's report of the present state (that of the last quiet step if
+        the state and force are still those it ended with)."""
+        kept = self.step_report
+        if kept is not None and kept[0] is self.state and kept[1] == self.force:
+            return kept[2]
+        return kernel.report(self.state, self.kernel_data()).tolist()
 
     # ---------------------------------------------------------- initial state
     def equilibrium_pressure(self, force: float) -> float:
@@ -527,7 +587,7 @@ class HydraulicsModel(OilSide, RefinedStepping):
     # ----------------------------------------------------------------- report
     def stored_energy(self) -> float:
         """Stored energy at the current state, J (see the module docstring)."""
-        return self.evaluate(self.state, energy=True).stored
+        return self.report()["stored_energy"]
 
     @property
     def dissipated_energy(self) -> float:
@@ -535,7 +595,10 @@ class HydraulicsModel(OilSide, RefinedStepping):
         return float(self.state[self.layout.dissipated])
 
     def report(self) -> dict[str, float]:
-        """Physical quantities at the current state, for outputs."""
+        """Physical quantities at the current state, for outputs (keys: ``kernel.REPORT``)."""
+        if self.compiled:
+            # the kernel's report has one value per name by construction
+            return dict(zip(kernel.REPORT, self._report_values(), strict=False))
         point = self.evaluate(self.state, energy=True)
         acc, link, _ = self._accelerate(point)
         if self.seal is not None and self.seal.stuck:

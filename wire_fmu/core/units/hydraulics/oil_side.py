@@ -14,11 +14,24 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["OilSide"]
+__all__ = ["OIL_LOSSLESS_RIGID", "OIL_ONE_NODE", "OIL_RIGID", "OIL_TWO_NODES", "OilSide"]
+
+OIL_LOSSLESS_RIGID, OIL_RIGID, OIL_ONE_NODE, OIL_TWO_NODES = 0, 1, 2, 3
+"""The four forms, as codes: incompressible oil with a lossless line, with line losses;
+compressible oil with a lossless massless line (one pressure node), with the line between
+chamber and gas (two pressure nodes)."""
 
 
 class OilSide:
     """The oil side's equations (a mixin of the model, which provides the layout and sizes)."""
+
+    def oil_form(self) -> int:
+        """Which of the four forms the effects chosen give, as an ``OIL_*`` code."""
+        if not self.compressible:
+            return OIL_RIGID if self.losses else OIL_LOSSLESS_RIGID
+        if self.layout.chamber_pressure < 0:
+            return OIL_ONE_NODE
+        return OIL_TWO_NODES
 
     def _choose_oil_side(self):
         """The oil side's equations for the effects chosen (chosen once, at build).
@@ -26,11 +39,13 @@ class OilSide:
         Each gives, at a state, the chamber pressure (Pa), the line flow (m^3/s), the line's
         loss (W) and the energy stored in oil and line (J).
         """
-        if not self.compressible:
-            return self._rigid_column if self.losses else self._lossless_rigid_column
-        if self.layout.chamber_pressure < 0:
-            return self._one_pressure_node
-        return self._two_pressure_nodes
+        forms = {
+            OIL_LOSSLESS_RIGID: self._lossless_rigid_column,
+            OIL_RIGID: self._rigid_column,
+            OIL_ONE_NODE: self._one_pressure_node,
+            OIL_TWO_NODES: self._two_pressure_nodes,
+        }
+        return forms[self.oil_form()]
 
     def _lossless_rigid_column(self, x: np.ndarray, vel: float, v_gas: float, p_g: float):
         """Incompressible oil, lossless line: the chamber is at the gas pressure."""

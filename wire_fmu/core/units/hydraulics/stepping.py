@@ -8,6 +8,13 @@ restarted at located events and in fixed pieces, so the result depends only
 on the state and the step (bit-reproducible). :class:`RefinedStepping` is the
 part of :class:`~wire_fmu.core.units.hydraulics.model.HydraulicsModel` that
 does this.
+
+With the compiled kernel (:mod:`~wire_fmu.core.units.hydraulics.kernel`) every
+fixed-step solver the cylinder makes is a
+:class:`~wire_fmu.core.framework.compiled_step.CompiledFixedStep`, and a step in
+which nothing happens (no limit, no seal breakaway, no event, no refinement) is
+taken in one call of the kernel; any other step goes the general way, in which
+the Python model switches the modes and words the events.
 """
 
 from __future__ import annotations
@@ -17,7 +24,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
 from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.step_limits import IntegrationError, internal_steps
+from wire_fmu.core.units.hydraulics import kernel
 
 __all__ = [
     "CONTACT_CHUNK_STEPS",
@@ -61,8 +71,16 @@ class RefinedStepping:
     """Advance, settle and the refined integration of a cylinder model (a mixin).
 
     The model provides ``state``, ``force``, ``settings``, ``solver``, ``stops``, ``seal``,
-    ``mass``, ``spec``, ``check_limits``, ``project`` and ``_settle_friction``.
+    ``mass``, ``spec``, ``compiled``, ``step_report``, ``kernel_data``, ``project``,
+    ``_directions``, ``_limits_and_force``, ``_refuse_at_limit`` and ``_settle_friction``.
     """
+
+    def _make_solver(self, settings: SolverSettings):
+        """A solver for ``settings``: the compiled fixed-step loop over the cylinder's kernel
+        when the model is compiled and the method has one, else the Python solver."""
+        if self.compiled and settings.method in COMPILED_METHODS:
+            return CompiledFixedStep(settings, kernel.advance)
+        return make_solver(settings)
 
     def _make_contact_solver(self, settings: SolverSettings):
         """A solver resolving the stop contact (fixed-step methods only), or None.
@@ -81,7 +99,7 @@ class RefinedStepping:
         fine = min(settings.max_step, CONTACT_STEP_FACTOR / omega)
         if fine >= settings.max_step:
             return None
-        return make_solver(replace(settings, max_step=fine))
+        return self._make_solver(replace(settings, max_step=fine))
 
     # -------------------------------------------------------------- stepping
     def advance(self, t: float, h: float, force: float) -> int:
@@ -108,29 +126,70 @@ class RefinedStepping:
         """
         self.last_events = []
         self.force = float(force)
-        self.check_limits(t, self.state)
-        self.state = self.settle(self.state)
+        self.step_report = None
         start = float(self.state[0])
-        x, events = self._integrate(t, self.state, t + h)
-        self.state = x
-        self.external_work += self.force * (float(x[0]) - start)
+        events = 0
+        if not self._quiet_step(t, t + h):
+            violated, rod_force = self._limits_and_force(self.state)
+            self._refuse_at_limit(violated, t, self.state)
+            self.state = self.settle(self.state, rod_force)
+            self.state, events = self._integrate(t, self.state, t + h)
+        self.external_work += self.force * (float(self.state[0]) - start)
         return events
 
-    def settle(self, x: np.ndarray) -> np.ndarray:
+    def _quiet_step(self, t: float, t_end: float) -> bool:
+        """Take a step in which nothing happens in one call of the compiled kernel.
+
+        Nothing happens when no limit is reached, the seal keeps its mode, no guard
+        fires and the step needs no refinement. The kernel then does what
+        :meth:`advance` would (limits, settle, :class:`CompiledFixedStep` on its grid)
+        and reports the end state (kept in :attr:`step_report` for the outputs). If
+        anything happens, it returns False and leaves the state alone: the step is
+        then taken the general way, from the start.
+        """
+        settings = self.settings
+        method = COMPILED_METHODS.get(settings.method) if self.compiled else None
+        if method is None or t >= t_end - settings.event_time_tolerance:
+            return False
+        if self.stops is not None and self._resolution(t, self.state) != "coarse":
+            return False
+        try:
+            count = internal_steps(t, t_end, settings.max_step)
+        except IntegrationError:
+            return False
+        if self.seal is not None:
+            self.seal.held_position = float(self.state[0])  # as settling would
+        taken, x, values = kernel.quiet_step(
+            method,
+            t,
+            t_end,
+            max(1, math.ceil(count - 1e-9)),  # the grid of CompiledFixedStep
+            self.state,
+            self._directions,
+            settings.event_time_tolerance,
+            self.kernel_data(),
+        )
+        if taken:
+            self.state = x
+            self.step_report = (x, self.force, values.tolist())
+        return taken
+
+    def settle(self, x: np.ndarray, force: float | None = None) -> np.ndarray:
         """Seal mode consistent with the force now held (it may have jumped); the new state.
 
         Parameters
         ----------
         x : numpy.ndarray
             The model's state (see :class:`HydraulicsModel`).
+        force : float or None
+            Every force on the rod but seal friction at ``x``, N, if already known.
         """
-        before = self._seal_mode()
-        x = self._settle_friction(np.array(x, dtype=float), [])
-        self.mode_changes += int(self._seal_mode() != before)
+        if self.seal is None:
+            return self.project(np.array(x, dtype=float))
+        before = self.seal.mode
+        x = self._settle_friction(np.array(x, dtype=float), [], force)
+        self.mode_changes += int(self.seal.mode != before)
         return self.project(x)
-
-    def _seal_mode(self) -> list[int]:
-        return [] if self.seal is None else self.seal.friction.get_mode()
 
     def _integrate(self, t: float, x: np.ndarray, t_end: float) -> tuple[np.ndarray, int]:
         """Integrate to ``t_end``; fixed-step solvers refine on a stop and in a cushion.
@@ -182,6 +241,6 @@ class RefinedStepping:
             c = self.spec.stops.cushion_coefficient
             h = CUSHION_STEP_FACTOR * self.mass / (c * self.stops.cushion_speed(float(x[1])))
             if h < self.settings.max_step:
-                solver = make_solver(replace(self.settings, max_step=h))
+                solver = self._make_solver(replace(self.settings, max_step=h))
                 return solver, min(t_end, t + CUSHION_CHUNK_STEPS * h)
         return self.solver, t_end

@@ -268,7 +268,7 @@ class HydraulicsUnit(Unit):
         """Complete state: continuous state, modes, held input, gas reference."""
         m = self._require_model()
         return {
-            "x": [float(c) for c in m.state],
+            "x": m.state.tolist(),
             "force": float(m.force),
             "stops": None if m.stops is None else m.stops.get_state(),
             "seal": None if m.seal is None else m.seal.get_state(),
@@ -281,6 +281,29 @@ class HydraulicsUnit(Unit):
             "time": float(self.time),
             "initial_energy": float(self.initial_energy),
         }
+
+    def _snapshot(self) -> tuple:
+        """What a step changes, copied (cheaper than :meth:`get_state`)."""
+        m = self._require_model()
+        return (
+            m.state.copy(),
+            m.force,
+            None if m.stops is None else m.stops.snapshot(),
+            None if m.seal is None else m.seal.snapshot(),
+            m.mode_changes,
+            m.external_work,
+            self.time,
+        )
+
+    def _restore_snapshot(self, saved: tuple) -> None:
+        """Implements :meth:`Unit._restore_snapshot`."""
+        m = self._require_model()
+        m.state, m.force, stops, seal, m.mode_changes, m.external_work, self.time = saved
+        if m.stops is not None:
+            m.stops.restore(stops)
+        if m.seal is not None:
+            m.seal.restore(seal)
+        self._update_outputs()
 
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`.
@@ -341,7 +364,7 @@ class HydraulicsUnit(Unit):
             - out["external_work"]
         )
         out["mode_changes"] = int(m.mode_changes)
-        if not all(math.isfinite(value) for value in r.values()):
+        if not all(map(math.isfinite, r.values())):
             raise FloatingPointError(f"{self.who}: non-finite outputs {r}")
 
 
