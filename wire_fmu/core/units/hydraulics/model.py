@@ -594,6 +594,13 @@ class HydraulicsModel(OilSide, RefinedStepping):
         """Energy dissipated since the start, J."""
         return float(self.state[self.layout.dissipated])
 
+    def report_values(self) -> list[float]:
+        """:meth:`report`'s quantities as a list, in the order of ``kernel.REPORT``."""
+        if self.compiled:
+            return self._report_values()
+        report = self.report()
+        return [report[name] for name in kernel.REPORT]
+
     def report(self) -> dict[str, float]:
         """Physical quantities at the current state, for outputs (keys: ``kernel.REPORT``)."""
         if self.compiled:

@@ -101,6 +101,7 @@ from wire_fmu.core.errors import ConfigurationError, ModelError
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_settings
 from wire_fmu.core.framework.unit import OdeView, Unit
+from wire_fmu.core.units.hydraulics.kernel import REPORT
 from wire_fmu.core.units.hydraulics.model import (
     HYDRAULICS_EFFECTS,
     AccumulatorSpec,
@@ -116,6 +117,24 @@ __all__ = ["HydraulicsUnit", "DEFAULT_ROD_FORCE"]
 
 
 logger = logging.getLogger(__name__)
+
+_OUTPUT_OF = {  # the model's report quantity: the output that shows it
+    "position": "rod.position",
+    "velocity": "rod.velocity",
+    "acceleration": "rod.acceleration",
+    "chamber_pressure": "chamber.pressure",
+    "hydraulic_force": "hydraulic_force",
+    "gas_pressure": "gas.pressure",
+    "gas_volume": "gas.volume",
+    "flow": "line.flow",
+    "oil_in_accumulator": "accumulator.oil_volume",
+    "stiffness": "rod.stiffness",
+    "stop_force": "end_stop.force",
+    "friction_force": "seal.friction_force",
+    "stored_energy": "stored_energy",
+}
+_REPORTED_OUTPUTS = tuple(_OUTPUT_OF[name] for name in REPORT)
+"""The outputs that show the model's report, in the order of its values."""
 
 
 class HydraulicsUnit(Unit):
@@ -336,36 +355,26 @@ class HydraulicsUnit(Unit):
     # -------------------------------------------------------------- helpers
     def _update_outputs(self) -> None:
         m = self._require_model()
-        r = m.report()
+        values = m.report_values()
         out = self.values
-        out["rod.position"] = r["position"]
-        out["rod.velocity"] = r["velocity"]
-        out["rod.displacement"] = r["position"] - m.initial_position
-        out["rod.acceleration"] = r["acceleration"]
-        out["rod.stiffness"] = r["stiffness"]
-        out["chamber.pressure"] = r["chamber_pressure"]
-        out["hydraulic_force"] = r["hydraulic_force"]
-        out["gas.pressure"] = r["gas_pressure"]
-        out["gas.volume"] = r["gas_volume"]
-        out["line.flow"] = r["flow"]
-        out["accumulator.oil_volume"] = r["oil_in_accumulator"]
-        out["stroke_used"] = r["position"] / m.cyl.stroke
-        out["seal.friction_force"] = r["friction_force"]
+        out.update(zip(_REPORTED_OUTPUTS, values, strict=True))
+        position = out["rod.position"]
+        out["rod.displacement"] = position - m.initial_position
+        out["stroke_used"] = position / m.cyl.stroke
         out["seal.stuck"] = m.seal is not None and m.seal.stuck
-        out["end_stop.force"] = r["stop_force"]
         out["end_stop.contact"] = m.stops is not None and any(m.stops.contact)
-        out["stored_energy"] = r["stored_energy"]
         out["dissipated_energy"] = m.dissipated_energy
         out["external_work"] = float(m.external_work)
         out["energy_balance"] = (
-            r["stored_energy"]
+            out["stored_energy"]
             - self.initial_energy
             + out["dissipated_energy"]
             - out["external_work"]
         )
         out["mode_changes"] = int(m.mode_changes)
-        if not all(map(math.isfinite, r.values())):
-            raise FloatingPointError(f"{self.who}: non-finite outputs {r}")
+        if not all(map(math.isfinite, values)):
+            report = dict(zip(REPORT, values, strict=True))
+            raise FloatingPointError(f"{self.who}: non-finite outputs {report}")
 
 
 class _HydraulicsOde(OdeView):
