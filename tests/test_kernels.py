@@ -168,21 +168,32 @@ def test_without_numba_units_fall_back_with_one_log_line(monkeypatch, caplog):
 
 
 def test_every_copy_of_the_sources_shares_one_cache(tmp_path, monkeypatch):
-    """Two copies of a kernel module at different paths (as two extracted FMUs) have one cache
-    folder, inside ``WIRE_FMU_CACHE_DIR``; a changed source gets another."""
+    """Two copies of the sources at different paths (as two extracted FMUs) have one cache
+    folder, inside ``WIRE_FMU_CACHE_DIR``; a change of the kernel, or of the shared loop its
+    entry point inlines, gets another."""
     import wire_fmu.core.units.block_train.kernel as kernel
 
     monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "cache"))
-    source = Path(kernel.__file__)
+    package = Path(compiled.__file__).parents[2]
+    sources = ["core/units/block_train/kernel.py", *compiled.SHARED_KERNEL_SOURCES]
     copies = []
     for name in ("fmu_a", "fmu_b"):
-        target = tmp_path / name / "resources" / "wire_fmu" / "core" / "units" / "block_train"
-        target.mkdir(parents=True)
-        copies.append(target / "kernel.py")
-        shutil.copy(source, copies[-1])
+        root = tmp_path / name / "resources" / "wire_fmu"
+        for source in sources:
+            (root / source).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(package / source, root / source)
+        copies.append(root)
     locate = compiled._ContentCacheLocator.from_function
-    paths = [locate(kernel.rhs.py_func, str(c)).get_cache_path() for c in copies]
-    assert paths[0] == paths[1]
-    assert paths[0].startswith(str(tmp_path / "cache"))
-    copies[1].write_text(copies[1].read_text() + "\n# changed\n")
-    assert locate(kernel.rhs.py_func, str(copies[1])).get_cache_path() != paths[0]
+
+    def cache_of(root: Path) -> str:
+        return locate(kernel.rhs.py_func, str(root / sources[0])).get_cache_path()
+
+    first = cache_of(copies[0])
+    assert cache_of(copies[1]) == first
+    assert first.startswith(str(tmp_path / "cache"))
+    loop = copies[1] / "core/framework/compiled_step.py"
+    loop.write_text(loop.read_text() + "\n# changed\n")
+    assert cache_of(copies[1]) != first
+    own = copies[0] / sources[0]
+    own.write_text(own.read_text() + "\n# changed\n")
+    assert cache_of(copies[0]) not in (first, cache_of(copies[1]))

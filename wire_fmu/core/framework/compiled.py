@@ -12,7 +12,8 @@ variable ``WIRE_FMU_KERNEL`` chooses:
     the Python kernel everywhere.
 
 Compiled code is cached on disk so that compiling is paid once per machine:
-by content, not by file path, in ``WIRE_FMU_CACHE_DIR`` (default
+by content (the kernel's own source and the shared loop every entry point
+inlines, :data:`SHARED_KERNEL_SOURCES`), not by file path, in ``WIRE_FMU_CACHE_DIR`` (default
 ``~/.cache/wire_fmu/numba``). Every copy of the ``wire_fmu`` sources with the
 same text shares one cache, so FMUs extracted to new temporary folders and FMUs
 loaded by a C++ host start warm. The cache locator is registered with numba
@@ -118,6 +119,19 @@ def _package_relative(py_file: str) -> str | None:
     return "/".join(parts[start:])
 
 
+SHARED_KERNEL_SOURCES = ("core/framework/compiled.py", "core/framework/compiled_step.py")
+"""Sources (relative to the package) that every unit's entry point inlines: part of every key."""
+
+
+def _shared_sources(py_file: str) -> list[Path]:
+    """The :data:`SHARED_KERNEL_SOURCES` of the package copy ``py_file`` belongs to."""
+    parts = Path(py_file).resolve().parts
+    if "wire_fmu" not in parts:
+        return []
+    root = Path(*parts[: len(parts) - parts[::-1].index("wire_fmu")])
+    return [root / name for name in SHARED_KERNEL_SOURCES if (root / name).is_file()]
+
+
 if _numba_caching is not None:
 
     class _ContentCacheLocator(
@@ -133,8 +147,10 @@ if _numba_caching is not None:
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
             relative = _package_relative(py_file) or Path(py_file).name
-            text = Path(py_file).read_bytes()
-            digest = hashlib.sha256(relative.encode() + b"\0" + text).hexdigest()[:16]
+            digest = hashlib.sha256(relative.encode())
+            for source in (Path(py_file), *_shared_sources(py_file)):
+                digest.update(b"\0" + source.read_bytes())
+            digest = digest.hexdigest()[:16]
             folder = relative.replace("/", "_").removesuffix(".py")
             self._cache_path = str(cache_directory() / f"{folder}-{digest}")
 

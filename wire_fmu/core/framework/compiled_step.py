@@ -110,7 +110,8 @@ def _w_inverse(method: int, jac: np.ndarray, h: float, w_h: float, w_inv: np.nda
     if method != _ROS2 or h == w_h:
         return w_inv, w_h
     n = jac.shape[0]
-    return np.ascontiguousarray(np.linalg.inv(np.eye(n) - _GAMMA * h * jac)), h
+    # numpy's inv solves W X = I (LAPACK gesv); so does this, for the same numbers
+    return np.ascontiguousarray(np.linalg.solve(np.eye(n) - _GAMMA * h * jac, np.eye(n))), h
 
 
 @jit
