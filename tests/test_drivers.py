@@ -23,6 +23,8 @@ from wire_fmu.master.drivers import (
     make_driver,
     pierson_moskowitz_spectrum,
 )
+from wire_fmu.master.manipulators import DriverSet
+from wire_fmu.master.scene import DriverSpec, VarRef
 
 WHERE = "driver 3 (rope.mover_b.position)"
 HS, TP = 4.0, 10.0  # m, s
@@ -277,6 +279,48 @@ def test_sea_state_rate_is_derivative_and_fade_in_starts_at_rest():
     late = np.array([40.0, 77.7])
     assert np.allclose(d.value(late), 0.8 * plain.value(late), rtol=1e-14)
     assert np.allclose(d.value(t), [d.value(float(x)) for x in t], rtol=1e-12, atol=1e-14)
+
+
+def test_sea_state_values_at_are_its_values_to_the_last_bit():
+    """``values_at`` evaluates many times in one vectorised call (the master asks for the
+    ends of the next steps at once): each number is the one ``value`` gives, bit for bit,
+    through the fade-in and after it."""
+    d = build(
+        {
+            "kind": "sea_state",
+            "significant_height": HS,
+            "peak_period": TP,
+            "ramp_time": 3.0,
+            "start_time": 0.5,
+            "heave_rao": 0.9,
+        }
+    )
+    times = [n / 1e9 for n in range(0, 20_000_000_000, 37 * 2_000_000)] + [0.25, 123.456]
+    assert d.values_at(times) == [d.value(t) for t in times]
+
+
+def test_driver_set_step_values_are_its_values():
+    """The per-step list of a driver set (each value computed once, a sea state's for the
+    next steps at once) holds the very numbers of ``values``: the position at the step's
+    start, the mean rate over it, a plain input at its midpoint; also across a shortened
+    step, where the values computed ahead do not apply."""
+    sea = {"kind": "sea_state", "significant_height": HS, "peak_period": TP, "ramp_time": 2.0}
+    specs = (
+        DriverSpec(VarRef("rope", "mover_b.position"), sea, VarRef("rope", "mover_b.velocity")),
+        DriverSpec(VarRef("rope", "command"), sea),
+        DriverSpec(VarRef("winch", "lever"), {"kind": "ramp", "points": [[0, 0], [1, 3]]}),
+    )
+    drivers, reference = DriverSet(specs, Path(".")), DriverSet(specs, Path("."))
+    ends = [2_000_000 * k for k in range(1, 200)] + [398_500_000, 400_000_000, 402_000_000]
+    start = 0
+    for end in sorted(ends):
+        t = start / 1e9
+        h = end / 1e9 - t
+        for unit in ("rope", "winch"):
+            expected = reference.values(unit, t, h)
+            assert drivers.targets(unit) == list(expected)
+            assert drivers.step_values(unit, t, h) == list(expected.values())
+        start = end
 
 
 def test_sea_state_is_reproducible_with_a_seed():

@@ -175,6 +175,50 @@ def test_adaptive_step_keeps_the_bond_residual_per_step_below_tolerance(fmus, tm
     assert np.max(np.abs(residual)) <= 1e-6 * (1 + 1e-9)
 
 
+class _CallCount:
+    """Observer: the FMI calls each unit took over the stepping loop, by function."""
+
+    def on_start(self, sim):
+        self.before = {name: dict(slave.calls) for name, slave in sim.slaves.items()}
+
+    def on_step(self, sim):
+        pass
+
+    def on_end(self, sim, result):
+        self.calls = {
+            name: {
+                fn: count - self.before[name].get(fn, 0)
+                for fn, count in slave.calls.items()
+                if count > self.before[name].get(fn, 0)
+            }
+            for name, slave in sim.slaves.items()
+        }
+
+
+@pytest.mark.parametrize("algorithm", ["jacobi", "gauss_seidel"])
+@pytest.mark.parametrize("output_interval", [None, 0.05])
+def test_each_unit_is_set_once_and_read_once_per_step(fmus, tmp_path, algorithm, output_interval):
+    """Per unit and macro step the master makes one batched set of the unit's inputs, the
+    step, and one batched read of what it needs afterwards: the outputs that feed
+    connections and, at the steps the recorder records, the recorded variables with them.
+
+    Mutation: the recorded variables read on their own (not with the step's read): two
+    getReal calls per unit at recorded steps, the count assertion failed.
+    """
+    data = scene_data(fmus, step=0.01, algorithm=algorithm, output_interval=output_interval)
+    data["outputs"]["variables"] += ["a.velocity", "b.force_on_flange"]
+    scene = parse_scene(data, base_dir=tmp_path)
+    count = _CallCount()
+    recorder = CsvRecorder(tmp_path / "counted", output_interval)
+    result = Simulation(scene, validate_scene(scene, through_fmi=False), [recorder, count]).run()
+    assert result.status == "finished", result.message
+    steps = result.steps
+    for unit in ("a", "b"):
+        assert count.calls[unit] == {"setReal": steps, "doStep": steps, "getReal": steps}, unit
+    columns = read_results(recorder.csv_path)
+    assert len(columns["time"]) == (steps if output_interval is None else 20) + 1
+
+
 # ------------------------------------------------------------- the bond's energy books
 E0 = 0.5 * (K1 + K) * X0**2  # J: the pair starts at rest, a displaced by X0, b at 0
 GUARDED = {"energy_tolerance": 0.5 * E0}  # the guard's floor: half the pair's energy

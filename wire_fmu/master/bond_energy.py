@@ -12,13 +12,61 @@ created (positive) or destroyed.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from .extrapolation import History
     from .scene import Bond
 
-__all__ = ["bond_step_energy"]
+__all__ = ["BondKeys", "bond_step_energy", "step_energy"]
+
+
+@dataclass(frozen=True)
+class BondKeys:
+    """The ``"unit.variable"`` names a bond's energy residual reads, worked out once.
+
+    Parameters
+    ----------
+    name : str
+        The bond's name.
+    effort, flow : str
+        Sources of the effort and flow links.
+    effort_target, flow_target : str
+        Inputs the effort and the flow are held at.
+    position : str or None
+        Source of the position link, if the bond has one.
+    """
+
+    name: str
+    effort: str
+    flow: str
+    effort_target: str
+    flow_target: str
+    position: str | None
+
+    @classmethod
+    def of(cls, bond: Bond) -> BondKeys:
+        """The names of ``bond``'s links.
+
+        Parameters
+        ----------
+        bond : Bond
+            The bond, with its effort, flow and (optional) position links.
+
+        Returns
+        -------
+        BondKeys
+        """
+        position = None if bond.position is None else str(bond.position.source)
+        return cls(
+            bond.name,
+            str(bond.effort.source),
+            str(bond.flow.source),
+            str(bond.effort.target),
+            str(bond.flow.target),
+            position,
+        )
 
 
 def bond_step_energy(
@@ -53,14 +101,42 @@ def bond_step_energy(
         Power the bond transmitted over the step (held effort times the mean
         flow), W.
     """
-    e_key, f_key = str(bond.effort.source), str(bond.flow.source)
+    return step_energy(BondKeys.of(bond), histories, held, new, h)
+
+
+def step_energy(
+    keys: BondKeys,
+    histories: Mapping[str, History],
+    held: Mapping[str, float],
+    new: Mapping[str, float],
+    h: float,
+) -> tuple[float, float]:
+    """:func:`bond_step_energy` of a bond given by the names of its links.
+
+    Parameters
+    ----------
+    keys : BondKeys
+        The bond's link names (:meth:`BondKeys.of`).
+    histories, held, new : mapping
+        As for :func:`bond_step_energy`.
+    h : float
+        The step just taken, s.
+
+    Returns
+    -------
+    residual : float
+        Energy the coupling created (positive) or destroyed, J.
+    power : float
+        Power the bond transmitted over the step, W.
+    """
+    e_key, f_key = keys.effort, keys.flow
     e0, e1 = histories[e_key].latest, new[e_key]
-    f_held = held.get(str(bond.flow.target), histories[f_key].latest)
-    e_held = held.get(str(bond.effort.target), e0)
-    if bond.position is None:  # the flow side's displacement, by the trapezoidal rule
+    f_held = held.get(keys.flow_target, histories[f_key].latest)
+    e_held = held.get(keys.effort_target, e0)
+    if keys.position is None:  # the flow side's displacement, by the trapezoidal rule
         moved, jump = 0.5 * (histories[f_key].latest + new[f_key]) * h, 0.0
     else:  # exactly; the effort side's position input will jump by what it missed
-        p_key = str(bond.position.source)
+        p_key = keys.position
         moved = new[p_key] - histories[p_key].latest
         jump = moved - f_held * h
     power = e_held * moved / h

@@ -158,13 +158,11 @@ class EnergyGuard:
         h : float
             The macro step just taken, s.
         """
-        if math.isinf(self.share):
+        if math.isinf(self.share) or self._within_limits():
             return None
         unstable = [
             (name, bond) for name, bond in self.bonds.items() if not bond.error <= self.limit(name)
         ]  # a NaN residual is unstable too
-        if not unstable:
-            return None
         details = "; ".join(_describe(name, bond) for name, bond in unstable)
         return (
             f"t = {t:.6g} s: the coupling blows up at the macro step {h:.3g} s: {details} "
@@ -172,6 +170,14 @@ class EnergyGuard:
             f"energy_tolerance {self.floor:g} J). The dynamics coupled across the bond "
             f"are too fast for this step: use {' or '.join(self.remedies)}"
         )
+
+    def _within_limits(self) -> bool:
+        """Whether every bond's error is within its limit (a NaN is not); after every step."""
+        share, floor = self.share, self.floor
+        for bond in self.bonds.values():
+            if not bond.error <= max(share * bond.carried, floor):
+                return False
+        return True
 
 
 def _describe(name: str, bond: BondEnergy) -> str:

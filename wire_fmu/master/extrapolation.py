@@ -73,6 +73,11 @@ def _lagrange(points: list[tuple[float, float]], t: float) -> float:
     return total
 
 
+def _line(t0: float, y0: float, t1: float, y1: float, t: float) -> float:
+    """:func:`_lagrange` through two points, operation for operation (the same bits)."""
+    return 0.0 + (t - t1) / (t0 - t1) * y0 + (t - t0) / (t1 - t0) * y1
+
+
 def held_value(
     history: History, t: float, step: float, scheme: str, fresh: float | None = None
 ) -> float:
@@ -89,14 +94,30 @@ def held_value(
     fresh : float, optional
         The source's value at ``t + step`` when it has already stepped
         (Gauss-Seidel, iteration).
+
+    Returns
+    -------
+    float
+        The value to hold, in the source's unit.
     """
     need = SCHEME_POINTS[scheme]
+    points = history.points
+    if need == 1 and points:  # the two common cases first: called for every link and step
+        return points[-1][1] if fresh is None else fresh
+    if need == 2 and points:
+        if fresh is not None:
+            t0, y0 = points[-1]
+            return _line(t0, y0, t + step, fresh, t + 0.5 * step)
+        if len(points) == 1:
+            return points[-1][1]
+        (t0, y0), (t1, y1) = points[-2], points[-1]
+        return _line(t0, y0, t1, y1, t + 0.5 * step)
     if fresh is not None:
         if scheme == "constant":
             return fresh
-        pts = list(history.points)[-(need - 1) :] + [(t + step, fresh)]
+        pts = list(points)[-(need - 1) :] + [(t + step, fresh)]
     else:
-        pts = list(history.points)[-need:]
+        pts = list(points)[-need:]
     if len(pts) == 1:
         return pts[0][1]
     if len(pts) == 2:

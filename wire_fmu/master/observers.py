@@ -2,8 +2,10 @@
 
 :class:`CsvRecorder`
     streams the recorded variables to ``timeseries.csv`` as the run goes
-    (one row per output interval, flushed every row, so a crash or Ctrl-C
-    keeps everything up to that point), with energy channels: each bond's
+    (one row per output interval, written out at least every
+    :data:`FLUSH_EVERY` seconds of wall-clock time and at the end, also after
+    a failure or Ctrl-C, so a crash of the process keeps all but the last
+    fraction of a second), with energy channels: each bond's
     accumulated energy residual (energy its coupling created), the energy it
     carried, its power, and the sum of the units' ledger residuals.
     pandas reads it with ``pandas.read_csv``, fmpy with ``fmpy.util.read_csv``.
@@ -46,9 +48,20 @@ power it transmitted (W)."""
 LEDGER_CHANNEL = "energy.units_balance"
 """Sum of the units' ``energy_balance`` outputs, J (each unit's own ledger)."""
 
+FLUSH_EVERY = 0.1
+"""Longest wall-clock time recorded rows wait before they are written to the file, s.
+
+Rows are formatted and written in batches: a row's formatting and its write to
+the file cost more than a macro step of the master when done one at a time."""
+
 
 class Observer(Protocol):
-    """Reads the simulation; never changes it."""
+    """Reads the simulation; never changes it.
+
+    An observer that reads unit variables after steps asks, in ``on_start``, for
+    them to be read with the units' own end-of-step reads
+    (:meth:`~wire_fmu.master.simulation.Simulation.watch`): no FMI call of its own.
+    """
 
     def on_start(self, sim: Simulation) -> None:
         """Called after initialisation, at the start time.
@@ -90,16 +103,24 @@ class CsvRecorder:
     interval : float or None
         Record every ``interval`` seconds (at the first step at or after
         each multiple); None records every accepted step.
+    flush_every : float
+        Longest wall-clock time a recorded row waits before it is written to
+        the file, s (0: every row at once).
     """
 
-    def __init__(self, directory: Path, interval: float | None = None) -> None:
+    def __init__(
+        self, directory: Path, interval: float | None = None, flush_every: float = FLUSH_EVERY
+    ) -> None:
         self.directory = Path(directory)
         self.interval = interval
+        self.flush_every = flush_every
         self.csv_path = self.directory / "timeseries.csv"
         self.meta_path = self.directory / "metadata.json"
         self._file = None
         self._writer = None
         self._next = 0.0
+        self._rows: list[tuple] = []  # recorded, not yet written (see _row)
+        self._written = -math.inf  # wall-clock time of the last write, s
         self.columns: list[str] = []
 
     # -- observer protocol -----------------------------------------------------
@@ -117,6 +138,12 @@ class CsvRecorder:
         self._ledger_units = [u for u, s in sim.slaves.items() if "energy_balance" in s.variables]
         if self._ledger_units:
             self.columns.append(LEDGER_CHANNEL)
+        self._ledger_at = {u: self._plan[u].index("energy_balance") for u in self._ledger_units}
+        self._read_units = [u for u, names in self._plan.items() if names]
+        self._ledger_of = [self._ledger_at.get(u) for u in self._read_units]
+        kinds = [sim.slaves[u].variables[n].type for u, names in self._plan.items() for n in names]
+        self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
+        self._watch = sim.watch(self._plan, self._due)
         self._file = self.csv_path.open("w", newline="")
         self._writer = csv.writer(self._file)
         self._writer.writerow(self.columns)
@@ -128,8 +155,12 @@ class CsvRecorder:
 
         Parameters as in :meth:`Observer.on_step`.
         """
-        if self.interval is None or sim.time >= self._next - 1e-9 * max(1.0, self._next):
+        if self._due(sim.time):
             self._row(sim)
+
+    def _due(self, t: float) -> bool:
+        """Whether a row is recorded after a step ending at ``t`` (s)."""
+        return self.interval is None or t >= self._next - 1e-9 * max(1.0, self._next)
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
         """Close the file and write the summary into the metadata (also after a failure).
@@ -137,8 +168,11 @@ class CsvRecorder:
         Parameters as in :meth:`Observer.on_end`.
         """
         if self._file is not None:
-            self._file.close()
-            self._file = None
+            try:
+                self._write_rows()
+            finally:
+                self._file.close()
+                self._file = None
         self.directory.mkdir(parents=True, exist_ok=True)
         self._write_metadata(sim, result)
 
@@ -167,26 +201,60 @@ class CsvRecorder:
         return plan
 
     def _row(self, sim: Simulation) -> None:
-        values: list[Any] = [sim.time]
-        ledger = 0.0
-        for unit, names in self._plan.items():
-            got = sim.slaves[unit].get(names) if names else {}
-            values += [got[n] for n in names]
-            if unit in self._ledger_units:
-                ledger += float(got["energy_balance"])
+        """Record a row; it is put together and written with the next batch (:meth:`_write_rows`).
+
+        What a row needs is kept as it is now: the units' end-of-step reads (never
+        changed once made) and the bonds' energies (which change with every step).
+        """
+        taken = [sim.watched_snapshot(self._watch, unit) for unit in self._read_units]
         bonds = sim.energy.bonds
-        values += [bond.created for bond in bonds.values()]
-        values += [bond.carried for bond in bonds.values()]
-        values += [sim.bond_power[b] for b in bonds]
-        if self._ledger_units:
-            values.append(ledger)
-        self._writer.writerow([_cell(v) for v in values])
-        self._file.flush()
+        created = [bond.created for bond in bonds.values()]
+        carried = [bond.carried for bond in bonds.values()]
+        power = [sim.bond_power[b] for b in bonds]
+        self._rows.append((sim.time, taken, created, carried, power))
+        if time.perf_counter() - self._written >= self.flush_every:
+            self._write_rows()
         if self.interval is not None:
             # the first multiple of the interval after now (in one step, however small the
             # interval: a loop adding it could run for ever once it is below the round-off)
             reached = math.floor((sim.time + 1e-9 * max(1.0, sim.time)) / self.interval)
             self._next = max(self._next, (reached + 1) * self.interval)
+
+    def _values(self, row: tuple) -> list[Any]:
+        """The cells of a recorded row: time, recorded variables, bond channels, ledger."""
+        t, taken, created, carried, power = row
+        values: list[Any] = [t]
+        ledger = 0.0
+        unpack = self._watch.unpack
+        for unit, at, kept in zip(self._read_units, self._ledger_of, taken, strict=True):
+            got = unpack(unit, kept)
+            values += got
+            if at is not None:
+                ledger += float(got[at])
+        values += created
+        values += carried
+        values += power
+        if self._ledger_units:
+            values.append(ledger)
+        for i in self._converted:  # text and booleans as the file shows them
+            values[i] = _cell(values[i])
+        return values
+
+    def _write_rows(self) -> None:
+        """Write the rows recorded since the last write and flush the file.
+
+        A float is written as its ``repr``, the shortest text that reads back to the
+        same number, as the csv module writes it; rows of numbers only are joined
+        directly (no cell of theirs needs quoting), the same text at half the cost.
+        """
+        rows = [self._values(row) for row in self._rows]
+        self._rows.clear()
+        if self._converted:
+            self._writer.writerows(rows)
+        else:
+            self._file.write("".join([",".join(map(repr, row)) + "\r\n" for row in rows]))
+        self._file.flush()
+        self._written = time.perf_counter()
 
     def _write_metadata(self, sim: Simulation, result: RunResult | None) -> None:
         variables = {}

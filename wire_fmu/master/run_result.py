@@ -31,3 +31,7 @@ class RunResult:
     bond_residual: dict[str, float] = field(default_factory=dict)
     bond_carried: dict[str, float] = field(default_factory=dict)
     bond_error: dict[str, float] = field(default_factory=dict)
+    stepping_wall_time: float = 0.0
+    """Wall time of the stepping loop alone (no instantiation, initialisation or clean-up), s."""
+    stepping_fmi_time: float = 0.0
+    """Time inside the FMI calls made by the stepping loop, s."""

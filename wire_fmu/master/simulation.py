@@ -21,6 +21,13 @@ observers (which read: recorder, progress, energy monitor). One macro step:
    passes a share of what the bond carried: with any settings, a macro step
    too large for the dynamics across a bond is never a silent blow-up.
 
+Across the FMI boundary each unit gets, per macro step, one batched set of
+its Real inputs (connected, driven, set by events) and, after its step, one
+batched read per FMI type of what the master needs: the outputs that feed
+connections, the ``mode_changes`` counter and, at the steps an observer
+records, the variables it watches (:meth:`Simulation.watch`). The value
+references are resolved once (:mod:`~wire_fmu.master.unit_io`).
+
 The energy residual of a bond over a step is computed in
 :mod:`~wire_fmu.master.bond_energy`; macro step sizes (nanosecond times, the
 step after a rejection, the adaptive controller) in
@@ -36,15 +43,16 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 
 from .algorithms import make_algorithm, step_order
-from .bond_energy import bond_step_energy
+from .bond_energy import BondKeys, step_energy
 from .energy_guard import EnergyGuard, _remedies
 from .extrapolation import History, held_value
 from .interrupts import _InterruptRequestedError, _Interrupts
 from .manipulators import DriverSet, ScheduledEvents
 from .run_result import RunResult, SimulationStoppedError
-from .scene import Connection, Scene
+from .scene import Scene
 from .slave import Slave, StepRefusedError, UnitFailedError
 from .step_size import _PI, _ns, new_h
+from .unit_io import EndValues, InputPlan, Link, ReadPlan, Watch, read_plan
 from .validate import Structure, unit_start_values
 
 __all__ = ["Simulation"]
@@ -52,14 +60,6 @@ __all__ = ["Simulation"]
 logger = logging.getLogger(__name__)
 
 MODE_OUTPUT = "mode_changes"
-
-
-@dataclass
-class _Link:
-    connection: Connection
-    key: str  # source "unit.var"
-    target_vr: int
-    scheme: str
 
 
 @dataclass
@@ -110,6 +110,12 @@ class Simulation:
         self.result = RunResult("not started")
         self._error_prev = 1.0
         self._interrupts = _Interrupts()
+        self._bond_keys = [BondKeys.of(b) for b in scene.bonds]
+        self._watches: list[Watch] = []
+        self._watching = False  # whether this step's end-of-step reads include the watches
+        self._inputs: dict[str, InputPlan] = {}
+        self._reads: dict[str, tuple[ReadPlan, ReadPlan]] = {}
+        self._ends: dict[str, EndValues] = {}  # the units' end-of-step reads still valid
 
     @property
     def bond_residual(self) -> dict[str, float]:
@@ -118,13 +124,15 @@ class Simulation:
 
     # -- structure -------------------------------------------------------------
     def _build_links(self) -> None:
-        self.links_into: dict[str, list[_Link]] = defaultdict(list)
+        self.links_into: dict[str, list[Link]] = defaultdict(list)
         self.source_keys: dict[str, list[str]] = defaultdict(list)
+        self.histories: dict[str, History] = {}
         for c in self.scene.all_connections:
             slave = self.slaves[c.target.unit]
             scheme = c.extrapolation or self.run_settings.extrapolation
             key = str(c.source)
-            link = _Link(c, key, slave.vr(c.target.variable), scheme)
+            history = self.histories.setdefault(key, History())
+            link = Link(c, key, slave.vr(c.target.variable), scheme, history)
             self.links_into[c.target.unit].append(link)
             if key not in self.source_keys[c.source.unit]:
                 self.source_keys[c.source.unit].append(key)
@@ -132,7 +140,85 @@ class Simulation:
             unit: [self.slaves[unit].vr(k.split(".", 1)[1]) for k in keys]
             for unit, keys in self.source_keys.items()
         }
-        self.histories = {k: History() for keys in self.source_keys.values() for k in keys}
+
+    def _build_plans(self) -> None:
+        """Each unit's batched set and end-of-step reads (after the observers' watches)."""
+        for name, slave in self.slaves.items():
+            links = tuple(self.links_into.get(name, ()))
+            driven = tuple(self.drivers.targets(name))
+            variables = [slave.variables.get(n) for n in driven]
+            reals = all(v is not None and v.type == "Real" for v in variables)
+            refs = [link.target_vr for link in links]
+            if reals:
+                refs += [v.valueReference for v in variables]
+            evented = name in self.events.units
+            self._inputs[name] = InputPlan(links, driven, refs, reals, evented)
+            sources = self.source_vrs.get(name, [])
+            mode = MODE_OUTPUT if name in self.mode_counts else None
+            self._reads[name] = (
+                read_plan(name, slave, sources, mode),
+                read_plan(name, slave, sources, mode, self._watches),
+            )
+
+    def watch(self, names: dict[str, list[str]], due) -> Watch:
+        """Read variables with the units' end-of-step reads at the steps ``due`` names.
+
+        For observers: call it in ``on_start``; the values of a step are then
+        read with what the master reads at the end of the step anyway.
+
+        Parameters
+        ----------
+        names : dict of str to list of str
+            Variable names by unit.
+        due : callable
+            ``due(t)``: whether the observer reads after the step that ends at
+            ``t`` (s).
+
+        Returns
+        -------
+        Watch
+            Its :meth:`~wire_fmu.master.unit_io.Watch.values` gives a unit's
+            variables now, from the end-of-step read when it has them.
+        """
+        watch = Watch(names, due)
+        self._watches.append(watch)
+        self._reads.clear()  # planned again before the next step
+        return watch
+
+    def watched_values(self, watch: Watch, unit: str) -> list:
+        """The current values of the variables ``watch`` names at ``unit``.
+
+        Parameters
+        ----------
+        watch : Watch
+            From :meth:`watch`.
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        list of object
+            Each value, in its unit, in the order the watch names them.
+        """
+        return watch.values(unit, self.slaves[unit], self._ends.get(unit))
+
+    def watched_snapshot(self, watch: Watch, unit: str) -> EndValues | list:
+        """:meth:`watched_values`, kept for later (:meth:`Watch.unpack <.unit_io.Watch.unpack>`).
+
+        Parameters
+        ----------
+        watch : Watch
+            From :meth:`watch`.
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        EndValues or list
+            The unit's end-of-step read when it holds the watched values, else
+            the values read now.
+        """
+        return watch.take(unit, self.slaves[unit], self._ends.get(unit))
 
     def _order(self, structure: Structure) -> list[str]:
         flows_to, feeds = defaultdict(set), defaultdict(set)
@@ -165,11 +251,13 @@ class Simulation:
             self.slaves[name].exit_initialization()
             self._push(name, start)
         for name, slave in self.slaves.items():
-            if MODE_OUTPUT in slave.variables:
+            # a mode event resets the unit's outgoing histories: watched where there are any
+            if MODE_OUTPUT in slave.variables and self.source_keys.get(name):
                 self.mode_counts[name] = int(slave.get([MODE_OUTPUT])[MODE_OUTPUT])
         self.time = start
 
     def _set_connected_from_latest(self, unit: str) -> None:
+        self._ends.pop(unit, None)
         refs, values = [], []
         for link in self.links_into.get(unit, ()):
             if self.histories[link.key].points:
@@ -195,6 +283,9 @@ class Simulation:
         dict of str to float
             Each output's value by its ``"unit.variable"`` name, in its unit.
         """
+        end = self._ends.get(unit)
+        if end is not None:  # read once, just after the unit's step
+            return dict(end.sources)
         keys = self.source_keys.get(unit, [])
         return dict(
             zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
@@ -213,24 +304,42 @@ class Simulation:
             Source outputs (``"unit.variable"``) at ``t + h`` from the previous
             sweep of an iterated step; None extrapolates from the past.
         """
-        refs, values = [], []
-        for link in self.links_into.get(unit, ()):
-            history = self.histories[link.key]
-            if link.connection.role == "position":
-                value = history.latest  # the unit advances it with the held velocity
+        self._ends.pop(unit, None)
+        plan = self._inputs[unit]
+        if plan.idle:
+            return
+        held, values = self.held, []
+        for link in plan.links:
+            if link.position:
+                value = link.history.points[-1][1]  # the unit advances it with the held velocity
             else:
                 value = held_value(
-                    history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
                 )
-            refs.append(link.target_vr)
             values.append(value)
-            self.held[f"{link.connection.target}"] = value
+            held[link.target] = value
         slave = self.slaves[unit]
+        by_name = None
+        if plan.driven:
+            driven = self.drivers.step_values(unit, t, h)
+            if not plan.driven_reals:
+                by_name = dict(zip(plan.driven, driven, strict=True))  # set by name, checked
+            elif all(type(v) is float for v in driven):
+                values += driven
+            else:  # checked as a set by name would, then sent as floats
+                slave.typed_values(dict(zip(plan.driven, driven, strict=True)))
+                values += [float(v) for v in driven]
+        refs, others = plan.refs, None
+        if by_name is not None:  # as the events' values override the drivers'
+            by_name.update(self.events.values(unit))
+        elif plan.evented:
+            refs, event_values, others = plan.event_inputs(slave, self.events)
+            values += event_values
         slave.set_reals(refs, values)
-        driven = self.drivers.values(unit, t, h)
-        driven.update(self.events.values(unit))
-        if driven:
-            slave.set_many(driven)
+        if by_name:
+            slave.set_many(by_name)
+        if others:
+            slave.set_typed(others)
 
     def step_unit(self, unit: str, t: float, h: float) -> None:
         """Step one unit (errors propagate as StepRefusedError / UnitFailedError).
@@ -242,7 +351,12 @@ class Simulation:
         t, h : float
             Start and length of the macro step, s.
         """
-        self.slaves[unit].do_step(t, h)
+        self._ends.pop(unit, None)
+        slave = self.slaves[unit]
+        slave.do_step(t, h)
+        plain, watched = self._reads[unit]
+        plan = watched if self._watching else plain
+        self._ends[unit] = plan.read(slave, self.source_keys.get(unit, ()))
 
     def _fire_events(self, t: float) -> list[str]:
         fired = self.events.fire_due(t)
@@ -256,6 +370,7 @@ class Simulation:
         return {name: s.get_state() for name, s in self.slaves.items()}
 
     def _restore(self, states) -> None:
+        self._ends.clear()
         for name, state in states.items():
             self.slaves[name].set_state(state)
 
@@ -266,7 +381,8 @@ class Simulation:
     def _read_all(self) -> dict[str, float]:
         new = {}
         for unit in self.slaves:
-            new.update(self.read_sources(unit))
+            end = self._ends.get(unit)
+            new.update(end.sources if end is not None else self.read_sources(unit))
         return new
 
     def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
@@ -317,14 +433,15 @@ class Simulation:
             The energy residual by bond name, J (positive: created).
         """
         out = {}
-        for bond in self.scene.bonds:
-            out[bond.name], self.bond_power[bond.name] = bond_step_energy(
-                bond, self.histories, self.held, new, h
-            )
+        histories, held, power = self.histories, self.held, self.bond_power
+        for keys in self._bond_keys:
+            out[keys.name], power[keys.name] = step_energy(keys, histories, held, new, h)
         return out
 
     def _attempt(self, t: float, h: float) -> _Attempt:
         """Take one macro step, rolling back when it is refused or rejected."""
+        if not self._reads:  # planned once, after the observers' watches
+            self._build_plans()
         rollback = self.run_settings.iterations > 1 or self.run_settings.adaptive
         states = self._save() if rollback else None
         try:
@@ -378,23 +495,35 @@ class Simulation:
         return _Attempt(True, residuals, sweeps, new)
 
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
+        histories, end = self.histories, t + h
         for key, value in new.items():
-            self.histories[key].push(t + h, value)
+            histories[key].push(end, value)
         switched = set()
         for name, before in self.mode_counts.items():
-            now = int(self.slaves[name].get([MODE_OUTPUT])[MODE_OUTPUT])
+            now = self._mode_count(name)
             if now != before:
                 switched.add(name)
                 self.mode_counts[name] = now
                 for key in self.source_keys.get(name, ()):
-                    self.histories[key].reset()
-        across = {
-            b.name
-            for b in self.scene.bonds
-            if b.effort.source.unit in switched or b.flow.source.unit in switched
-        }
+                    histories[key].reset()
+        across = (
+            {
+                b.name
+                for b in self.scene.bonds
+                if b.effort.source.unit in switched or b.flow.source.unit in switched
+            }
+            if switched
+            else ()
+        )
         self.energy.book(residuals, self.bond_power, h, across_events=across)
         self.time = t + h
+
+    def _mode_count(self, unit: str) -> int:
+        """The unit's ``mode_changes`` output now (from its end-of-step read if valid)."""
+        end = self._ends.get(unit)
+        if end is not None and end.mode is not None:
+            return end.mode
+        return int(self.slaves[unit].get([MODE_OUTPUT])[MODE_OUTPUT])
 
     def _next_step(self, h: float, residuals) -> float:
         s = self.run_settings
@@ -427,7 +556,7 @@ class Simulation:
                 self._fire_events(self.time)
                 for obs in self.observers:
                     obs.on_start(self)
-                self._loop(result)
+                self._stepping(result)
             except (KeyboardInterrupt, _InterruptRequestedError):
                 result.status = "interrupted"
                 result.message = f"interrupted at t = {self.time:.6g} s"
@@ -462,6 +591,26 @@ class Simulation:
         for slave in self.slaves.values():
             slave.terminate()
 
+    def _watched_at(self, end: float) -> bool:
+        """Whether some observer reads its watched variables after a step ending at ``end``."""
+        for watch in self._watches:
+            if watch.due(end):
+                return True
+        return False
+
+    def _stepping(self, result: RunResult) -> None:
+        """:meth:`_loop`, timed: the loop's wall time and the time in FMI calls within it."""
+        fmi = self._fmi_seconds()
+        start = time.perf_counter()
+        try:
+            self._loop(result)
+        finally:
+            result.stepping_wall_time = time.perf_counter() - start
+            result.stepping_fmi_time = self._fmi_seconds() - fmi
+
+    def _fmi_seconds(self) -> float:
+        return sum(sum(slave.seconds.values()) for slave in self.slaves.values())
+
     def _loop(self, result: RunResult) -> None:
         # Time is counted in integer nanoseconds, as libcosim does: no drift over long
         # runs, event times hit exactly, and the same step sizes as libcosim's.
@@ -477,6 +626,7 @@ class Simulation:
             h = next_ns / 1e9 - t
             if self._interrupts.requested:
                 raise _InterruptRequestedError
+            self._watching = self._watched_at(next_ns / 1e9)
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps
             if not attempt.accepted:

@@ -46,6 +46,8 @@ __all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS", "value_
 logger = logging.getLogger(__name__)
 
 FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
+_GETTERS = {kind: f"get{kind}" for kind in ("Real", "Integer", "Boolean", "String")}
+_clock = time.perf_counter
 _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
 
@@ -265,6 +267,28 @@ class Slave:
         UnitFailedError
             For an unknown variable, a value its type cannot take, or an FMI error.
         """
+        self.set_typed(self.typed_values(values))
+
+    def typed_values(self, values: dict[str, Any]) -> dict[str, tuple[list[int], list[Any]]]:
+        """Values by name as value references and checked values, grouped by FMI type.
+
+        Parameters
+        ----------
+        values : dict of str to object
+            Value by variable name, in the variable's unit, as for :meth:`set_many`.
+
+        Returns
+        -------
+        dict of str to (list of int, list of object)
+            For each FMI type (``"Real"``, ``"Integer"``, ...), in the order the
+            types first appear: the value references and their values (a Real
+            as a float).
+
+        Raises
+        ------
+        UnitFailedError
+            For an unknown variable or a value its type cannot take.
+        """
         groups: dict[str, tuple[list[int], list[Any]]] = defaultdict(lambda: ([], []))
         for name, value in values.items():
             var = self.variables.get(name)
@@ -281,8 +305,40 @@ class Slave:
                     f"unit {self.name!r}: {name} = {value!r}: {problem}", self.name
                 )
             vals.append(float(value) if var.type == "Real" else value)
+        return dict(groups)
+
+    def set_typed(self, groups: dict[str, tuple[Sequence[int], Sequence[Any]]]) -> None:
+        """Set values grouped by FMI type, one call per type.
+
+        Parameters
+        ----------
+        groups : dict of str to (sequence of int, sequence of object)
+            For each FMI type, value references and checked values (see
+            :meth:`typed_values`), in the variables' units.
+        """
         for kind, (refs, vals) in groups.items():
-            self._call(f"set{kind}", refs, vals)
+            if refs:
+                self._call(f"set{kind}", list(refs), list(vals))
+
+    def get_typed(self, kind: str, refs: Sequence[int]) -> list[Any]:
+        """Values of variables of one FMI type by value reference, in one call.
+
+        Parameters
+        ----------
+        kind : str
+            The variables' FMI type: ``"Real"``, ``"Integer"``, ``"Boolean"`` or
+            ``"String"``.
+        refs : sequence of int
+            Value references (see :meth:`vr`).
+
+        Returns
+        -------
+        list of object
+            A value for each, in the variable's unit (a String as bytes).
+        """
+        if not refs:
+            return []
+        return self._call(_GETTERS.get(kind) or f"get{kind}", _listed(refs))
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
         """Fast path: set Reals by value reference.
@@ -295,7 +351,7 @@ class Slave:
             A value for each, in the variable's unit.
         """
         if refs:
-            self._call("setReal", list(refs), list(values))
+            self._call("setReal", _listed(refs), _listed(values))
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:
         """Fast path: get Reals by value reference.
@@ -310,7 +366,7 @@ class Slave:
         list of float
             A value for each, in the variable's unit.
         """
-        return self._call("getReal", list(refs)) if refs else []
+        return self._call("getReal", _listed(refs)) if refs else []
 
     def get(self, names: Iterable[str]) -> dict[str, Any]:
         """Values of variables by name.
@@ -330,7 +386,7 @@ class Slave:
         for name in names:
             by_type[self.variables[name].type].append(name)
         for kind, group in by_type.items():
-            values = self._call(f"get{kind}", [self.vr(n) for n in group])
+            values = self.get_typed(kind, [self.vr(n) for n in group])
             out.update(zip(group, values, strict=True))
         return out
 
@@ -354,7 +410,7 @@ class Slave:
         """
         self.messages.kept.clear()
         try:
-            self._call("doStep", currentCommunicationPoint=t, communicationStepSize=h)
+            self._call("doStep", t, h)  # currentCommunicationPoint, communicationStepSize
         except FMICallException as exc:
             self._fatal = self._fatal or exc.status == 4
             said = "; ".join(self.messages.kept[-3:]) or "no message"
@@ -394,13 +450,13 @@ class Slave:
         self._call("freeFMUstate", state)
 
     def _call(self, fn: str, *args, **kwargs):
-        if self._fmu is None:
+        fmu = self._fmu
+        if fmu is None:
             raise UnitFailedError(f"unit {self.name!r} is not instantiated", self.name)
-        start = time.perf_counter()
+        method = getattr(fmu, fn)
+        start = _clock()
         try:
-            if fn == "instantiate":
-                return self._fmu.instantiate(*args, **kwargs)
-            return getattr(self._fmu, fn)(*args, **kwargs)
+            return method(*args, **kwargs)
         except FMICallException as exc:
             self._fatal = self._fatal or exc.status == 4
             if fn == "doStep":
@@ -414,8 +470,13 @@ class Slave:
                 self.name,
             ) from None
         finally:
+            self.seconds[fn] += _clock() - start
             self.calls[fn] += 1
-            self.seconds[fn] += time.perf_counter() - start
+
+
+def _listed(items: Sequence[Any]) -> list[Any]:
+    """``items`` as a list (itself when it is one: fmpy copies it into a C array)."""
+    return items if type(items) is list else list(items)
 
 
 _INT32 = (-(2**31), 2**31 - 1)

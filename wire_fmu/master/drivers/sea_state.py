@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .protocol import _fade, _out
+from .protocol import _fade, _fade_scalar, _out
 
 __all__ = ["SeaStateDriver", "pierson_moskowitz_spectrum", "jonswap_spectrum", "SPECTRA"]
 
@@ -138,9 +138,39 @@ class SeaStateDriver:
 
         Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
         """
+        if isinstance(t, float):  # one time, every macro step: the sum as one dot product
+            tau = float(t) - self.start_time
+            weight, _ = _fade_scalar(tau, self.ramp_time)
+            wave = float(np.cos(self.angular_frequencies * tau + self.phases) @ self.amplitudes)
+            return float(self.heave_rao * weight * wave)
         weight, _ = _fade(t, self.start_time, self.ramp_time)
         wave = self._sum(t, np.cos, self.amplitudes)
         return _out(self.heave_rao * weight * wave, t)
+
+    def values_at(self, times: Sequence[float]) -> list[float]:
+        """:meth:`value` at each of ``times`` (s), m: the same numbers, computed together.
+
+        The cosines of all times and components are evaluated in one call; each
+        time's sum is then the dot product :meth:`value` takes, so every value
+        is identical to it to the last bit.
+
+        Parameters
+        ----------
+        times : sequence of float
+            Times, s.
+
+        Returns
+        -------
+        list of float
+            The heave at each time, m.
+        """
+        taus = [float(t) - self.start_time for t in times]
+        waves = np.cos(np.multiply.outer(np.array(taus), self.angular_frequencies) + self.phases)
+        out = []
+        for tau, row in zip(taus, waves, strict=True):
+            weight, _ = _fade_scalar(tau, self.ramp_time)
+            out.append(float(self.heave_rao * weight * float(row @ self.amplitudes)))
+        return out
 
     def rate(self, t: float) -> float:
         """Heave velocity at ``t`` (s), m/s.

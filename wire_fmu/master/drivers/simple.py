@@ -29,6 +29,8 @@ class ConstantDriver:
 
         Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
         """
+        if isinstance(t, float):  # one time, every macro step
+            return float(self.constant)
         return _out(np.full(np.shape(t), self.constant), t)
 
     def rate(self, t: float) -> float:
@@ -78,6 +80,8 @@ class PiecewiseLinearDriver:
 
         Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
         """
+        if isinstance(t, float):  # one time, every macro step
+            return float(np.interp(t, self.times, self.values))
         return _out(np.interp(t, self.times, self.values), t)
 
     def rate(self, t: float) -> float:

@@ -1,0 +1,338 @@
+"""What the master sets and reads at each unit per macro step, worked out once.
+
+Per unit and macro step the master makes one batched set of its Real inputs
+(connected, driven and set by events) before the step and one batched get per
+FMI type after it: the outputs that feed connections, the ``mode_changes``
+counter and, at the steps an observer records, the variables it records. The
+value references of all of these are resolved here, once, into plans:
+
+:class:`ReadPlan`
+    the value references a unit's end-of-step read asks for, by type, and
+    where each output sits in the answer;
+:class:`EndValues`
+    what that read returned (valid until the unit is set, stepped or
+    restored again);
+:class:`Watch`
+    variables an observer reads at the end of the steps it records: read with
+    the unit's end-of-step read when due, else on their own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from .extrapolation import History
+from .manipulators import ScheduledEvents
+from .scene import Connection
+from .slave import Slave
+
+__all__ = ["EndValues", "InputPlan", "Link", "ReadPlan", "Watch", "read_plan"]
+
+_Place = tuple[str, int]  # (FMI type, position in that type's answer)
+
+
+@dataclass
+class Link:
+    """A connection as the master holds it over a step.
+
+    Parameters
+    ----------
+    connection : Connection
+        The scene's connection.
+    key : str
+        Its source, ``"unit.variable"``.
+    target_vr : int
+        Value reference of the input it sets.
+    scheme : str
+        Its extrapolation (``"constant"``, ``"linear"``, ``"quadratic"``).
+    history : History
+        Its source's history (shared by every link from that source).
+    """
+
+    connection: Connection
+    key: str
+    target_vr: int
+    scheme: str
+    history: History
+    target: str = field(init=False)
+    """The input it sets, ``"unit.variable"``."""
+    position: bool = field(init=False)
+    """Whether it is a bond's position link (held at the source's latest value)."""
+
+    def __post_init__(self) -> None:
+        self.target = str(self.connection.target)
+        self.position = self.connection.role == "position"
+
+
+@dataclass
+class InputPlan:
+    """What one unit's batched set holds before each step.
+
+    Parameters
+    ----------
+    links : tuple of Link
+        Connections into the unit, in order.
+    driven : tuple of str
+        Inputs set by drivers, in the order of
+        :meth:`~wire_fmu.master.manipulators.DriverSet.step_values`.
+    refs : list of int
+        Value references of the links' inputs, then of the driven inputs when
+        they are all Reals (:attr:`driven_reals`).
+    driven_reals : bool
+        Whether every driven input is a Real (else they are set by name, checked).
+    evented : bool
+        Whether some scheduled event sets an input of the unit.
+
+    Attributes
+    ----------
+    idle : bool
+        Whether nothing sets an input of the unit during the run.
+    """
+
+    links: tuple[Link, ...]
+    driven: tuple[str, ...]
+    refs: list[int]
+    driven_reals: bool
+    evented: bool
+    _fired: int = field(default=-1, repr=False)
+    _event_refs: list[int] = field(default_factory=list, repr=False)
+    _event_values: list[float] = field(default_factory=list, repr=False)
+    _event_others: dict[str, tuple[list[int], list[Any]]] = field(default_factory=dict, repr=False)
+    idle: bool = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.idle = not (self.links or self.driven or self.evented)
+
+    def event_inputs(
+        self, slave: Slave, events: ScheduledEvents
+    ) -> tuple[list[int], list[float], dict[str, tuple[list[int], list[Any]]]]:
+        """The inputs the events so far set, checked once after each event fires.
+
+        Parameters
+        ----------
+        slave : Slave
+            The unit.
+        events : ScheduledEvents
+            The scene's events.
+
+        Returns
+        -------
+        refs : list of int
+            :attr:`refs` followed by the Reals the events set.
+        values : list of float
+            The values of those Reals, in their units.
+        others : dict of str to (list of int, list of object)
+            Inputs of other FMI types the events set, by type.
+
+        Raises
+        ------
+        UnitFailedError
+            For an unknown variable or a value its type cannot take.
+        """
+        if self._fired != events.fired:
+            typed = slave.typed_values(events.values(slave.name))
+            event_refs, self._event_values = typed.pop("Real", ([], []))
+            self._event_refs = self.refs + event_refs
+            self._event_others = typed
+            self._fired = events.fired
+        return self._event_refs, self._event_values, self._event_others
+
+
+@dataclass
+class Watch:
+    """Variables an observer reads after the steps it is due at.
+
+    Parameters
+    ----------
+    names : mapping of str to sequence of str
+        Variable names by unit, in the order :meth:`values` gives them.
+    due : callable
+        ``due(t)``: whether the observer reads at a step that ends at ``t`` (s).
+    """
+
+    names: Mapping[str, Sequence[str]]
+    due: Callable[[float], bool]
+    places: dict[str, list[_Place]] = field(default_factory=dict, repr=False)
+
+    def values(self, unit: str, slave: Slave, end: EndValues | None) -> list[Any]:
+        """The watched variables of ``unit`` now, in the order of :attr:`names`.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        slave : Slave
+            The unit, read directly when ``end`` does not hold the values.
+        end : EndValues or None
+            What the unit's last end-of-step read returned, if it is still valid.
+
+        Returns
+        -------
+        list of object
+            Each variable's value, in its unit (a String as bytes).
+        """
+        return self.unpack(unit, self.take(unit, slave, end))
+
+    def take(self, unit: str, slave: Slave, end: EndValues | None) -> EndValues | list[Any]:
+        """What :meth:`values` would give, kept as cheaply as possible for :meth:`unpack`.
+
+        Parameters
+        ----------
+        unit, slave, end
+            As for :meth:`values`.
+
+        Returns
+        -------
+        EndValues or list
+            The end-of-step read itself when it holds the watched variables (its
+            lists are never changed), else their values read now.
+        """
+        if end is not None and end.watched and unit in self.places:
+            return end
+        names = self.names.get(unit, ())
+        if not names:
+            return []
+        got = slave.get(names)
+        return [got[n] for n in names]
+
+    def unpack(self, unit: str, taken: EndValues | list[Any]) -> list[Any]:
+        """The values of :meth:`values` from what :meth:`take` kept.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        taken : EndValues or list
+            What :meth:`take` returned for ``unit``.
+
+        Returns
+        -------
+        list of object
+            Each variable's value, in its unit, in the order of :attr:`names`.
+        """
+        if isinstance(taken, list):
+            return taken
+        by_kind = taken.by_kind
+        return [by_kind[kind][position] for kind, position in self.places[unit]]
+
+
+@dataclass(frozen=True)
+class ReadPlan:
+    """What one unit's end-of-step read asks for.
+
+    Parameters
+    ----------
+    groups : tuple of (str, list of int)
+        For each FMI type with something to read, its value references, Real
+        first; the Reals start with the unit's source outputs, in order.
+    mode : (str, int) or None
+        Type and position of the ``mode_changes`` output, if the unit has one.
+    watched : bool
+        Whether the read includes the watched variables.
+    """
+
+    groups: tuple[tuple[str, list[int]], ...]
+    mode: _Place | None
+    watched: bool
+
+    def read(self, slave: Slave, source_keys: Sequence[str]) -> EndValues:
+        """Read the plan's values from ``slave``, one call per FMI type.
+
+        Parameters
+        ----------
+        slave : Slave
+            The unit, just stepped.
+        source_keys : sequence of str
+            ``"unit.variable"`` names of its source outputs, in plan order.
+
+        Returns
+        -------
+        EndValues
+        """
+        by_kind = {}
+        for kind, refs in self.groups:
+            by_kind[kind] = slave.get_typed(kind, refs)
+        sources = {}
+        if source_keys:  # the sources come first among the Reals, the watched variables after
+            sources = dict(zip(source_keys, by_kind["Real"][: len(source_keys)], strict=True))
+        mode = None if self.mode is None else int(by_kind[self.mode[0]][self.mode[1]])
+        return EndValues(by_kind, sources, mode, self.watched)
+
+
+class EndValues:
+    """What a unit's end-of-step read returned (made for every unit and step).
+
+    Parameters
+    ----------
+    by_kind : dict of str to list
+        The values by FMI type, in the order of the plan's value references.
+    sources : dict of str to float
+        The source outputs by ``"unit.variable"`` name, in their units.
+    mode : int or None
+        The ``mode_changes`` counter, if the unit has one.
+    watched : bool
+        Whether the watched variables were read too.
+    """
+
+    __slots__ = ("by_kind", "sources", "mode", "watched")
+
+    def __init__(
+        self,
+        by_kind: dict[str, list[Any]],
+        sources: dict[str, float],
+        mode: int | None,
+        watched: bool,
+    ) -> None:
+        self.by_kind = by_kind
+        self.sources = sources
+        self.mode = mode
+        self.watched = watched
+
+
+def read_plan(
+    unit: str,
+    slave: Slave,
+    source_refs: Sequence[int],
+    mode_output: str | None,
+    watches: Sequence[Watch] = (),
+) -> ReadPlan:
+    """The end-of-step read of one unit; the watches learn where their variables sit.
+
+    Parameters
+    ----------
+    unit : str
+        Instance name of the unit in the scene.
+    slave : Slave
+        The unit.
+    source_refs : sequence of int
+        Value references of its outputs that feed connections (Reals), in order.
+    mode_output : str or None
+        Name of the unit's mode-change counter output, if it is read.
+    watches : sequence of Watch
+        Observers' variables to read too (empty: the plain plan).
+
+    Returns
+    -------
+    ReadPlan
+    """
+    groups: dict[str, list[int]] = {"Real": list(source_refs)}
+    index: dict[_Place, int] = {}
+    for position, ref in enumerate(source_refs):
+        index.setdefault(("Real", ref), position)
+
+    def place(name: str) -> _Place:
+        var = slave.variables[name]
+        key = (var.type, var.valueReference)
+        if key not in index:
+            refs = groups.setdefault(var.type, [])
+            index[key] = len(refs)
+            refs.append(var.valueReference)
+        return var.type, index[key]
+
+    mode = None if mode_output is None else place(mode_output)
+    for watch in watches:
+        watch.places[unit] = [place(name) for name in watch.names.get(unit, ())]
+    kept = tuple((kind, refs) for kind, refs in groups.items() if refs)
+    return ReadPlan(kept, mode, bool(watches))
