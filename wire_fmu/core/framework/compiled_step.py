@@ -19,7 +19,9 @@ numpy temporaries inside the compiled code.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -38,6 +40,7 @@ if TYPE_CHECKING:
 __all__ = [
     "COMPILED_METHODS",
     "CompiledFixedStep",
+    "KernelModel",
     "STATUS_DONE",
     "STATUS_EVENT",
     "STATUS_NONFINITE",
@@ -294,3 +297,44 @@ class CompiledFixedStep(FixedStepSolver):
         with system.python_kernel():
             self._python._checked_step(system, t, x, h)
         raise IntegrationError(f"non-finite state after a step of {h:.3g} s at t = {t:.6g} s")
+
+
+class KernelModel:
+    """What a model with a compiled kernel shares (a mixin).
+
+    The model sets :attr:`compiled` when it is built and names its kernel module
+    in :attr:`KERNEL` (which offers ``kernel_data(model)`` and the entry point
+    ``advance``); its ``rhs``/``guards`` hand over to the kernel while
+    :attr:`compiled` is True.
+    """
+
+    KERNEL: ModuleType
+    compiled: bool = False
+
+    def kernel_data(self) -> tuple:
+        """The tuple of arrays the compiled kernel takes, for the present modes and inputs."""
+        return self.KERNEL.kernel_data(self)
+
+    @contextmanager
+    def python_kernel(self) -> Iterator[None]:
+        """Evaluate with the Python kernel inside the ``with`` block."""
+        compiled, self.compiled = self.compiled, False
+        try:
+            yield
+        finally:
+            self.compiled = compiled
+
+    def kernel_solver(self, settings: SolverSettings):
+        """The compiled fixed-step loop over the kernel when compiled and the method has one,
+        else the Python solver.
+
+        Parameters
+        ----------
+        settings : SolverSettings
+            The solver's settings.
+        """
+        from wire_fmu.core.framework.hybrid import make_solver
+
+        if self.compiled and settings.method in COMPILED_METHODS:
+            return CompiledFixedStep(settings, self.KERNEL.advance)
+        return make_solver(settings)

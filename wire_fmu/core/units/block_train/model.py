@@ -35,8 +35,6 @@ The equations of motion are Lagrange's with the rope strain energy of
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,9 +43,9 @@ from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
+from wire_fmu.core.framework.compiled_step import KernelModel
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.block_train import kernel
 from wire_fmu.core.units.block_train.modes import ModeSwitching
 from wire_fmu.core.units.block_train.path import ReevedPath
@@ -91,7 +89,7 @@ class BlockTrainInputs:
     mover_velocity: dict[str, float]
 
 
-class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
+class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
     """Hybrid ODE of a block train; see the module docstring.
 
     Parameters
@@ -104,6 +102,7 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         Internal solver for :meth:`advance`.
     """
 
+    KERNEL = kernel
     GEOMETRY_STEP = 1e-6  # m, central differences of lengths w.r.t. body motion
 
     def __init__(self, reeving: Reeving, effects: frozenset[str], solver: SolverSettings) -> None:
@@ -142,10 +141,7 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
         self.contact_mask = np.zeros(len(self.blocks), dtype=bool)
         self._build_kernel_arrays()
         self.compiled = self.kernel_applies() and use_compiled("block train")
-        if self.compiled and solver.method in COMPILED_METHODS:
-            self.solver = CompiledFixedStep(solver, kernel.advance)
-        else:
-            self.solver = make_solver(solver)
+        self.solver = self.kernel_solver(solver)
 
     # ------------------------------------------------------------- kernels
     def kernel_applies(self) -> bool:
@@ -168,19 +164,6 @@ class BlockTrainModel(ReevedPath, ModeSwitching, StartingState):
             if b.floor is not None:
                 blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
         self.kernel_blocks = blocks
-
-    def kernel_data(self) -> tuple:
-        """The tuple of arrays the compiled kernel takes, for the present modes and inputs."""
-        return kernel.kernel_data(self)
-
-    @contextmanager
-    def python_kernel(self) -> Iterator[None]:
-        """Evaluate with the Python kernel inside the ``with`` block."""
-        compiled, self.compiled = self.compiled, False
-        try:
-            yield
-        finally:
-            self.compiled = compiled
 
     # ------------------------------------------------------------------ build
     def _build_friction(self) -> None:

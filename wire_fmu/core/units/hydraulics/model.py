@@ -10,8 +10,6 @@ compiled, which the model evaluates instead when ``self.compiled`` (see
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +26,7 @@ from wire_fmu.core.components.gas import ISOTHERMAL, PolytropicGas, isothermal_c
 from wire_fmu.core.components.rod_seal import RodSeal, SealSpec
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.compiled import use_compiled
+from wire_fmu.core.framework.compiled_step import KernelModel
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.hydraulics import kernel
@@ -125,7 +124,7 @@ class _Point:
     stored: float
 
 
-class HydraulicsModel(OilSide, RefinedStepping):
+class HydraulicsModel(KernelModel, OilSide, RefinedStepping):
     """Hybrid ODE of a cylinder with gas accumulator; see the module docstring.
 
     Parameters
@@ -137,6 +136,8 @@ class HydraulicsModel(OilSide, RefinedStepping):
     solver : SolverSettings
         Internal solver used by :meth:`advance`.
     """
+
+    KERNEL = kernel
 
     def __init__(
         self, spec: HydraulicsSpec, effects: frozenset[str], solver: SolverSettings
@@ -171,7 +172,7 @@ class HydraulicsModel(OilSide, RefinedStepping):
         self.kernel_layout = kernel.kernel_layout(self)
         self.step_report: tuple | None = None
         """``(state, force, report values)`` of the state a quiet step ended in, or None."""
-        self.solver = self._make_solver(solver)
+        self.solver = self.kernel_solver(solver)
         self.contact_solver = self._make_contact_solver(solver)
         self._current_resolution = "coarse"
         self._integrating = False
@@ -218,20 +219,6 @@ class HydraulicsModel(OilSide, RefinedStepping):
     def n_states(self) -> int:
         """Number of continuous states, dissipated energy included."""
         return self.layout.size
-
-    # ------------------------------------------------------------- kernels
-    def kernel_data(self) -> tuple:
-        """The tuple of arrays the compiled kernel takes, for the present modes and force."""
-        return kernel.kernel_data(self)
-
-    @contextmanager
-    def python_kernel(self) -> Iterator[None]:
-        """Evaluate with the Python kernel inside the ``with`` block."""
-        compiled, self.compiled = self.compiled, False
-        try:
-            yield
-        finally:
-            self.compiled = compiled
 
     # ------------------------------------------------------------ evaluation
     def gas_volume(self, x: np.ndarray) -> float:

@@ -24,8 +24,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
+from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.step_limits import IntegrationError, internal_steps
 from wire_fmu.core.units.hydraulics import kernel
 
@@ -75,13 +75,6 @@ class RefinedStepping:
     ``_directions``, ``_limits_and_force``, ``_refuse_at_limit`` and ``_settle_friction``.
     """
 
-    def _make_solver(self, settings: SolverSettings):
-        """A solver for ``settings``: the compiled fixed-step loop over the cylinder's kernel
-        when the model is compiled and the method has one, else the Python solver."""
-        if self.compiled and settings.method in COMPILED_METHODS:
-            return CompiledFixedStep(settings, kernel.advance)
-        return make_solver(settings)
-
     def _make_contact_solver(self, settings: SolverSettings):
         """A solver resolving the stop contact (fixed-step methods only), or None.
 
@@ -99,7 +92,7 @@ class RefinedStepping:
         fine = min(settings.max_step, CONTACT_STEP_FACTOR / omega)
         if fine >= settings.max_step:
             return None
-        return self._make_solver(replace(settings, max_step=fine))
+        return self.kernel_solver(replace(settings, max_step=fine))
 
     # -------------------------------------------------------------- stepping
     def advance(self, t: float, h: float, force: float) -> int:
@@ -241,6 +234,6 @@ class RefinedStepping:
             c = self.spec.stops.cushion_coefficient
             h = CUSHION_STEP_FACTOR * self.mass / (c * self.stops.cushion_speed(float(x[1])))
             if h < self.settings.max_step:
-                solver = self._make_solver(replace(self.settings, max_step=h))
+                solver = self.kernel_solver(replace(self.settings, max_step=h))
                 return solver, min(t_end, t + CUSHION_CHUNK_STEPS * h)
         return self.solver, t_end

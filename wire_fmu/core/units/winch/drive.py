@@ -13,9 +13,9 @@ import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, CompiledFixedStep
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, KernelModel
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
@@ -24,7 +24,7 @@ from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLD
 __all__ = ["WinchModel"]
 
 
-class WinchModel(_WinchBase):
+class WinchModel(KernelModel, _WinchBase):
     """Winch with drum inertia: a hybrid ODE (:mod:`wire_fmu.core.units.winch.model`).
 
     State ``[theta_0..theta_{n-1}, omega_0..omega_{n-1}, dissipated,
@@ -41,6 +41,8 @@ class WinchModel(_WinchBase):
         Internal solver; ``"energy"``/``"energy1"`` (paper 004) only for a
         rigid drive train (one mass).
     """
+
+    KERNEL = kernel
 
     def __init__(self, config: WinchConfig, solver: SolverSettings) -> None:
         super().__init__(config)
@@ -65,24 +67,8 @@ class WinchModel(_WinchBase):
             if self.n != 1:
                 raise ValueError("the energy-form solver needs a rigid drive train (one mass)")
             self.solver = make_energy_solver(solver)
-        elif self.compiled:
-            self.solver = CompiledFixedStep(solver, kernel.advance)
         else:
-            self.solver = make_solver(solver)
-
-    # ---------------------------------------------------------- kernels
-    def kernel_data(self) -> tuple:
-        """The tuple of arrays the compiled kernel takes, for the present inputs and modes."""
-        return kernel.kernel_data(self)
-
-    @contextmanager
-    def python_kernel(self) -> Iterator[None]:
-        """Evaluate with the Python kernel inside the ``with`` block."""
-        compiled, self.compiled = self.compiled, False
-        try:
-            yield
-        finally:
-            self.compiled = compiled
+            self.solver = self.kernel_solver(solver)
 
     # ---------------------------------------------------------- state views
     @property
