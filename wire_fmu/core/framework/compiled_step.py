@@ -259,20 +259,41 @@ class CompiledFixedStep(FixedStepSolver):
         self.method = COMPILED_METHODS[settings.method]
         self._python = RK4(settings) if settings.method == "rk4" else ROS2(settings)
 
-    def advance(self, system, t0: float, x0: np.ndarray, t1: float) -> tuple[np.ndarray, int]:
+    def internal_count(self, t0: float, t1: float) -> int:
+        """The number of equal internal steps the loop takes over ``[t0, t1]`` (s)."""
+        return max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
+
+    def advance(
+        self, system, t0: float, x0: np.ndarray, t1: float, first: tuple | None = None
+    ) -> tuple[np.ndarray, int]:
         """Integrate from ``t0`` to ``t1``; return the state and the number of events.
 
         Implements :meth:`FixedStepSolver.advance`; ``system`` also offers
         ``kernel_data()``, the tuple its compiled functions take.
+
+        Parameters
+        ----------
+        system : HybridSystem
+            The model, with its compiled kernel.
+        t0, t1 : float
+            The communication step, s.
+        x0 : numpy.ndarray
+            State at ``t0``.
+        first : tuple, optional
+            What a kernel's one-call step already returned for the first stretch
+            from ``(t0, x0)`` (the entry point's answer): the loop goes on from there.
         """
-        n = max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
+        n = self.internal_count(t0, t1)
         tol = self.settings.event_time_tolerance
         t, x, k, events = t0, np.array(x0, dtype=float), 0, 0
         directions = np.asarray(system.guard_directions(), dtype=float)
         while k < n:
-            status, x, t_hit, k, mask, steps, calls, h = self.entry(
-                self.method, t0, t1, n, k, t, x, directions, tol, system.kernel_data()
-            )
+            if first is not None:
+                (status, x, t_hit, k, mask, steps, calls, h), first = first, None
+            else:
+                status, x, t_hit, k, mask, steps, calls, h = self.entry(
+                    self.method, t0, t1, n, k, t, x, directions, tol, system.kernel_data()
+                )
             self.steps += steps
             self.rhs_calls += calls
             if status == STATUS_DONE:

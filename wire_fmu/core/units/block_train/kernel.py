@@ -40,11 +40,23 @@ import math
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import advance_to_event
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, advance_to_event
 
-__all__ = ["advance", "evaluate", "guards", "kernel_data", "project", "rhs", "summary"]
+__all__ = [
+    "STATUS_PYTHON",
+    "advance",
+    "evaluate",
+    "guards",
+    "kernel_data",
+    "project",
+    "quiet_step",
+    "rhs",
+    "summary",
+]
 
 N_LINES = 2
+STATUS_PYTHON = 3
+""":func:`quiet_step` left the step to Python (a mode to settle first, or no rope left)."""
 
 
 def kernel_data(model) -> tuple:
@@ -342,3 +354,69 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
     return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+
+
+@jit
+def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
+    """A whole communication step in one call, when the new inputs switch no mode.
+
+    What :meth:`BlockTrainModel.advance
+    <wire_fmu.core.units.block_train.model.BlockTrainModel.advance>` does, in the same
+    order and with the same arithmetic: the strain energy the inputs' jump puts into
+    the rope booked as external work, then the loop of :func:`advance` up to the end
+    of the step or its first event, then the outputs' :func:`summary` at the end.
+    It changes nothing it was given.
+
+    Parameters
+    ----------
+    method, t0, t1, n, tol, directions
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them
+        (the loop starts at ``t0``, interval 0).
+    x : numpy.ndarray
+        State at ``t0``.
+    data : tuple
+        See the module docstring; its held inputs are those of the last step.
+    held : numpy.ndarray
+        The held inputs from ``t0`` on (layout of ``data[11]``).
+
+    Returns
+    -------
+    tuple
+        The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)`` and the
+        :func:`summary` at ``t1`` (empty unless the status is ``STATUS_DONE``). The
+        status is :data:`STATUS_PYTHON`, and nothing else meaningful, when a span or
+        floor is in the wrong mode for the new inputs or a span has no unstretched
+        rope: Python then takes the step.
+    """
+    new = (
+        data[0],
+        data[1],
+        data[2],
+        data[3],
+        data[4],
+        data[5],
+        data[6],
+        data[7],
+        data[8],
+        data[9],
+        data[10],
+        held,
+    )
+    no_fire = np.zeros(directions.size, dtype=np.bool_)
+    no_summary = np.zeros(0)
+    before = evaluate(t0, x, data)
+    after = evaluate(t0, x, new)
+    if not (before[13] and after[13]):
+        return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
+    g = guards(t0, x, new)
+    for i in range(data[3].size + data[0][1]):  # the spans' and floors' mode guards
+        if g[i] < 0.0:
+            return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
+    x = x.copy()
+    x[2 * data[0][0] + 1] += after[9].sum() - before[9].sum()
+    status, x, t, k, fired, steps, calls, h = advance_to_event(
+        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, new
+    )
+    if status == STATUS_DONE:
+        return status, x, t, k, fired, steps, calls, h, summary(t1, x, new)
+    return status, x, t, k, fired, steps, calls, h, no_summary

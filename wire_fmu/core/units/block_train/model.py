@@ -43,7 +43,7 @@ from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import KernelModel
+from wire_fmu.core.framework.compiled_step import CompiledFixedStep, KernelModel
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.block_train import kernel
@@ -260,15 +260,24 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         inputs : BlockTrainInputs
             Line payouts and mover positions at ``t``, with their rates.
         """
-        self.inputs = inputs
-        self._t_step = t
+        self._hold(t, inputs, self._held(t, inputs))
+
+    def _held(self, t: float, inputs: BlockTrainInputs) -> np.ndarray:
+        """The held-input vector of the kernels (see :mod:`kernel`) for ``inputs`` from ``t``."""
         lines = list(zip(LINE_PORTS, self._line_signs, strict=True))
         held = [t]
         held += [sign * inputs.payout.get(p, 0.0) for p, sign in lines]
         held += [sign * inputs.payout_rate.get(p, 0.0) for p, sign in lines]
         held += [inputs.mover_position.get(p, 0.0) for p in self.driver_ports]
         held += [inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports]
-        self.held_vector = vector = np.array(held)
+        return np.array(held)
+
+    def _hold(self, t: float, inputs: BlockTrainInputs, vector: np.ndarray) -> None:
+        """Hold ``inputs`` (and their vector ``vector``, from :meth:`_held`) from ``t`` on."""
+        self.inputs = inputs
+        self._t_step = t
+        self._step_summary = None
+        self.held_vector = vector
         lines, movers = 1 + len(LINE_PORTS), 1 + 2 * len(LINE_PORTS)
         self._line_s0, self._line_rate = vector[1:lines], vector[lines:movers]
         self._mover_y0 = vector[movers : movers + len(self.driver_ports)]
@@ -485,6 +494,10 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             Number of events the solver located in the step.
         """
         self.last_events = []
+        self._step_summary = None
+        quiet = self.compiled and isinstance(self.solver, CompiledFixedStep)
+        if quiet and break_segment is None and self._quiet_step(t, h, inputs):
+            return self._quiet_events
         before = self._input_energy(t)
         self.set_inputs(t, inputs)
         changed = self._settle_contact_modes(t, self.state)
@@ -498,6 +511,40 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         x, events = self.solver.advance(self, t, self.state, t + h)
         self.state = x
         return events
+
+    def _quiet_step(self, t: float, h: float, inputs: BlockTrainInputs) -> bool:
+        """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's.
+
+        Events inside the step are switched by :meth:`handle_events` as in any step:
+        the compiled loop goes on from the first one.
+        """
+        held = self._held(t, inputs)
+        solver = self.solver
+        t1 = t + h
+        n = solver.internal_count(t, t1)
+        status, x, t_hit, k, fired, steps, calls, h_last, values = kernel.quiet_step(
+            solver.method,
+            t,
+            t1,
+            n,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            self.kernel_data(),
+            held,
+        )
+        if status == kernel.STATUS_PYTHON:
+            return False
+        self._hold(t, inputs, held)
+        if status == kernel.STATUS_DONE:
+            solver.steps += steps
+            solver.rhs_calls += calls
+            self.state, self._quiet_events = x, 0
+            self._step_summary = (t1, x, values)
+            return True
+        first = (status, x, t_hit, k, fired, steps, calls, h_last)
+        self.state, self._quiet_events = solver.advance(self, t, self.state, t1, first)
+        return True
 
     def _input_energy(self, t: float) -> float:
         """The part of the stored energy that inputs can change at once (rope strain), J."""
@@ -525,7 +572,11 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             Force of the rope on each body along its direction (blocks, then driven), N.
         """
         if self.compiled:
-            values = kernel.summary(t, x, self.kernel_data())
+            done = self._step_summary
+            if done is not None and done[0] == t and done[1] is x:
+                values = done[2]
+            else:
+                values = kernel.summary(t, x, self.kernel_data())
             if math.isfinite(values[0]):
                 n_spans = len(self.spans)
                 return values[0], values[1], values[2 : 2 + n_spans], values[2 + n_spans :]

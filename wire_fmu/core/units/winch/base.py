@@ -135,6 +135,7 @@ class _WinchBase:
             Inputs held from now on.
         """
         self.inputs = inputs
+        self._step_summary = None  # outputs a compiled step computed are for other inputs
         if self.config.has_brake:
             self._caps = np.array([self.brake.capacities(inputs.lever_force)])
         else:

@@ -13,7 +13,11 @@ import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, KernelModel
+from wire_fmu.core.framework.compiled_step import (
+    COMPILED_METHODS,
+    CompiledFixedStep,
+    KernelModel,
+)
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
@@ -59,6 +63,7 @@ class WinchModel(KernelModel, _WinchBase):
         self.engaged = False
         self.state = np.zeros(2 * self.n + 2)
         self._held_angle = 0.0
+        self._step_summary: tuple[np.ndarray, np.ndarray] | None = None  # (x, its summary)
         self._n_brake_guards = 2 if config.has_brake else 0
         self._guard_dirs = -np.ones(self._n_brake_guards + 2 * int(self.drum.layered))
         self.settings = solver
@@ -399,11 +404,64 @@ class WinchModel(KernelModel, _WinchBase):
         """
         self.last_events = []
         self.set_inputs(inputs)
+        kept = self._kept_brake_mode()
+        if kept is not None and self._quiet_step(t, h, *kept):
+            return self._quiet_events
         self.state = self._settle_modes(t, self.state)
         x, events = self.solver.advance(self, t, self.state, t + h)
         self.state = x
         self._forces(x)
         return events
+
+    def _kept_brake_mode(self) -> tuple[bool, bool] | None:
+        """How :func:`kernel.quiet_step` may keep the brake's mode, or None if it may not.
+
+        ``(check_stick, hold_angle)``: without a brake nothing to keep; a brake
+        released without capacity, or engaged and sliding, keeps its mode; one
+        that holds the drum keeps it while it can (the kernel checks); anything
+        else is settled by :meth:`_settle_modes`, in Python.
+        """
+        if not (self.compiled and isinstance(self.solver, CompiledFixedStep)):
+            return None
+        if not self.config.has_brake:
+            return False, False
+        if min(self.capacities) <= 0.0:
+            return None if self.engaged else (False, True)
+        if not self.engaged:
+            return None
+        return self.friction.mode[0] == 0, True
+
+    def _quiet_step(self, t: float, h: float, check_stick: bool, hold_angle: bool) -> bool:
+        """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's."""
+        solver = self.solver
+        t1 = t + h
+        status, x, t_hit, k, fired, steps, calls, h_last, values = kernel.quiet_step(
+            solver.method,
+            t,
+            t1,
+            solver.internal_count(t, t1),
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            self.kernel_data(),
+            check_stick,
+            hold_angle,
+        )
+        if status == kernel.STATUS_PYTHON:
+            return False
+        if hold_angle:
+            self._held_angle = float(self.state[self.n - 1])
+        if status == kernel.STATUS_DONE:
+            solver.steps += steps
+            solver.rhs_calls += calls
+            self._quiet_events = 0
+            self._step_summary = (x, values)
+        else:
+            first = (status, x, t_hit, k, fired, steps, calls, h_last)
+            x, self._quiet_events = solver.advance(self, t, self.state, t1, first)
+        self.state = x
+        self._forces(x)
+        return True
 
     # ---------------------------------------------------------- outputs
     def stored_energy(self, x: np.ndarray | None = None) -> float:
@@ -427,7 +485,11 @@ class WinchModel(KernelModel, _WinchBase):
         x = self.state
         n = self.n
         if self.compiled:
-            brake, stored = kernel.summary(x, self.kernel_data()).tolist()
+            done = self._step_summary
+            values = done[1] if done is not None and done[0] is x else None
+            if values is None:
+                values = kernel.summary(x, self.kernel_data())
+            brake, stored = values.tolist()
         else:
             brake, stored = float(self._dynamics(x)[1][0]) if self.engaged else 0.0, None
         w, k = float(x[2 * n - 1]), self.layer

@@ -25,9 +25,22 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import advance_to_event
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, advance_to_event
 
-__all__ = ["HELD", "advance", "guards", "kernel_data", "project", "rhs", "summary"]
+__all__ = [
+    "HELD",
+    "STATUS_PYTHON",
+    "advance",
+    "guards",
+    "kernel_data",
+    "project",
+    "quiet_step",
+    "rhs",
+    "summary",
+]
+
+STATUS_PYTHON = 3
+""":func:`quiet_step` left the step to Python (the held brake slips under the new inputs)."""
 
 HELD = (
     "motor torque at zero speed reduced to the drum shaft (N m)",
@@ -44,6 +57,7 @@ HELD = (
     "drum angle the brake holds (rad)",
 )
 """What the ``held`` array holds, in order: inputs and the present layer's constants."""
+_HELD_ANGLE = len(HELD) - 1
 
 
 def kernel_data(model) -> tuple:
@@ -242,3 +256,54 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
     return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+
+
+@jit
+def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle):
+    """A whole communication step in one call, when the new inputs switch no brake mode.
+
+    What :meth:`WinchModel.advance <wire_fmu.core.units.winch.drive.WinchModel.advance>`
+    does once its inputs are set, in the same order and with the same arithmetic: the
+    brake's mode kept (a held drum keeps its angle and rests), the loop of
+    :func:`advance` to the end of the step or its first event, the :func:`summary` at
+    the end. It changes nothing it was given.
+
+    Parameters
+    ----------
+    method, t0, t1, n, tol, directions
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them
+        (the loop starts at ``t0``, interval 0).
+    x : numpy.ndarray
+        State at ``t0``.
+    data : tuple
+        See the module docstring, for the new inputs.
+    check_stick : bool
+        The brake holds the drum: leave the step to Python if it cannot hold any more.
+    hold_angle : bool
+        The brake is in the mode it keeps: a held drum stays at the angle it has now.
+
+    Returns
+    -------
+    tuple
+        The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)`` and the
+        :func:`summary` at the end (empty unless the status is ``STATUS_DONE``); the
+        status is :data:`STATUS_PYTHON`, and nothing else meaningful, when Python must
+        settle the brake first.
+    """
+    no_summary = np.zeros(0)
+    if check_stick and guards(t0, x, data)[0] < 0.0:
+        no_fire = np.zeros(directions.size, dtype=np.bool_)
+        return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
+    x = x.copy()
+    if hold_angle:
+        modes, inertia, stiffness, damping, held = data
+        held = held.copy()
+        held[_HELD_ANGLE] = x[inertia.size - 1]
+        data = (modes, inertia, stiffness, damping, held)
+        x = project(x, data)
+    status, x, t, k, fired, steps, calls, h = advance_to_event(
+        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
+    )
+    if status == STATUS_DONE:
+        return status, x, t, k, fired, steps, calls, h, summary(x, data)
+    return status, x, t, k, fired, steps, calls, h, no_summary
