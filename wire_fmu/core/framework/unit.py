@@ -194,10 +194,10 @@ class Unit(ABC):
         step : float
             Its length, s.
         """
-        who = f"{self.who} at t = {time:.6g} s"
         bad = self.input_problems()
         if bad:
-            return StepResult(False, f"{who}: step refused: " + "; ".join(bad))
+            refused = f"{self.who} at t = {time:.6g} s: step refused: "
+            return StepResult(False, refused + "; ".join(bad))
         saved = self._snapshot()
         try:
             events = self._advance(time, step)
@@ -205,7 +205,9 @@ class Unit(ABC):
             self._update_outputs()
         except STEP_ERRORS as err:
             self._restore_snapshot(saved)
-            return StepResult(False, f"{who}: step of {step:.3g} s refused: {err}")
+            return StepResult(
+                False, f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
+            )
         return StepResult(True, events=tuple(events))
 
     def timed_advance(self, time: float, step: float) -> StepResult:

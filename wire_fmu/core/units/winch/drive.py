@@ -562,6 +562,34 @@ class WinchModel(KernelModel, _WinchBase):
             "solver": {"rhs_calls": int(self.solver.rhs_calls), "steps": int(self.solver.steps)},
         }
 
+    def snapshot(self) -> tuple:
+        """What undoing a step needs, kept in this process (cheaper than :meth:`get_state`)."""
+        return (
+            self.state,  # never changed in place: every step makes a new array
+            self.layer,
+            self.engaged,
+            self.friction.get_mode(),
+            self._held_angle,
+            self.mode_changes,
+            self.inputs,
+            self.solver.rhs_calls,
+            self.solver.steps,
+        )
+
+    def restore(self, saved: tuple) -> None:
+        """Undo to what :meth:`snapshot` kept.
+
+        Parameters
+        ----------
+        saved : tuple
+            A snapshot of this model.
+        """
+        (self.state, self.layer, self.engaged, mode, self._held_angle, self.mode_changes,
+         inputs, self.solver.rhs_calls, self.solver.steps) = saved  # fmt: skip
+        self.friction.set_mode(mode)
+        self.set_inputs(inputs)
+        self._forces(self.state)
+
     def set_state(self, data: dict) -> None:
         """Restore a state from :meth:`get_state`.
 

@@ -151,6 +151,23 @@ class WinchUnit(HeldInputsUnit):
             "initial_energy": float(self.initial_energy),
         }
 
+    def _snapshot(self) -> Any:
+        """The model's own snapshot where it has one (the winch with drum inertia)."""
+        model = self._require_model()
+        if isinstance(model, WinchModel):
+            return model.snapshot(), self.time
+        return super()._snapshot()
+
+    def _restore_snapshot(self, saved: Any) -> None:
+        """Implements :meth:`Unit._restore_snapshot`."""
+        model = self._require_model()
+        if isinstance(model, WinchModel):
+            kept, self.time = saved
+            model.restore(kept)
+            self._update_outputs()
+        else:
+            super()._restore_snapshot(saved)
+
     def set_state(self, state: Mapping[str, Any]) -> None:
         """Restore a state from :meth:`get_state`.
 
