@@ -206,6 +206,9 @@ class CoreFacade(Fmi2Slave):
         self._reconfigure = False
         self._inputs_changed = False
         self._initial_outputs_stale = True
+        self._core_reals: dict[int, Variable] = {}  # value reference -> declared Real
+        self._read_plans: dict[tuple[int, ...], tuple[tuple[str, ...], bool] | None] = {}
+        self._write_plans: dict[tuple[int, ...], tuple[str, ...] | None] = {}
         for var in unit_class.variables():
             self._register(var)
         self._register_timing()
@@ -243,6 +246,8 @@ class CoreFacade(Fmi2Slave):
         )
         # nested=False: dotted names are plain keys of unit.values.
         self.register_variable(scalar, nested=False)
+        if var.type is float:
+            self._core_reals[scalar.value_reference] = var
 
     def _register_timing(self) -> None:
         # the unit base's timing hook, readable by any master (studies time the physics)
@@ -324,11 +329,85 @@ class CoreFacade(Fmi2Slave):
             self._reconfigure = True
 
     # The FMU binary's variable access, each failure logged (fmi2GetReal ... fmi2SetString).
-    get_real = _fmi_access("fmi2GetReal", Fmi2Slave.get_real)
+    # Reals, read and set every step, take a plan worked out once per list of references.
+    _get_reals = _fmi_access("fmi2GetReal", Fmi2Slave.get_real)
     get_integer = _fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
     get_boolean = _fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
     get_string = _fmi_access("fmi2GetString", Fmi2Slave.get_string)
-    set_real = _fmi_access("fmi2SetReal", Fmi2Slave.set_real)
+    _set_reals = _fmi_access("fmi2SetReal", Fmi2Slave.set_real)
+
+    def get_real(self, vrs: list[int]) -> list[float]:
+        """fmi2GetReal: the values of ``vrs``, in their declared units.
+
+        While stepping, references read before are answered from a plan (their
+        names, and whether any depends on inputs); everything else, and every
+        failure, goes through :meth:`pythonfmu.Fmi2Slave.get_real` and the
+        per-variable checks (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        """
+        key = tuple(vrs)
+        plan = self._read_plans.get(key, False)
+        if plan is False:
+            plan = self._read_plans[key] = self._read_plan(key)
+        if plan is not None and self._phase is Phase.step:
+            names, feedthrough = plan
+            if not (feedthrough and self._inputs_changed):
+                values = self.unit.values
+                return [float(values[name]) for name in names]
+        return self._get_reals(vrs)
+
+    def _read_plan(self, vrs: tuple[int, ...]) -> tuple[tuple[str, ...], bool] | None:
+        # None: not all declared Reals of the unit (the generic path answers, or refuses)
+        found = [self._core_reals.get(vr) for vr in vrs]
+        if not all(found):
+            return None
+        feedthrough = any(v.causality is Causality.output and v.depends_on for v in found)
+        return tuple(v.name for v in found), feedthrough
+
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        """fmi2SetReal: set ``vrs`` to ``values``, in their declared units.
+
+        While stepping, a list of finite values for inputs only, set before, is
+        written at once; everything else goes through
+        :meth:`pythonfmu.Fmi2Slave.set_real` and the per-variable checks
+        (failures logged).
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        values : list of float
+            A value for each.
+        """
+        key = tuple(vrs)
+        names = self._write_plans.get(key, False)
+        if names is False:
+            names = self._write_plans[key] = self._write_plan(key)
+        if (
+            names is not None
+            and self._phase is Phase.step
+            and len(values) == len(names)
+            and all(map(math.isfinite, values))
+        ):
+            held = self.unit.values
+            for name, value in zip(names, values, strict=True):
+                held[name] = float(value)
+            self._initial_outputs_stale = True
+            self._inputs_changed = True
+            return
+        self._set_reals(vrs, values)
+
+    def _write_plan(self, vrs: tuple[int, ...]) -> tuple[str, ...] | None:
+        # None: not all inputs of the unit (the generic path sets them, or refuses)
+        found = [self._core_reals.get(vr) for vr in vrs]
+        if not all(v is not None and v.causality is Causality.input for v in found):
+            return None
+        return tuple(v.name for v in found)
+
     set_integer = _fmi_access("fmi2SetInteger", Fmi2Slave.set_integer)
     set_boolean = _fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean)
     set_string = _fmi_access("fmi2SetString", Fmi2Slave.set_string)
