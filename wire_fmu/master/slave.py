@@ -36,6 +36,9 @@ from fmpy.fmi2 import (
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    fmi2Integer,
+    fmi2Real,
+    fmi2ValueReference,
 )
 from fmpy.logging import addLoggerProxy
 
@@ -47,6 +50,8 @@ logger = logging.getLogger(__name__)
 
 FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
 _GETTERS = {kind: f"get{kind}" for kind in ("Real", "Integer", "Boolean", "String")}
+_C_TYPES = {"Real": fmi2Real, "Integer": fmi2Integer}
+"""FMI types read every step into C arrays made once per list of value references."""
 _clock = time.perf_counter
 _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
@@ -122,6 +127,7 @@ class Slave:
         self.seconds: dict[str, float] = defaultdict(float)
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
+        self._c_arrays: dict[tuple[str, tuple[int, ...]], tuple[Any, Any, int]] = {}
         self._fatal = False
         self._unzipdir: str | None = None
 
@@ -338,7 +344,17 @@ class Slave:
         """
         if not refs:
             return []
-        return self._call(_GETTERS.get(kind) or f"get{kind}", _listed(refs))
+        fmu, ctype = self._fmu, _C_TYPES.get(kind)
+        if fmu is None or ctype is None:
+            return self._call(_GETTERS.get(kind) or f"get{kind}", _listed(refs))
+        key = (kind, refs if type(refs) is tuple else tuple(refs))
+        arrays = self._c_arrays.get(key)
+        if arrays is None:  # the references and the answer's place, made once
+            n = len(refs)
+            arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), (ctype * n)(), n)
+        vrs, values, n = arrays
+        self._invoke(_GETTERS[kind], getattr(fmu, f"fmi2Get{kind}"), fmu.component, vrs, n, values)
+        return list(values)
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
         """Fast path: set Reals by value reference.
@@ -350,8 +366,18 @@ class Slave:
         values : sequence of float
             A value for each, in the variable's unit.
         """
-        if refs:
-            self._call("setReal", _listed(refs), _listed(values))
+        fmu = self._fmu
+        if not refs or fmu is None:
+            if refs:
+                self._call("setReal", _listed(refs), _listed(values))
+            return
+        key = ("Real", refs if type(refs) is tuple else tuple(refs))
+        arrays = self._c_arrays.get(key)
+        if arrays is None:
+            n = len(refs)
+            arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), None, n)
+        vrs, _, n = arrays
+        self._invoke("setReal", fmu.fmi2SetReal, fmu.component, vrs, n, (fmi2Real * n)(*values))
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:
         """Fast path: get Reals by value reference.
@@ -453,7 +479,10 @@ class Slave:
         fmu = self._fmu
         if fmu is None:
             raise UnitFailedError(f"unit {self.name!r} is not instantiated", self.name)
-        method = getattr(fmu, fn)
+        return self._invoke(fn, getattr(fmu, fn), *args, **kwargs)
+
+    def _invoke(self, fn: str, method, *args, **kwargs):
+        """``method(*args, **kwargs)``, an FMI call counted and timed as ``fn``."""
         start = _clock()
         try:
             return method(*args, **kwargs)
