@@ -136,16 +136,23 @@ def test_hard_cases_agree(fmus, tmp_path, monkeypatch, case):
 
 
 def test_block_train_runs_the_compiled_kernel_only_where_it_applies(monkeypatch):
-    """Fixed geometry without friction links compiles; moving geometry and bearing friction
-    run the Python kernel; ``WIRE_FMU_KERNEL=python`` turns compiling off."""
-    from wire_fmu.core.units.block_train.reevings import single_fall
+    """Fixed geometry and planar moving geometry without friction links compile; moving
+    spatial geometry, bearing friction and rope slip run the Python kernel;
+    ``WIRE_FMU_KERNEL=python`` turns compiling off."""
+    from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
 
     reeving = single_fall(mass=1000.0, length=10.0)
+    sheaves = drilling_block_train(2)
     monkeypatch.setenv(KERNEL_ENV, "compiled")
     assert make_unit(reeving, "rope_damping").model.compiled
-    assert not make_unit(reeving, "moving_geometry").model.compiled
+    assert make_unit(reeving, "moving_geometry").model.compiled
+    assert make_unit(sheaves, "sheave_inertia,moving_geometry").model.compiled
+    assert not make_unit(reeving, "moving_geometry,spatial_geometry").model.compiled
+    assert not make_unit(sheaves, "sheave_inertia,bearing_friction").model.compiled
+    assert not make_unit(sheaves, "sheave_inertia,rope_slip").model.compiled
     monkeypatch.setenv(KERNEL_ENV, "python")
     assert not make_unit(reeving, "rope_damping").model.compiled
+    assert not make_unit(reeving, "moving_geometry").model.compiled
 
 
 def test_a_misspelt_kernel_choice_is_a_clear_error(monkeypatch):

@@ -2,16 +2,19 @@
 
 The same physics as :meth:`BlockTrainModel.evaluate
 <wire_fmu.core.units.block_train.model.BlockTrainModel.evaluate>` (the readable
-numpy reference), for block trains whose segment lengths are linear in the body
-motion (no ``moving_geometry``) and that have no friction links (no
-``bearing_friction``, no ``rope_slip``); other block trains run the Python
-kernel. Everything a step needs is in one tuple of arrays, built by
+numpy reference), for block trains without friction links (no
+``bearing_friction``, no ``rope_slip``) whose segment lengths are either linear in
+the body motion (no ``moving_geometry``) or follow the planar tangent geometry
+(``moving_geometry`` without ``spatial_geometry``); other block trains run the
+Python kernel. Everything a step needs is in one tuple of arrays, built by
 :func:`kernel_data`:
 
 =====  ==================  ==================================================
 index  name                contents
 =====  ==================  ==================================================
-0      ``sizes``           int: coordinates ``n``, blocks ``nb``, driven bodies
+0      ``sizes``           int: coordinates ``n``, blocks ``nb``, driven bodies,
+                           moving geometry (1: lengths from :func:`span_geometry`,
+                           0: linear in the body motion)
 1      ``rope``            float: ``EA`` (N), damping ``c`` (N s), breaking load (N)
 2      ``masses``          per coordinate, kg
 3      ``span_length0``    geometric span lengths with every body at 0, m
@@ -26,7 +29,27 @@ index  name                contents
 11     ``held``            time the inputs hold from (s), line rope positions
                            ``s`` (m) and rates (m/s), mover positions (m) and
                            velocities (m/s)
+12     ``path_nodes``      moving geometry, per path node: plane coordinates
+                           ``x``, ``z`` of its centre with every body at 0 (m),
+                           signed radius ``sense * r`` (m); else empty
+13     ``carriers``        int, per path node: the bodies (index into ``y``)
+                           that carry it, in the order their motions are
+                           summed, padded with -1
+14     ``body_dirs``       per body: its direction in plane coordinates, 1
+15     ``segment_span``    int, per segment: the span it belongs to
+16     ``geometry_step``   float: the central-difference step of the lengths
+                           with respect to the body motion, m
 =====  ==================  ==================================================
+
+With moving geometry, :func:`segment_lengths` is
+:meth:`ReevedPath._planar_segment_lengths
+<wire_fmu.core.units.block_train.path.ReevedPath._planar_segment_lengths>` (the
+closed form of :func:`~wire_fmu.core.components.sheave_geometry.planar_path.planar_path_lengths`)
+and :func:`span_geometry` is :meth:`BlockTrainModel.span_lengths
+<wire_fmu.core.units.block_train.model.BlockTrainModel.span_lengths>`, operation
+for operation: the central differences of the lengths amplify any rounding by
+``L / (2 h)``, so the two kernels agree only if each segment length is computed
+with the same operations in the same order.
 
 The guards are in the order of :meth:`ModeSwitching.guards
 <wire_fmu.core.units.block_train.modes.ModeSwitching.guards>` (friction links
@@ -51,12 +74,16 @@ __all__ = [
     "project",
     "quiet_step",
     "rhs",
+    "segment_lengths",
+    "span_geometry",
     "summary",
 ]
 
 N_LINES = 2
 STATUS_PYTHON = 3
 """:func:`quiet_step` left the step to Python (a mode to settle first, or no rope left)."""
+_POS_TOL = 1e-9  # m: tangent existence, as ``sheave_geometry.circles._POS_TOL``
+_TWO_PI = 2.0 * math.pi
 
 
 def kernel_data(model) -> tuple:
@@ -80,6 +107,11 @@ def kernel_data(model) -> tuple:
         model.broken_mask,
         model.contact_mask,
         model.held_vector,
+        model.kernel_path_nodes,
+        model.kernel_carriers,
+        model.kernel_body_dirs,
+        model.kernel_segment_span,
+        model.kernel_geometry_step,
     )
 
 
@@ -104,6 +136,138 @@ def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
 
 
 @jit
+def _wrap_2pi(angle: float) -> float:
+    """Map an angle from atan2 into [0, 2 pi), rad (as ``sheave_geometry.circles``)."""
+    if angle < 0.0:
+        angle += _TWO_PI
+    return 0.0 if angle >= _TWO_PI else angle
+
+
+@jit
+def segment_lengths(y: np.ndarray, path_nodes, carriers, body_dirs):
+    """Segment lengths of a planar path, straight part plus half of each adjoining arc.
+
+    :meth:`ReevedPath._planar_segment_lengths
+    <wire_fmu.core.units.block_train.path.ReevedPath._planar_segment_lengths>` with
+    the same operations in the same order.
+
+    Parameters
+    ----------
+    y : numpy.ndarray
+        Body displacements along their directions, m: the blocks, then the driven bodies.
+    path_nodes, carriers, body_dirs : numpy.ndarray
+        See the module docstring (indices 12-14).
+
+    Returns
+    -------
+    lengths : numpy.ndarray
+        Length of each segment, m.
+    ok : bool
+        False when a segment has no tangent (circles overlap, or a point lies inside
+        a sheave); the lengths are then meaningless.
+    """
+    n_nodes = path_nodes.shape[0]
+    xs = np.empty(n_nodes)
+    zs = np.empty(n_nodes)
+    for k in range(n_nodes):
+        shift_x = 0.0
+        shift_z = 0.0
+        for c in range(carriers.shape[1]):
+            b = carriers[k, c]
+            if b < 0:
+                break
+            shift_x += y[b] * body_dirs[b, 0]
+            shift_z += y[b] * body_dirs[b, 1]
+        xs[k] = path_nodes[k, 0] + shift_x
+        zs[k] = path_nodes[k, 1] + shift_z
+    n_seg = n_nodes - 1
+    seg = np.empty(n_seg)
+    dir_x = np.empty(n_seg)
+    dir_z = np.empty(n_seg)
+    for i in range(n_seg):
+        dx = xs[i + 1] - xs[i]
+        dy = zs[i + 1] - zs[i]
+        k = path_nodes[i + 1, 2] - path_nodes[i, 2]
+        l2 = dx * dx + dy * dy
+        if math.sqrt(l2) - abs(k) <= _POS_TOL:
+            return seg, False
+        lt = math.sqrt(l2 - k * k)
+        seg[i] = lt
+        dir_x[i] = (lt * dx + k * dy) / l2
+        dir_z[i] = (lt * dy - k * dx) / l2
+    half_arcs = np.empty(max(n_nodes - 2, 0))
+    for j in range(1, n_nodes - 1):
+        ax, ay, bx, by = dir_x[j - 1], dir_z[j - 1], dir_x[j], dir_z[j]
+        cr = ax * by - ay * bx
+        dt = ax * bx + ay * by
+        rho = path_nodes[j, 2]
+        if rho == 0.0:
+            wrap = abs(math.atan2(cr, dt))
+        else:
+            wrap = _wrap_2pi(math.atan2(cr if rho > 0.0 else -cr, dt))
+        half_arcs[j - 1] = 0.5 * abs(rho) * wrap
+    for i in range(n_seg - 1):
+        seg[i] += half_arcs[i]
+    for i in range(n_seg - 1):
+        seg[i + 1] += half_arcs[i]
+    return seg, True
+
+
+@jit
+def span_geometry(y: np.ndarray, data):
+    """Geometric span lengths (m) and their Jacobian w.r.t. body motion, moving geometry.
+
+    :meth:`BlockTrainModel.span_lengths
+    <wire_fmu.core.units.block_train.model.BlockTrainModel.span_lengths>`: central
+    differences of :func:`segment_lengths` with the step ``data[16][0]``, then the
+    segments summed into their spans.
+
+    Parameters
+    ----------
+    y : numpy.ndarray
+        Body displacements along their directions, m: the blocks, then the driven bodies.
+    data : tuple
+        See the module docstring.
+
+    Returns
+    -------
+    lengths : numpy.ndarray
+        Length of each span, m.
+    jacobian : numpy.ndarray
+        ``d lengths / d y``, one row per span and one column per body, 1.
+    ok : bool
+        False when a segment has no tangent at ``y`` or at a differencing point.
+    """
+    path_nodes, carriers, body_dirs, segment_span = data[12], data[13], data[14], data[15]
+    h = data[16][0]
+    n_spans = data[3].size
+    n_bodies = y.size
+    seg, ok = segment_lengths(y, path_nodes, carriers, body_dirs)
+    n_seg = seg.size
+    jac = np.zeros((n_seg, n_bodies))
+    y_plus = np.empty(n_bodies)
+    y_minus = np.empty(n_bodies)
+    for b in range(n_bodies):
+        for j in range(n_bodies):
+            step = h if j == b else 0.0
+            y_plus[j] = y[j] + step
+            y_minus[j] = y[j] - step
+        plus, ok_plus = segment_lengths(y_plus, path_nodes, carriers, body_dirs)
+        minus, ok_minus = segment_lengths(y_minus, path_nodes, carriers, body_dirs)
+        ok = ok and ok_plus and ok_minus
+        for i in range(n_seg):
+            jac[i, b] = (plus[i] - minus[i]) / (2.0 * h)
+    lengths = np.zeros(n_spans)
+    span_jac = np.zeros((n_spans, n_bodies))
+    for i in range(n_seg):
+        span = segment_span[i]
+        lengths[span] += seg[i]
+        for b in range(n_bodies):
+            span_jac[span, b] += jac[i, b]
+    return lengths, span_jac, ok
+
+
+@jit
 def evaluate(t: float, x: np.ndarray, data):
     """Forces, tensions, energies and guard inputs at ``(t, x)``.
 
@@ -123,9 +287,10 @@ def evaluate(t: float, x: np.ndarray, data):
         ``elastic`` tension (N), ``stretch`` (m), ``line_force`` (N), ``body_force`` (N),
         floor ``depth`` (m) and ``trial_contact`` (N), ``span_energy`` (J), ``potential``
         (J), ``loss`` (W), external ``power`` (W), and ``ok`` (False when a span has no
-        unstretched rope left).
+        unstretched rope left, or a segment no tangent).
     """
-    sizes, rope, masses, len0, jac, flow, blocks, offsets, taut, broken, contact, held = data
+    sizes, rope, masses, len0, jac0, flow, blocks = data[:7]
+    offsets, taut, broken, contact, held = data[7:12]
     n, nb, nd = sizes[0], sizes[1], sizes[2]
     ea, damping = rope[0], rope[1]
     n_spans = len0.size
@@ -148,11 +313,13 @@ def evaluate(t: float, x: np.ndarray, data):
     for i in range(N_LINES):
         flow_q[n + i] = held[1 + i] + line_rate[i] * dt
         flow_v[n + i] = line_rate[i]
-    big_l = len0 + _matvec(jac, y)
+    if sizes[3]:
+        big_l, jac, ok = span_geometry(y, data)
+    else:
+        big_l, jac, ok = len0 + _matvec(jac0, y), jac0, True
     big_l_rate = _matvec(jac, ydot)
     small_l = offsets + _matvec(flow, flow_q)
     small_l_rate = _matvec(flow, flow_v)
-    ok = True
     tension = np.zeros(n_spans)
     trial = np.empty(n_spans)
     elastic = np.empty(n_spans)
@@ -318,7 +485,8 @@ def summary(t: float, x: np.ndarray, data) -> np.ndarray:
     -------
     numpy.ndarray
         Rope strain energy (J), potential energy (J), span tensions (N), forces on the
-        bodies (N); the first entry is NaN when a span has no unstretched rope left.
+        bodies (N); the first entry is NaN when a span has no unstretched rope left
+        (or a segment no tangent).
     """
     result = evaluate(t, x, data)
     tension, body_force, energy = result[1], result[6], result[9]
@@ -385,8 +553,8 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)`` and the
         :func:`summary` at ``t1`` (empty unless the status is ``STATUS_DONE``). The
         status is :data:`STATUS_PYTHON`, and nothing else meaningful, when a span or
-        floor is in the wrong mode for the new inputs or a span has no unstretched
-        rope: Python then takes the step.
+        floor is in the wrong mode for the new inputs, a span has no unstretched
+        rope or a segment no tangent: Python then takes the step.
     """
     new = (
         data[0],
@@ -401,6 +569,11 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         data[9],
         data[10],
         held,
+        data[12],
+        data[13],
+        data[14],
+        data[15],
+        data[16],
     )
     no_fire = np.zeros(directions.size, dtype=np.bool_)
     no_summary = np.zeros(0)

@@ -147,14 +147,18 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
     def kernel_applies(self) -> bool:
         """Whether the compiled kernel covers this block train's effects.
 
-        It does without friction links and with lengths linear in the body motion
-        (see :mod:`~wire_fmu.core.units.block_train.kernel`).
+        It does without friction links, with lengths linear in the body motion or
+        recomputed by the planar path (``moving_geometry`` without
+        ``spatial_geometry``); see :mod:`~wire_fmu.core.units.block_train.kernel`.
         """
-        return not self.friction.links and not self.moving
+        return not self.friction.links and (not self.moving or self._planar is not None)
 
     def _build_kernel_arrays(self) -> None:
         """The parameters of :mod:`~wire_fmu.core.units.block_train.kernel` as flat arrays."""
-        self.kernel_sizes = np.array([self.n_coords, len(self.blocks), len(self.drivers)])
+        moving = int(self.moving and self._planar is not None)
+        self.kernel_sizes = np.array(
+            [self.n_coords, len(self.blocks), len(self.drivers), moving], dtype=np.int64
+        )
         self.kernel_rope = np.array(
             [self.rope.axial_stiffness, self.rope.damping, self.rope.breaking_load]
         )
@@ -164,6 +168,26 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             if b.floor is not None:
                 blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
         self.kernel_blocks = blocks
+        self._build_kernel_geometry(bool(moving))
+
+    def _build_kernel_geometry(self, moving: bool) -> None:
+        """The planar path of :meth:`_planar_segment_lengths` as flat arrays (empty if fixed)."""
+        segment_span = [self.span_of_segment[k] for k in range(self.n_segments)]
+        self.kernel_segment_span = np.array(segment_span, dtype=np.int64)
+        self.kernel_geometry_step = np.array([self.GEOMETRY_STEP])
+        if not moving:
+            self.kernel_path_nodes = np.zeros((0, 3))
+            self.kernel_carriers = np.zeros((0, 1), dtype=np.int64)
+            self.kernel_body_dirs = np.zeros((0, 2))
+            return
+        xy0, radii, dof_of_node, dirs, _ = self._planar
+        self.kernel_path_nodes = np.array([(x, z, r) for (x, z), r in zip(xy0, radii, strict=True)])
+        width = max(1, max(len(dofs) for dofs in dof_of_node))
+        carriers = np.full((self.n_nodes, width), -1, dtype=np.int64)
+        for k, dofs in enumerate(dof_of_node):
+            carriers[k, : len(dofs)] = dofs
+        self.kernel_carriers = carriers
+        self.kernel_body_dirs = np.array(dirs, dtype=float).reshape(len(self.body_dof), 2)
 
     # ------------------------------------------------------------------ build
     def _build_friction(self) -> None:
@@ -299,7 +323,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             ``d lengths / d y``, one row per span and one column per body, 1.
         """
         if not self.moving:
-            return self.span_length0 + self.span_jacobian @ y, self.span_jacobian
+            return self.span_length0 + _ordered_matvec(self.span_jacobian, y), self.span_jacobian
         lengths = self._planar_segment_lengths if self._planar else self._spatial_segment_lengths
         seg = lengths(y)
         jac = np.zeros((self.n_segments, len(y)))
@@ -308,7 +332,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             step = np.zeros(len(y))
             step[b] = h
             jac[:, b] = (lengths(y + step) - lengths(y - step)) / (2 * h)
-        return self.span_matrix @ seg, self.span_matrix @ jac
+        return _ordered_matvec(self.span_matrix, seg), _ordered_matmul(self.span_matrix, jac)
 
     def _spatial_segment_lengths(self, y: np.ndarray) -> np.ndarray:
         return self._segment_lengths(dict(zip(self.body_dof, y, strict=True)))[0]
@@ -344,7 +368,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         big_l, dl_dy = self.span_lengths(y)
         flow = np.concatenate((q, self._line_s0 + self._line_rate * dt))
         flow_rate = np.concatenate((v, self._line_rate))
-        small_l = self.offsets + self.flow_matrix @ flow
+        small_l = self.offsets + _ordered_matvec(self.flow_matrix, flow)
         if np.any(small_l <= 0.0):
             i = int(np.argmin(small_l))
             raise FloatingPointError(f"rope span {i} has no unstretched rope left")
@@ -353,16 +377,16 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             self.rope,
             big_l,
             small_l,
-            dl_dy @ ydot,
-            self.flow_matrix @ flow_rate,
+            _ordered_matvec(dl_dy, ydot),
+            _ordered_matvec(self.flow_matrix, flow_rate),
             self.taut_mask & intact,
         )
         tension = rf.tension * intact
         g_big = rf.force_on_length * intact
         g_small = rf.force_on_unstretched * intact
         span_energy = rf.energy * intact
-        body_force = -(g_big @ dl_dy)
-        generalised = g_small @ self.flow_matrix  # on [q, s_line_a, s_line_b]
+        body_force = -_ordered_vecmat(g_big, dl_dy)
+        generalised = _ordered_vecmat(g_small, self.flow_matrix)  # on [q, s_line_a, s_line_b]
         forces = generalised[:n].copy()
         forces[:nb] += body_force[:nb] + self.block_weight
         potential = -float(self.block_weight @ q[:nb])
@@ -628,6 +652,33 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         rope_energy, potential, _, _ = self.summary(t, self.state)
         kinetic = 0.5 * float(self.masses @ self.v**2)
         return kinetic + rope_energy + potential
+
+
+# The products below are summed term after term, as the compiled kernel sums them, not
+# in the blocked order of BLAS: the two kernels then agree to the last bit, which matters
+# because the solvers' finite-difference Jacobians turn a last-bit difference of the
+# right-hand side into a difference of 1e-9 of the Jacobian.
+
+
+def _ordered_matvec(a: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``a @ v``, summed over the columns in order."""
+    if a.shape[1] == 0:
+        return np.zeros(a.shape[0])
+    return np.cumsum(a * v, axis=1)[:, -1]
+
+
+def _ordered_vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """``v @ a``, summed over the rows in order."""
+    if a.shape[0] == 0:
+        return np.zeros(a.shape[1])
+    return np.cumsum(v[:, None] * a, axis=0)[-1]
+
+
+def _ordered_matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b``, summed over the inner index in order."""
+    if a.shape[1] == 0:
+        return np.zeros((a.shape[0], b.shape[1]))
+    return np.cumsum(a[:, :, None] * b[None, :, :], axis=1)[:, -1, :]
 
 
 def _floor_contact(floor, position: float, velocity: float):
