@@ -44,6 +44,7 @@ __all__ = [
     "STATUS_DONE",
     "STATUS_EVENT",
     "STATUS_NONFINITE",
+    "STATUS_PYTHON",
     "advance_to_event",
 ]
 
@@ -59,6 +60,8 @@ STATUS_EVENT = 1
 """The loop stopped just after the first guard crossing it located."""
 STATUS_NONFINITE = 2
 """A step gave a non-finite state; the loop returns the state it started that step from."""
+STATUS_PYTHON = 3
+"""A kernel's one-call ``quiet_step`` left the step to Python (a mode to settle first)."""
 
 
 @jit
@@ -312,6 +315,39 @@ class CompiledFixedStep(FixedStepSolver):
             if k >= n and self.method == COMPILED_METHODS["ros2"]:
                 self.rhs_calls += x.size + 1  # the Python solver's Jacobian after the last event
         return x, events
+
+    def finish_quiet_step(
+        self, system, t0: float, x0: np.ndarray, t1: float, result: tuple
+    ) -> tuple[np.ndarray, int, np.ndarray | None]:
+        """Book what a kernel's one-call ``quiet_step`` returned; go on from its event, if any.
+
+        Call it once the model holds the step's inputs and modes (the status is not
+        :data:`STATUS_PYTHON`).
+
+        Parameters
+        ----------
+        system : HybridSystem
+            The model, with its compiled kernel.
+        t0, t1 : float
+            The communication step, s.
+        x0 : numpy.ndarray
+            State at ``t0``.
+        result : tuple
+            ``quiet_step``'s answer: the loop's ``(status, x, t, k, fired, steps,
+            rhs_calls, h)`` and the values the outputs need at ``t1``.
+
+        Returns
+        -------
+        tuple
+            The state at ``t1``, the number of events and the outputs' values (None
+            after an event: the model computes them).
+        """
+        if result[0] == STATUS_DONE:
+            self.steps += result[5]
+            self.rhs_calls += result[6]
+            return result[1], 0, result[8]
+        x, events = self.advance(system, t0, x0, t1, result[:8])
+        return x, events, None
 
     def _explain_nonfinite(self, system, t: float, x: np.ndarray, h: float) -> None:
         """Re-take the failed step with the Python kernel, which raises the error it names."""

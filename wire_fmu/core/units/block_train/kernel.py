@@ -63,10 +63,9 @@ import math
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import STATUS_DONE, advance_to_event
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
 
 __all__ = [
-    "STATUS_PYTHON",
     "advance",
     "evaluate",
     "guards",
@@ -80,8 +79,6 @@ __all__ = [
 ]
 
 N_LINES = 2
-STATUS_PYTHON = 3
-""":func:`quiet_step` left the step to Python (a mode to settle first, or no rope left)."""
 _POS_TOL = 1e-9  # m: tangent existence, as ``sheave_geometry.circles._POS_TOL``
 _TWO_PI = 2.0 * math.pi
 

@@ -43,7 +43,11 @@ from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import CompiledFixedStep, KernelModel
+from wire_fmu.core.framework.compiled_step import (
+    STATUS_PYTHON,
+    CompiledFixedStep,
+    KernelModel,
+)
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.block_train import kernel
@@ -546,7 +550,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         solver = self.solver
         t1 = t + h
         n = solver.internal_count(t, t1)
-        status, x, t_hit, k, fired, steps, calls, h_last, values = kernel.quiet_step(
+        result = kernel.quiet_step(
             solver.method,
             t,
             t1,
@@ -557,17 +561,14 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             self.kernel_data(),
             held,
         )
-        if status == kernel.STATUS_PYTHON:
+        if result[0] == STATUS_PYTHON:
             return False
         self._hold(t, inputs, held)
-        if status == kernel.STATUS_DONE:
-            solver.steps += steps
-            solver.rhs_calls += calls
-            self.state, self._quiet_events = x, 0
-            self._step_summary = (t1, x, values)
-            return True
-        first = (status, x, t_hit, k, fired, steps, calls, h_last)
-        self.state, self._quiet_events = solver.advance(self, t, self.state, t1, first)
+        self.state, self._quiet_events, values = solver.finish_quiet_step(
+            self, t, self.state, t1, result
+        )
+        if values is not None:
+            self._step_summary = (t1, self.state, values)
         return True
 
     def _input_energy(self, t: float) -> float:

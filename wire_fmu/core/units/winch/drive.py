@@ -15,6 +15,7 @@ from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.framework.compiled import use_compiled
 from wire_fmu.core.framework.compiled_step import (
     COMPILED_METHODS,
+    STATUS_PYTHON,
     CompiledFixedStep,
     KernelModel,
 )
@@ -435,7 +436,7 @@ class WinchModel(KernelModel, _WinchBase):
         """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's."""
         solver = self.solver
         t1 = t + h
-        status, x, t_hit, k, fired, steps, calls, h_last, values = kernel.quiet_step(
+        result = kernel.quiet_step(
             solver.method,
             t,
             t1,
@@ -447,18 +448,13 @@ class WinchModel(KernelModel, _WinchBase):
             check_stick,
             hold_angle,
         )
-        if status == kernel.STATUS_PYTHON:
+        if result[0] == STATUS_PYTHON:
             return False
         if hold_angle:
             self._held_angle = float(self.state[self.n - 1])
-        if status == kernel.STATUS_DONE:
-            solver.steps += steps
-            solver.rhs_calls += calls
-            self._quiet_events = 0
+        x, self._quiet_events, values = solver.finish_quiet_step(self, t, self.state, t1, result)
+        if values is not None:
             self._step_summary = (x, values)
-        else:
-            first = (status, x, t_hit, k, fired, steps, calls, h_last)
-            x, self._quiet_events = solver.advance(self, t, self.state, t1, first)
         self.state = x
         self._forces(x)
         return True

@@ -25,11 +25,10 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import STATUS_DONE, advance_to_event
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
 
 __all__ = [
     "HELD",
-    "STATUS_PYTHON",
     "advance",
     "guards",
     "kernel_data",
@@ -39,8 +38,6 @@ __all__ = [
     "summary",
 ]
 
-STATUS_PYTHON = 3
-""":func:`quiet_step` left the step to Python (the held brake slips under the new inputs)."""
 
 HELD = (
     "motor torque at zero speed reduced to the drum shaft (N m)",
