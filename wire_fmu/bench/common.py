@@ -28,6 +28,8 @@ from pathlib import Path
 from wire_fmu.core.framework.compiled import KERNEL_ENV
 from wire_fmu.core.framework.unit import Unit
 
+from .tables import markdown_table
+
 __all__ = ["Case", "Row", "measure", "table", "ROOT", "run_cases", "command_line"]
 
 logger = logging.getLogger(__name__)
@@ -263,18 +265,32 @@ def table(rows: list[Row]) -> str:
     rows : list of Row
         One per case.
     """
-    lines = [
-        "| effects | states | Python kernel ms/step | compiled ms/step | ratio "
-        "| FMU ms/step | FMI overhead ms | share |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    for r in rows:
-        lines.append(
-            f"| {r.label} | {r.states} | {r.python_ms:.3f} | {r.core_ms:.3f} | "
-            f"{r.kernel_ratio:.1f} | {r.fmu_ms:.3f} | "
-            f"{r.overhead_ms:.3f} | {100 * r.overhead_share:.1f} % |"
-        )
-    return "\n".join(lines)
+    headings = (
+        "effects",
+        "states",
+        "Python kernel ms/step",
+        "compiled ms/step",
+        "ratio",
+        "FMU ms/step",
+        "FMI overhead ms",
+        "share",
+    )
+    return markdown_table(
+        headings,
+        (
+            (
+                r.label,
+                f"{r.states}",
+                f"{r.python_ms:.3f}",
+                f"{r.core_ms:.3f}",
+                f"{r.kernel_ratio:.1f}",
+                f"{r.fmu_ms:.3f}",
+                f"{r.overhead_ms:.3f}",
+                f"{100 * r.overhead_share:.1f} %",
+            )
+            for r in rows
+        ),
+    )
 
 
 def command_line(description: str, argv: list[str] | None) -> argparse.Namespace:

@@ -24,6 +24,8 @@ from pathlib import Path
 
 from wire_fmu.master.run import run_scene, shipped_scenes
 
+from .tables import markdown_table
+
 logger = logging.getLogger(__name__)
 
 
@@ -99,17 +101,32 @@ def table(rows: list[SceneFigures]) -> str:
     rows : list of SceneFigures
         One per scene.
     """
-    lines = [
-        "| scene | units | macro steps | simulated s | wall s | real-time factor | "
-        "master overhead per unit per step | set-up and clean-up |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    for r in rows:
-        lines.append(
-            f"| {r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
-            f"{r.real_time_factor:.3g} | {r.overhead_us:.1f} µs | {r.setup_ms:.0f} ms |"
-        )
-    return "\n".join(lines)
+    headings = (
+        "scene",
+        "units",
+        "macro steps",
+        "simulated s",
+        "wall s",
+        "real-time factor",
+        "master overhead per unit per step",
+        "set-up and clean-up",
+    )
+    return markdown_table(
+        headings,
+        (
+            (
+                r.scene,
+                f"{r.units}",
+                f"{r.steps}",
+                f"{r.simulated:g}",
+                f"{r.wall:.2f}",
+                f"{r.real_time_factor:.3g}",
+                f"{r.overhead_us:.1f} µs",
+                f"{r.setup_ms:.0f} ms",
+            )
+            for r in rows
+        ),
+    )
 
 
 def main(argv: list[str] | None = None) -> None:
