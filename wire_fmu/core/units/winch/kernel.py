@@ -164,12 +164,8 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
 
     Parameters
     ----------
-    t : float
-        Time, s.
-    x : numpy.ndarray
-        State (see the module docstring).
-    data : tuple
-        See the module docstring.
+    t, x, data
+        Time (s), state and kernel data, as :func:`rhs` takes them.
     """
     modes, inertia, _, _, held = data
     n = inertia.size
