@@ -1,35 +1,31 @@
 """The winch with drum inertia: a hybrid ODE of drum, drive train, motor and band brake.
 
 The equations, sign convention and energy ledger are in :mod:`wire_fmu.core.units.winch.model`.
+The brake's modes are in :mod:`~wire_fmu.core.units.winch.drive_brake_modes`, keeping
+and restoring the state in :mod:`~wire_fmu.core.units.winch.drive_snapshots`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import (
-    COMPILED_METHODS,
-    STATUS_PYTHON,
-    CompiledFixedStep,
-    KernelModel,
-)
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, STATUS_PYTHON, KernelModel
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
 from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
-from wire_fmu.core.units.winch.brake import _BRAKE_WORDS, BRAKE_FREE, BRAKE_HOLDING, BRAKE_SLIPPING
+from wire_fmu.core.units.winch.drive_brake_modes import DrumBrakeModes
+from wire_fmu.core.units.winch.drive_snapshots import DriveSnapshots
 
 __all__ = ["WinchModel"]
 
 
-class WinchModel(KernelModel, _WinchBase):
+class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
     """Winch with drum inertia: a hybrid ODE (:mod:`wire_fmu.core.units.winch.model`).
 
     State ``[theta_0..theta_{n-1}, omega_0..omega_{n-1}, dissipated,
@@ -297,55 +293,6 @@ class WinchModel(KernelModel, _WinchBase):
         """
         return work.speed, work.driving - work.angle
 
-    # ---------------------------------------------------------- modes
-    def brake_state(self) -> int:
-        """0 released, 1 slipping, 2 holding."""
-        if not self.engaged:
-            return BRAKE_FREE
-        return BRAKE_HOLDING if self.friction.mode[0] == 0 else BRAKE_SLIPPING
-
-    def _mode_key(self) -> tuple[bool, int]:
-        return self.engaged, int(self.friction.mode[0]) if self.friction.links else 0
-
-    def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
-        """Make the brake's engagement and stick/slip mode fit the inputs at (t, x)."""
-        if not self.config.has_brake:
-            return x
-        x = np.array(x, dtype=float)
-        if fired is None and self.compiled and self._brake_mode_holds(x):
-            self._held_angle = float(x[self.n - 1])
-            return self.project(x)
-        before = self._mode_key()
-        n = self.n
-        if min(self.capacities) <= 0.0:
-            self.engaged = False
-        else:
-            if not self.engaged:
-                self.friction.set_mode([int(np.sign(x[2 * n - 1]))])
-                self.engaged = True
-            forces = self._forces(x)
-            x[n : 2 * n] = self.friction.switch(x[n : 2 * n], forces, self._caps, fired or [])
-        if self._mode_key() != before or fired:
-            self._event(t, f"brake {_BRAKE_WORDS[self.brake_state()]}")
-            if fired is None:
-                self.mode_changes += 1
-        self._held_angle = float(x[n - 1])
-        return self.project(x)
-
-    def _brake_mode_holds(self, x: np.ndarray) -> bool:
-        """Whether the brake's present mode fits the inputs at ``x`` (nothing to settle).
-
-        Released and without capacity; or engaged with capacity, and sliding, or
-        stuck with a holding margin left (the compiled kernel's stick guard).
-        """
-        if min(self.capacities) <= 0.0:
-            return not self.engaged
-        if not self.engaged:
-            return False
-        if self.friction.mode[0] != 0:
-            return True
-        return bool(kernel.guards(0.0, x, self.kernel_data())[0] >= 0.0)
-
     # ---------------------------------------------------------- life cycle
     def initialize(self, t0: float, inputs: WinchInputs) -> None:
         """Start at the configured speed with the shafts already carrying their torques.
@@ -378,19 +325,6 @@ class WinchModel(KernelModel, _WinchBase):
         self.state = self._settle_modes(t0, x, [])
         self._forces(self.state)
 
-    def _rigid_acceleration(self, torque: float, inertia: float, omega: float) -> float:
-        """Acceleration of the chain locked rigid under ``torque`` (N m) and the brake."""
-        plus, minus = self.capacities
-        if not self.config.has_brake or min(plus, minus) <= 0.0:
-            return torque / inertia
-        if omega == 0.0:
-            if -minus <= torque <= plus:  # the brake can hold
-                return 0.0
-            direction = 1.0 if torque > 0.0 else -1.0
-        else:
-            direction = 1.0 if omega > 0.0 else -1.0
-        return (torque - direction * (plus if direction > 0 else minus)) / inertia
-
     def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
         """Advance by ``h`` with ``inputs`` held; return the number of events.
 
@@ -413,24 +347,6 @@ class WinchModel(KernelModel, _WinchBase):
         self.state = x
         self._forces(x)
         return events
-
-    def _kept_brake_mode(self) -> tuple[bool, bool] | None:
-        """How :func:`kernel.quiet_step` may keep the brake's mode, or None if it may not.
-
-        ``(check_stick, hold_angle)``: without a brake nothing to keep; a brake
-        released without capacity, or engaged and sliding, keeps its mode; one
-        that holds the drum keeps it while it can (the kernel checks); anything
-        else is settled by :meth:`_settle_modes`, in Python.
-        """
-        if not (self.compiled and isinstance(self.solver, CompiledFixedStep)):
-            return None
-        if not self.config.has_brake:
-            return False, False
-        if min(self.capacities) <= 0.0:
-            return None if self.engaged else (False, True)
-        if not self.engaged:
-            return None
-        return self.friction.mode[0] == 0, True
 
     def _quiet_step(self, t: float, h: float, check_stick: bool, hold_angle: bool) -> bool:
         """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's."""
@@ -507,100 +423,3 @@ class WinchModel(KernelModel, _WinchBase):
             dissipated_energy=float(x[2 * n]),
             external_work=float(x[2 * n + 1]),
         )
-
-    @contextmanager
-    def trial(self, inputs: WinchInputs) -> Iterator[None]:
-        """Modes settled for other inputs, undone on exit (for feedthrough outputs).
-
-        Parameters
-        ----------
-        inputs : WinchInputs
-            The inputs to read the outputs for.
-        """
-        saved = (
-            self.inputs,
-            self.engaged,
-            self.friction.get_mode(),
-            self.mode_changes,
-            list(self.last_events),
-            self._held_angle,
-            self.state.copy(),
-        )
-        try:
-            self.set_inputs(inputs)
-            self._settle_modes(0.0, self.state)
-            self.mode_changes = saved[3]  # a trial is not an event
-            yield
-        finally:
-            (
-                inputs_,
-                self.engaged,
-                mode,
-                self.mode_changes,
-                self.last_events,
-                self._held_angle,
-                self.state,
-            ) = saved
-            self.friction.set_mode(mode)
-            self.set_inputs(inputs_)
-            self._forces(self.state)
-
-    def get_state(self) -> dict:
-        """Complete model state as plain data."""
-        return {
-            "x": [float(c) for c in self.state],
-            "layer": int(self.layer),
-            "engaged": bool(self.engaged),
-            "friction_mode": self.friction.get_mode(),
-            "held_angle": float(self._held_angle),
-            "mode_changes": int(self.mode_changes),
-            "inputs": self.held_inputs(),
-            "solver": {"rhs_calls": int(self.solver.rhs_calls), "steps": int(self.solver.steps)},
-        }
-
-    def snapshot(self) -> tuple:
-        """What undoing a step needs, kept in this process (cheaper than :meth:`get_state`)."""
-        return (
-            self.state,  # never changed in place: every step makes a new array
-            self.layer,
-            self.engaged,
-            self.friction.get_mode(),
-            self._held_angle,
-            self.mode_changes,
-            self.inputs,
-            self.solver.rhs_calls,
-            self.solver.steps,
-        )
-
-    def restore(self, saved: tuple) -> None:
-        """Undo to what :meth:`snapshot` kept.
-
-        Parameters
-        ----------
-        saved : tuple
-            A snapshot of this model.
-        """
-        (self.state, self.layer, self.engaged, mode, self._held_angle, self.mode_changes,
-         inputs, self.solver.rhs_calls, self.solver.steps) = saved  # fmt: skip
-        self.friction.set_mode(mode)
-        self.set_inputs(inputs)
-        self._forces(self.state)
-
-    def set_state(self, data: dict) -> None:
-        """Restore a state from :meth:`get_state`.
-
-        Parameters
-        ----------
-        data : dict
-            A state from :meth:`get_state`.
-        """
-        self.state = np.array(data["x"], dtype=float)
-        self.layer = int(data["layer"])
-        self.engaged = bool(data["engaged"])
-        self.friction.set_mode(list(data["friction_mode"]))
-        self._held_angle = float(data["held_angle"])
-        self.mode_changes = int(data["mode_changes"])
-        self.restore_held_inputs(data["inputs"])
-        self.solver.rhs_calls = int(data["solver"]["rhs_calls"])
-        self.solver.steps = int(data["solver"]["steps"])
-        self._forces(self.state)
