@@ -28,53 +28,41 @@ connections, the ``mode_changes`` counter and, at the steps an observer
 records, the variables it watches (:meth:`Simulation.watch`). The value
 references are resolved once (:mod:`~wire_fmu.master.unit_io`).
 
-The energy residual of a bond over a step is computed in
-:mod:`~wire_fmu.master.bond_energy`; macro step sizes (nanosecond times, the
-step after a rejection, the adaptive controller) in
+The exchange with the units (the links, the batched sets and reads, the
+calls the coupling algorithms make) is in :mod:`~wire_fmu.master.exchange`;
+taking, judging and rolling back one macro step in
+:mod:`~wire_fmu.master.macro_step`. The energy residual of a bond over a step
+is computed in :mod:`~wire_fmu.master.bond_energy`; macro step sizes
+(nanosecond times, the step after a rejection, the adaptive controller) in
 :mod:`~wire_fmu.master.step_size`.
 """
 
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections import defaultdict
-from dataclasses import dataclass, field
 
 from .algorithms import make_algorithm, step_order
-from .bond_energy import BondKeys, step_energy
+from .bond_energy import BondKeys
 from .energy_guard import EnergyGuard, _remedies
-from .extrapolation import History, held_value
+from .exchange import MODE_OUTPUT, UnitExchange
 from .interrupts import _InterruptRequestedError, _Interrupts
+from .macro_step import MacroStep
 from .manipulators import DriverSet, ScheduledEvents
 from .run_result import RunResult, SimulationStoppedError
 from .scene import Scene
 from .slave import Slave, StepRefusedError, UnitFailedError
-from .step_size import _PI, _ns, new_h
-from .unit_io import EndValues, InputPlan, Link, ReadPlan, Watch, read_plan
+from .step_size import _ns
+from .unit_io import EndValues, InputPlan, ReadPlan, Watch
 from .validate import Structure, unit_start_values
 
 __all__ = ["Simulation"]
 
 logger = logging.getLogger(__name__)
 
-MODE_OUTPUT = "mode_changes"
 
-
-@dataclass
-class _Attempt:
-    """One try at a macro step."""
-
-    accepted: bool
-    residuals: dict[str, float]
-    sweeps: int
-    new: dict[str, float] = field(default_factory=dict)
-    retry_step: float = 0.0
-    message: str = ""
-
-
-class Simulation:
+class Simulation(UnitExchange, MacroStep):
     """A scene ready to run.
 
     Parameters
@@ -123,103 +111,6 @@ class Simulation:
         return {name: bond.created for name, bond in self.energy.bonds.items()}
 
     # -- structure -------------------------------------------------------------
-    def _build_links(self) -> None:
-        self.links_into: dict[str, list[Link]] = defaultdict(list)
-        self.source_keys: dict[str, list[str]] = defaultdict(list)
-        self.histories: dict[str, History] = {}
-        for c in self.scene.all_connections:
-            slave = self.slaves[c.target.unit]
-            scheme = c.extrapolation or self.run_settings.extrapolation
-            key = str(c.source)
-            history = self.histories.setdefault(key, History())
-            link = Link(c, key, slave.vr(c.target.variable), scheme, history)
-            self.links_into[c.target.unit].append(link)
-            if key not in self.source_keys[c.source.unit]:
-                self.source_keys[c.source.unit].append(key)
-        self.source_vrs = {
-            unit: [self.slaves[unit].vr(k.split(".", 1)[1]) for k in keys]
-            for unit, keys in self.source_keys.items()
-        }
-
-    def _build_plans(self) -> None:
-        """Each unit's batched set and end-of-step reads (after the observers' watches)."""
-        for name, slave in self.slaves.items():
-            links = tuple(self.links_into.get(name, ()))
-            driven = tuple(self.drivers.targets(name))
-            variables = [slave.variables.get(n) for n in driven]
-            reals = all(v is not None and v.type == "Real" for v in variables)
-            refs = [link.target_vr for link in links]
-            if reals:
-                refs += [v.valueReference for v in variables]
-            evented = name in self.events.units
-            self._inputs[name] = InputPlan(links, driven, refs, reals, evented)
-            sources = self.source_vrs.get(name, [])
-            mode = MODE_OUTPUT if name in self.mode_counts else None
-            self._reads[name] = (
-                read_plan(name, slave, sources, mode),
-                read_plan(name, slave, sources, mode, self._watches),
-            )
-
-    def watch(self, names: dict[str, list[str]], due) -> Watch:
-        """Read variables with the units' end-of-step reads at the steps ``due`` names.
-
-        For observers: call it in ``on_start``; the values of a step are then
-        read with what the master reads at the end of the step anyway.
-
-        Parameters
-        ----------
-        names : dict of str to list of str
-            Variable names by unit.
-        due : callable
-            ``due(t)``: whether the observer reads after the step that ends at
-            ``t`` (s).
-
-        Returns
-        -------
-        Watch
-            Its :meth:`~wire_fmu.master.unit_io.Watch.values` gives a unit's
-            variables now, from the end-of-step read when it has them.
-        """
-        watch = Watch(names, due)
-        self._watches.append(watch)
-        self._reads.clear()  # planned again before the next step
-        return watch
-
-    def watched_values(self, watch: Watch, unit: str) -> list:
-        """The current values of the variables ``watch`` names at ``unit``.
-
-        Parameters
-        ----------
-        watch : Watch
-            From :meth:`watch`.
-        unit : str
-            Instance name of the unit in the scene.
-
-        Returns
-        -------
-        list of object
-            Each value, in its unit, in the order the watch names them.
-        """
-        return watch.values(unit, self.slaves[unit], self._ends.get(unit))
-
-    def watched_snapshot(self, watch: Watch, unit: str) -> EndValues | list:
-        """:meth:`watched_values`, kept for later (:meth:`Watch.unpack <.unit_io.Watch.unpack>`).
-
-        Parameters
-        ----------
-        watch : Watch
-            From :meth:`watch`.
-        unit : str
-            Instance name of the unit in the scene.
-
-        Returns
-        -------
-        EndValues or list
-            The unit's end-of-step read when it holds the watched values, else
-            the values read now.
-        """
-        return watch.take(unit, self.slaves[unit], self._ends.get(unit))
-
     def _order(self, structure: Structure) -> list[str]:
         flows_to, feeds = defaultdict(set), defaultdict(set)
         for c in self.scene.all_connections:
@@ -256,285 +147,12 @@ class Simulation:
                 self.mode_counts[name] = int(slave.get([MODE_OUTPUT])[MODE_OUTPUT])
         self.time = start
 
-    def _set_connected_from_latest(self, unit: str) -> None:
-        self._ends.pop(unit, None)
-        refs, values = [], []
-        for link in self.links_into.get(unit, ()):
-            if self.histories[link.key].points:
-                refs.append(link.target_vr)
-                values.append(self.histories[link.key].latest)
-        self.slaves[unit].set_reals(refs, values)
-
-    def _push(self, unit: str, t: float) -> None:
-        for key, value in self.read_sources(unit).items():
-            self.histories[key].push(t, value)
-
-    # -- what algorithms call ------------------------------------------------------
-    def read_sources(self, unit: str) -> dict[str, float]:
-        """Current values of ``unit``'s outputs that feed connections.
-
-        Parameters
-        ----------
-        unit : str
-            Instance name of the unit in the scene.
-
-        Returns
-        -------
-        dict of str to float
-            Each output's value by its ``"unit.variable"`` name, in its unit.
-        """
-        end = self._ends.get(unit)
-        if end is not None:  # read once, just after the unit's step
-            return dict(end.sources)
-        keys = self.source_keys.get(unit, [])
-        return dict(
-            zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
-        )
-
-    def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
-        """Held values of every connected, driven or overridden input of ``unit``.
-
-        Parameters
-        ----------
-        unit : str
-            Instance name of the unit in the scene.
-        t, h : float
-            Start and length of the macro step, s.
-        fresh : dict or None
-            Source outputs (``"unit.variable"``) at ``t + h`` from the previous
-            sweep of an iterated step; None extrapolates from the past.
-        """
-        self._ends.pop(unit, None)
-        plan = self._inputs[unit]
-        if plan.idle:
-            return
-        held, values = self.held, []
-        for link in plan.links:
-            if link.position:
-                value = link.history.points[-1][1]  # the unit advances it with the held velocity
-            else:
-                value = held_value(
-                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
-                )
-            values.append(value)
-            held[link.target] = value
-        slave = self.slaves[unit]
-        by_name = None
-        if plan.driven:
-            driven = self.drivers.step_values(unit, t, h)
-            if not plan.driven_reals:
-                by_name = dict(zip(plan.driven, driven, strict=True))  # set by name, checked
-            elif all(type(v) is float for v in driven):
-                values += driven
-            else:  # checked as a set by name would, then sent as floats
-                slave.typed_values(dict(zip(plan.driven, driven, strict=True)))
-                values += [float(v) for v in driven]
-        refs, others = plan.refs, None
-        if by_name is not None:  # as the events' values override the drivers'
-            by_name.update(self.events.values(unit))
-        elif plan.evented:
-            refs, event_values, others = plan.event_inputs(slave, self.events)
-            values += event_values
-        slave.set_reals(refs, values)
-        if by_name:
-            slave.set_many(by_name)
-        if others:
-            slave.set_typed(others)
-
-    def step_unit(self, unit: str, t: float, h: float) -> None:
-        """Step one unit (errors propagate as StepRefusedError / UnitFailedError).
-
-        Parameters
-        ----------
-        unit : str
-            Instance name of the unit in the scene.
-        t, h : float
-            Start and length of the macro step, s.
-        """
-        self._ends.pop(unit, None)
-        slave = self.slaves[unit]
-        slave.do_step(t, h)
-        plain, watched = self._reads[unit]
-        plan = watched if self._watching else plain
-        self._ends[unit] = plan.read(slave, self.source_keys.get(unit, ()))
-
     def _fire_events(self, t: float) -> list[str]:
         fired = self.events.fire_due(t)
         if fired:  # inputs jump: nothing may be extrapolated across
             for history in self.histories.values():
                 history.reset()
         return fired
-
-    # -- one macro step -----------------------------------------------------------------
-    def _save(self):
-        return {name: s.get_state() for name, s in self.slaves.items()}
-
-    def _restore(self, states) -> None:
-        self._ends.clear()
-        for name, state in states.items():
-            self.slaves[name].set_state(state)
-
-    def _free(self, states) -> None:
-        for name, state in states.items():
-            self.slaves[name].free_state(state)
-
-    def _read_all(self) -> dict[str, float]:
-        new = {}
-        for unit in self.slaves:
-            end = self._ends.get(unit)
-            new.update(end.sources if end is not None else self.read_sources(unit))
-        return new
-
-    def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
-        self.algorithm.sweep(self, t, h)
-        new = self._read_all()
-        sweeps, changes = 1, []
-        for _ in range(self.run_settings.iterations - 1):
-            if not all(map(math.isfinite, new.values())):
-                return new, sweeps  # never handed on: the caller rejects the step
-            before = dict(self.held)
-            self._restore(states)
-            self.algorithm.sweep(self, t, h, fresh=new)
-            new = self._read_all()
-            sweeps += 1
-            changes.append(
-                max(
-                    (
-                        abs(self.held[k] - before.get(k, 0.0)) / max(1.0, abs(self.held[k]))
-                        for k in self.held
-                    ),
-                    default=0.0,
-                )
-            )
-            if changes[-1] < self.run_settings.iteration_tolerance:
-                return new, sweeps
-        if len(changes) >= 3 and changes[-1] > changes[0]:  # the fixed point runs away
-            raise SimulationStoppedError(
-                f"t = {t:.6g} s: the iteration over the step of {h:.3g} s diverges (input "
-                f"change {changes[0]:.3g} after the second sweep, {changes[-1]:.3g} after the "
-                f"last of {sweeps}): the coupling cannot be resolved at this step; use a "
-                "smaller step or adaptive steps"
-            )
-        return new, sweeps
-
-    def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
-        """Energy each bond's coupling created over the step just taken, J.
-
-        Parameters
-        ----------
-        new : dict of str to float
-            Source outputs (``"unit.variable"``) at the end of the step.
-        h : float
-            The step just taken, s.
-
-        Returns
-        -------
-        dict of str to float
-            The energy residual by bond name, J (positive: created).
-        """
-        out = {}
-        histories, held, power = self.histories, self.held, self.bond_power
-        for keys in self._bond_keys:
-            out[keys.name], power[keys.name] = step_energy(keys, histories, held, new, h)
-        return out
-
-    def _attempt(self, t: float, h: float) -> _Attempt:
-        """Take one macro step, rolling back when it is refused or rejected."""
-        if not self._reads:  # planned once, after the observers' watches
-            self._build_plans()
-        rollback = self.run_settings.iterations > 1 or self.run_settings.adaptive
-        states = self._save() if rollback else None
-        try:
-            if states is not None:
-                new, sweeps = self._sweep_iterated(t, h, states)
-            else:
-                self.algorithm.sweep(self, t, h)
-                new, sweeps = self._read_all(), 1
-        except StepRefusedError as exc:
-            if states is None:
-                raise SimulationStoppedError(str(exc)) from None
-            self._restore(states)
-            self._free(states)
-            return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
-        if not all(map(math.isfinite, new.values())):  # never accepted, never recorded
-            bad = ", ".join(
-                f"{key} = {value!r}" for key, value in new.items() if not math.isfinite(value)
-            )
-            message = f"t = {t:.6g} s: after the step of {h:.3g} s, {bad}"
-            if states is None:
-                raise SimulationStoppedError(
-                    f"{message}: not finite; the run stops here, "
-                    "everything before is kept; try a smaller step"
-                )
-            self._restore(states)
-            self._free(states)
-            return _Attempt(False, {}, sweeps, retry_step=new_h(h, 4.0), message=message)
-        residuals = self.bond_residuals(new, h)
-        if self.run_settings.adaptive:
-            error = max((abs(r) for r in residuals.values()), default=0.0)
-            error /= self.run_settings.energy_tolerance
-            if error > 1.0 and h > self.run_settings.min_step * (1 + 1e-9):
-                self._restore(states)
-                self._free(states)
-                return _Attempt(
-                    False,
-                    residuals,
-                    sweeps,
-                    retry_step=new_h(h, error),
-                    message=f"bond energy residual {error:.3g} x tolerance",
-                )
-            if error > 1.0:
-                self._free(states)
-                raise SimulationStoppedError(
-                    f"t = {t:.6g} s: the bonds' energy residual is {error:.3g} times "
-                    f"energy_tolerance even at the minimum step {h:.3g} s: the coupling "
-                    "cannot meet the tolerance; lower min_step or raise energy_tolerance"
-                )
-        if states is not None:
-            self._free(states)
-        return _Attempt(True, residuals, sweeps, new)
-
-    def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
-        histories, end = self.histories, t + h
-        for key, value in new.items():
-            histories[key].push(end, value)
-        switched = set()
-        for name, before in self.mode_counts.items():
-            now = self._mode_count(name)
-            if now != before:
-                switched.add(name)
-                self.mode_counts[name] = now
-                for key in self.source_keys.get(name, ()):
-                    histories[key].reset()
-        across = (
-            {
-                b.name
-                for b in self.scene.bonds
-                if b.effort.source.unit in switched or b.flow.source.unit in switched
-            }
-            if switched
-            else ()
-        )
-        self.energy.book(residuals, self.bond_power, h, across_events=across)
-        self.time = t + h
-
-    def _mode_count(self, unit: str) -> int:
-        """The unit's ``mode_changes`` output now (from its end-of-step read if valid)."""
-        end = self._ends.get(unit)
-        if end is not None and end.mode is not None:
-            return end.mode
-        return int(self.slaves[unit].get([MODE_OUTPUT])[MODE_OUTPUT])
-
-    def _next_step(self, h: float, residuals) -> float:
-        s = self.run_settings
-        if not s.adaptive:
-            return s.step
-        error = max((abs(r) for r in residuals.values()), default=0.0) / s.energy_tolerance
-        error = max(error, 1e-10)
-        factor = _PI["safety"] * error ** -_PI["k_i"] * (self._error_prev / error) ** _PI["k_p"]
-        self._error_prev = error
-        factor = min(_PI["grow"], max(_PI["shrink"], factor))
-        return min(s.max_step or math.inf, max(s.min_step, h * factor))
 
     # -- the run --------------------------------------------------------------------------
     def run(self) -> RunResult:

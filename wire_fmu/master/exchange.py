@@ -1,0 +1,245 @@
+"""What the master hands to its units and reads from them, unit by unit, each macro step.
+
+:class:`UnitExchange` is the part of
+:class:`~wire_fmu.master.simulation.Simulation` that builds the connections
+(the links into each unit and their extrapolation histories), plans each unit's
+one batched set of Real inputs and its end-of-step reads
+(:mod:`~wire_fmu.master.unit_io`), and makes the calls the coupling algorithms
+make: set a unit's inputs, step it, read its sources. The observers' watched
+variables are read with the end-of-step reads (:meth:`UnitExchange.watch`).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+from .extrapolation import History, held_value
+from .unit_io import EndValues, InputPlan, Link, Watch, read_plan
+
+__all__ = ["MODE_OUTPUT", "UnitExchange"]
+
+MODE_OUTPUT = "mode_changes"
+"""The output whose change marks a unit's mode event (a rope break, a stick/slip switch)."""
+
+
+class UnitExchange:
+    """The units' inputs and outputs across the FMI boundary (a mixin of the simulation).
+
+    The simulation provides ``scene``, ``run_settings``, ``slaves``, ``drivers``,
+    ``events``, ``held``, ``mode_counts``, ``_watches``, ``_watching``, ``_inputs``,
+    ``_reads`` and ``_ends``.
+    """
+
+    # -- structure -------------------------------------------------------------
+    def _build_links(self) -> None:
+        self.links_into: dict[str, list[Link]] = defaultdict(list)
+        self.source_keys: dict[str, list[str]] = defaultdict(list)
+        self.histories: dict[str, History] = {}
+        for c in self.scene.all_connections:
+            slave = self.slaves[c.target.unit]
+            scheme = c.extrapolation or self.run_settings.extrapolation
+            key = str(c.source)
+            history = self.histories.setdefault(key, History())
+            link = Link(c, key, slave.vr(c.target.variable), scheme, history)
+            self.links_into[c.target.unit].append(link)
+            if key not in self.source_keys[c.source.unit]:
+                self.source_keys[c.source.unit].append(key)
+        self.source_vrs = {
+            unit: [self.slaves[unit].vr(k.split(".", 1)[1]) for k in keys]
+            for unit, keys in self.source_keys.items()
+        }
+
+    def _build_plans(self) -> None:
+        """Each unit's batched set and end-of-step reads (after the observers' watches)."""
+        for name, slave in self.slaves.items():
+            links = tuple(self.links_into.get(name, ()))
+            driven = tuple(self.drivers.targets(name))
+            variables = [slave.variables.get(n) for n in driven]
+            reals = all(v is not None and v.type == "Real" for v in variables)
+            refs = [link.target_vr for link in links]
+            if reals:
+                refs += [v.valueReference for v in variables]
+            evented = name in self.events.units
+            self._inputs[name] = InputPlan(links, driven, refs, reals, evented)
+            sources = self.source_vrs.get(name, [])
+            mode = MODE_OUTPUT if name in self.mode_counts else None
+            self._reads[name] = (
+                read_plan(name, slave, sources, mode),
+                read_plan(name, slave, sources, mode, self._watches),
+            )
+
+    def watch(self, names: dict[str, list[str]], due) -> Watch:
+        """Read variables with the units' end-of-step reads at the steps ``due`` names.
+
+        For observers: call it in ``on_start``; the values of a step are then
+        read with what the master reads at the end of the step anyway.
+
+        Parameters
+        ----------
+        names : dict of str to list of str
+            Variable names by unit.
+        due : callable
+            ``due(t)``: whether the observer reads after the step that ends at
+            ``t`` (s).
+
+        Returns
+        -------
+        Watch
+            Its :meth:`~wire_fmu.master.unit_io.Watch.values` gives a unit's
+            variables now, from the end-of-step read when it has them.
+        """
+        watch = Watch(names, due)
+        self._watches.append(watch)
+        self._reads.clear()  # planned again before the next step
+        return watch
+
+    def watched_values(self, watch: Watch, unit: str) -> list:
+        """The current values of the variables ``watch`` names at ``unit``.
+
+        Parameters
+        ----------
+        watch : Watch
+            From :meth:`watch`.
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        list of object
+            Each value, in its unit, in the order the watch names them.
+        """
+        return watch.values(unit, self.slaves[unit], self._ends.get(unit))
+
+    def watched_snapshot(self, watch: Watch, unit: str) -> EndValues | list:
+        """:meth:`watched_values`, kept for later (:meth:`Watch.unpack <.unit_io.Watch.unpack>`).
+
+        Parameters
+        ----------
+        watch : Watch
+            From :meth:`watch`.
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        EndValues or list
+            The unit's end-of-step read when it holds the watched values, else
+            the values read now.
+        """
+        return watch.take(unit, self.slaves[unit], self._ends.get(unit))
+
+    def _set_connected_from_latest(self, unit: str) -> None:
+        self._ends.pop(unit, None)
+        refs, values = [], []
+        for link in self.links_into.get(unit, ()):
+            if self.histories[link.key].points:
+                refs.append(link.target_vr)
+                values.append(self.histories[link.key].latest)
+        self.slaves[unit].set_reals(refs, values)
+
+    def _push(self, unit: str, t: float) -> None:
+        for key, value in self.read_sources(unit).items():
+            self.histories[key].push(t, value)
+
+    # -- what algorithms call ------------------------------------------------------
+    def read_sources(self, unit: str) -> dict[str, float]:
+        """Current values of ``unit``'s outputs that feed connections.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        dict of str to float
+            Each output's value by its ``"unit.variable"`` name, in its unit.
+        """
+        end = self._ends.get(unit)
+        if end is not None:  # read once, just after the unit's step
+            return dict(end.sources)
+        keys = self.source_keys.get(unit, [])
+        return dict(
+            zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
+        )
+
+    def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
+        """Held values of every connected, driven or overridden input of ``unit``.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        t, h : float
+            Start and length of the macro step, s.
+        fresh : dict or None
+            Source outputs (``"unit.variable"``) at ``t + h`` from the previous
+            sweep of an iterated step; None extrapolates from the past.
+        """
+        self._ends.pop(unit, None)
+        plan = self._inputs[unit]
+        if plan.idle:
+            return
+        held, values = self.held, []
+        for link in plan.links:
+            if link.position:
+                value = link.history.points[-1][1]  # the unit advances it with the held velocity
+            else:
+                value = held_value(
+                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+                )
+            values.append(value)
+            held[link.target] = value
+        slave = self.slaves[unit]
+        by_name = None
+        if plan.driven:
+            driven = self.drivers.step_values(unit, t, h)
+            if not plan.driven_reals:
+                by_name = dict(zip(plan.driven, driven, strict=True))  # set by name, checked
+            elif all(type(v) is float for v in driven):
+                values += driven
+            else:  # checked as a set by name would, then sent as floats
+                slave.typed_values(dict(zip(plan.driven, driven, strict=True)))
+                values += [float(v) for v in driven]
+        refs, others = plan.refs, None
+        if by_name is not None:  # as the events' values override the drivers'
+            by_name.update(self.events.values(unit))
+        elif plan.evented:
+            refs, event_values, others = plan.event_inputs(slave, self.events)
+            values += event_values
+        slave.set_reals(refs, values)
+        if by_name:
+            slave.set_many(by_name)
+        if others:
+            slave.set_typed(others)
+
+    def step_unit(self, unit: str, t: float, h: float) -> None:
+        """Step one unit (errors propagate as StepRefusedError / UnitFailedError).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        t, h : float
+            Start and length of the macro step, s.
+        """
+        self._ends.pop(unit, None)
+        slave = self.slaves[unit]
+        slave.do_step(t, h)
+        plain, watched = self._reads[unit]
+        plan = watched if self._watching else plain
+        self._ends[unit] = plan.read(slave, self.source_keys.get(unit, ()))
+
+    def _read_all(self) -> dict[str, float]:
+        new = {}
+        for unit in self.slaves:
+            end = self._ends.get(unit)
+            new.update(end.sources if end is not None else self.read_sources(unit))
+        return new
+
+    def _mode_count(self, unit: str) -> int:
+        """The unit's ``mode_changes`` output now (from its end-of-step read if valid)."""
+        end = self._ends.get(unit)
+        if end is not None and end.mode is not None:
+            return end.mode
+        return int(self.slaves[unit].get([MODE_OUTPUT])[MODE_OUTPUT])

@@ -1,0 +1,200 @@
+"""One macro step: the sweeps, their iteration, the bonds' energy, rejection and rollback.
+
+:class:`MacroStep` is the part of :class:`~wire_fmu.master.simulation.Simulation`
+that takes one macro step and decides on it: the coupling algorithm's sweep
+(repeated from saved FMU states with ``iterations > 1`` until the inputs stop
+changing), the bonds' energy residuals (:mod:`~wire_fmu.master.bond_energy`),
+the rollback of a refused, non-finite or (``adaptive``) rejected step, the
+acceptance that advances the histories and books the energy, and the next
+step's size (:mod:`~wire_fmu.master.step_size`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .bond_energy import step_energy
+from .run_result import SimulationStoppedError
+from .slave import StepRefusedError
+from .step_size import _PI, new_h
+
+__all__ = ["MacroStep"]
+
+
+@dataclass
+class _Attempt:
+    """One try at a macro step."""
+
+    accepted: bool
+    residuals: dict[str, float]
+    sweeps: int
+    new: dict[str, float] = field(default_factory=dict)
+    retry_step: float = 0.0
+    message: str = ""
+
+
+class MacroStep:
+    """Taking, judging, accepting and rolling back a macro step (a mixin of the simulation).
+
+    The simulation provides ``scene``, ``run_settings``, ``slaves``, ``algorithm``,
+    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_counts``,
+    ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``, ``_reads``, ``_ends``,
+    ``_build_plans``, ``_read_all`` and ``_mode_count``.
+    """
+
+    def _save(self):
+        return {name: s.get_state() for name, s in self.slaves.items()}
+
+    def _restore(self, states) -> None:
+        self._ends.clear()
+        for name, state in states.items():
+            self.slaves[name].set_state(state)
+
+    def _free(self, states) -> None:
+        for name, state in states.items():
+            self.slaves[name].free_state(state)
+
+    def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
+        self.algorithm.sweep(self, t, h)
+        new = self._read_all()
+        sweeps, changes = 1, []
+        for _ in range(self.run_settings.iterations - 1):
+            if not all(map(math.isfinite, new.values())):
+                return new, sweeps  # never handed on: the caller rejects the step
+            before = dict(self.held)
+            self._restore(states)
+            self.algorithm.sweep(self, t, h, fresh=new)
+            new = self._read_all()
+            sweeps += 1
+            changes.append(
+                max(
+                    (
+                        abs(self.held[k] - before.get(k, 0.0)) / max(1.0, abs(self.held[k]))
+                        for k in self.held
+                    ),
+                    default=0.0,
+                )
+            )
+            if changes[-1] < self.run_settings.iteration_tolerance:
+                return new, sweeps
+        if len(changes) >= 3 and changes[-1] > changes[0]:  # the fixed point runs away
+            raise SimulationStoppedError(
+                f"t = {t:.6g} s: the iteration over the step of {h:.3g} s diverges (input "
+                f"change {changes[0]:.3g} after the second sweep, {changes[-1]:.3g} after the "
+                f"last of {sweeps}): the coupling cannot be resolved at this step; use a "
+                "smaller step or adaptive steps"
+            )
+        return new, sweeps
+
+    def bond_residuals(self, new: dict[str, float], h: float) -> dict[str, float]:
+        """Energy each bond's coupling created over the step just taken, J.
+
+        Parameters
+        ----------
+        new : dict of str to float
+            Source outputs (``"unit.variable"``) at the end of the step.
+        h : float
+            The step just taken, s.
+
+        Returns
+        -------
+        dict of str to float
+            The energy residual by bond name, J (positive: created).
+        """
+        out = {}
+        histories, held, power = self.histories, self.held, self.bond_power
+        for keys in self._bond_keys:
+            out[keys.name], power[keys.name] = step_energy(keys, histories, held, new, h)
+        return out
+
+    def _attempt(self, t: float, h: float) -> _Attempt:
+        """Take one macro step, rolling back when it is refused or rejected."""
+        if not self._reads:  # planned once, after the observers' watches
+            self._build_plans()
+        rollback = self.run_settings.iterations > 1 or self.run_settings.adaptive
+        states = self._save() if rollback else None
+        try:
+            if states is not None:
+                new, sweeps = self._sweep_iterated(t, h, states)
+            else:
+                self.algorithm.sweep(self, t, h)
+                new, sweeps = self._read_all(), 1
+        except StepRefusedError as exc:
+            if states is None:
+                raise SimulationStoppedError(str(exc)) from None
+            self._restore(states)
+            self._free(states)
+            return _Attempt(False, {}, 0, retry_step=new_h(h, 4.0), message=str(exc))
+        if not all(map(math.isfinite, new.values())):  # never accepted, never recorded
+            bad = ", ".join(
+                f"{key} = {value!r}" for key, value in new.items() if not math.isfinite(value)
+            )
+            message = f"t = {t:.6g} s: after the step of {h:.3g} s, {bad}"
+            if states is None:
+                raise SimulationStoppedError(
+                    f"{message}: not finite; the run stops here, "
+                    "everything before is kept; try a smaller step"
+                )
+            self._restore(states)
+            self._free(states)
+            return _Attempt(False, {}, sweeps, retry_step=new_h(h, 4.0), message=message)
+        residuals = self.bond_residuals(new, h)
+        if self.run_settings.adaptive:
+            error = max((abs(r) for r in residuals.values()), default=0.0)
+            error /= self.run_settings.energy_tolerance
+            if error > 1.0 and h > self.run_settings.min_step * (1 + 1e-9):
+                self._restore(states)
+                self._free(states)
+                return _Attempt(
+                    False,
+                    residuals,
+                    sweeps,
+                    retry_step=new_h(h, error),
+                    message=f"bond energy residual {error:.3g} x tolerance",
+                )
+            if error > 1.0:
+                self._free(states)
+                raise SimulationStoppedError(
+                    f"t = {t:.6g} s: the bonds' energy residual is {error:.3g} times "
+                    f"energy_tolerance even at the minimum step {h:.3g} s: the coupling "
+                    "cannot meet the tolerance; lower min_step or raise energy_tolerance"
+                )
+        if states is not None:
+            self._free(states)
+        return _Attempt(True, residuals, sweeps, new)
+
+    def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
+        histories, end = self.histories, t + h
+        for key, value in new.items():
+            histories[key].push(end, value)
+        switched = set()
+        for name, before in self.mode_counts.items():
+            now = self._mode_count(name)
+            if now != before:
+                switched.add(name)
+                self.mode_counts[name] = now
+                for key in self.source_keys.get(name, ()):
+                    histories[key].reset()
+        across = (
+            {
+                b.name
+                for b in self.scene.bonds
+                if b.effort.source.unit in switched or b.flow.source.unit in switched
+            }
+            if switched
+            else ()
+        )
+        self.energy.book(residuals, self.bond_power, h, across_events=across)
+        self.time = t + h
+
+    def _next_step(self, h: float, residuals) -> float:
+        s = self.run_settings
+        if not s.adaptive:
+            return s.step
+        error = max((abs(r) for r in residuals.values()), default=0.0) / s.energy_tolerance
+        error = max(error, 1e-10)
+        factor = _PI["safety"] * error ** -_PI["k_i"] * (self._error_prev / error) ** _PI["k_p"]
+        self._error_prev = error
+        factor = min(_PI["grow"], max(_PI["shrink"], factor))
+        return min(s.max_step or math.inf, max(s.min_step, h * factor))
