@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 from .bond_energy import step_energy
 from .run_result import SimulationStoppedError
-from .slave import StepRefusedError
 from .step_size import _PI, new_h
+from .unit_errors import StepRefusedError
 
 __all__ = ["MacroStep"]
 
