@@ -39,35 +39,34 @@ anything else as its type and message (the traceback goes to the Python
 logger at debug level), both with status Error, then re-raises. Every
 message is also sent to the Python logger ``wire_fmu.export.facade`` at
 debug level (the master says the FMI message itself, once).
+
+The logged entry points, the phases and :class:`FacadeError` are in
+:mod:`~wire_fmu.export.facade_calls`; the FMU state in
+:mod:`~wire_fmu.export.facade_state`.
 """
 
 from __future__ import annotations
 
-import copy
 import functools
-import json
 import logging
 import math
-import traceback
-from collections.abc import Callable, Mapping
-from enum import StrEnum
-from typing import Any, ClassVar, TypeVar
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 
 import wire_fmu
-from wire_fmu.core.errors import ConfigurationError, WireFmuError
+from wire_fmu.core.errors import WireFmuError
 from wire_fmu.core.framework.unit import Causality, Unit, Variability, Variable
+from wire_fmu.export.facade_calls import FacadeError, Phase, fmi_access, fmi_entry
+from wire_fmu.export.facade_state import STATE_FORMAT, FacadeState
 from wire_fmu.export.guard import check_core
-from wire_fmu.export.state import json_copy
 
 __all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
 
 logger = logging.getLogger(__name__)
 
-STATE_FORMAT = "wire_fmu.fmu_state/1"
-"""Tag of the FMU state layout written by :meth:`CoreFacade._get_fmu_state`."""
 STEP_TIME_TOLERANCE = 1e-9
 """Relative tolerance (of max(1 s, t)) between a step's start and the unit's time."""
 PHYSICS_SECONDS = "physics_seconds"
@@ -86,92 +85,8 @@ _INITIAL = {
     Causality.output: Fmi2Initial.calculated,
 }
 
-_F = TypeVar("_F", bound=Callable[..., Any])
 
-
-def _fmi_access(fmi_name: str, access: Callable[..., Any]) -> Callable[..., Any]:
-    """Make pythonfmu's variable access ``access`` a facade method whose failures are logged.
-
-    Parameters
-    ----------
-    fmi_name : str
-        The FMI function (``"fmi2GetReal"``), for messages.
-    access : callable
-        The :class:`pythonfmu.Fmi2Slave` method: ``(self, vrs)`` for a get, ``(self, vrs,
-        values)`` for a set (value references and values in the variables' declared units).
-    """
-
-    def method(self: CoreFacade, *args: Any) -> Any:
-        return access(self, *args)
-
-    method.__name__ = access.__name__
-    method.__doc__ = (
-        f"{fmi_name}, as :meth:`pythonfmu.Fmi2Slave.{access.__name__}` (failures logged)."
-    )
-    return fmi_entry(fmi_name)(method)
-
-
-class FacadeError(WireFmuError, RuntimeError):
-    """An FMI call the facade cannot honour (wrong phase, bad state, ...)."""
-
-
-class Phase(StrEnum):
-    """Life-cycle phase of a facade (FMI 2.0 co-simulation states)."""
-
-    instantiated = "instantiated"
-    initialization = "initialization"
-    step = "step"
-    terminated = "terminated"
-
-
-def fmi_entry(fmi_name: str) -> Callable[[_F], _F]:
-    """Decorate a method the FMU binary calls: log why it fails, then re-raise.
-
-    Parameters
-    ----------
-    fmi_name : str
-        The FMI function, for the message (e.g. ``"fmi2DoStep"``).
-    """
-
-    def decorate(method: _F) -> _F:
-        """``method`` wrapped so that a failure is logged, then re-raised.
-
-        Parameters
-        ----------
-        method : callable
-            A facade method the FMU binary calls.
-        """
-
-        @functools.wraps(method)
-        def guarded(self: CoreFacade, *args: Any, **kwargs: Any) -> Any:
-            """Call the method; on failure report it through the facade and re-raise.
-
-            Parameters
-            ----------
-            *args, **kwargs : Any
-                Arguments of the method.
-            """
-            try:
-                return method(self, *args, **kwargs)
-            except ConfigurationError as exc:  # its problems, without the "where" we say already
-                self._report(f"{fmi_name} failed: {'; '.join(exc.problems)}", Fmi2Status.error)
-                raise
-            except WireFmuError as exc:
-                self._report(f"{fmi_name} failed: {exc}", Fmi2Status.error)
-                raise
-            except Exception as exc:
-                logger.debug("%s: %s", fmi_name, traceback.format_exc())
-                self._report(
-                    f"{fmi_name} failed unexpectedly: {type(exc).__name__}: {exc}", Fmi2Status.error
-                )
-                raise
-
-        return guarded  # type: ignore[return-value]
-
-    return decorate
-
-
-class CoreFacade(Fmi2Slave):
+class CoreFacade(FacadeState, Fmi2Slave):
     """pythonfmu slave that exposes one core :class:`~wire_fmu.core.framework.unit.Unit`.
 
     Subclasses set :attr:`unit_class` and nothing else.
@@ -330,11 +245,11 @@ class CoreFacade(Fmi2Slave):
 
     # The FMU binary's variable access, each failure logged (fmi2GetReal ... fmi2SetString).
     # Reals, read and set every step, take a plan worked out once per list of references.
-    _get_reals = _fmi_access("fmi2GetReal", Fmi2Slave.get_real)
-    get_integer = _fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
-    get_boolean = _fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
-    get_string = _fmi_access("fmi2GetString", Fmi2Slave.get_string)
-    _set_reals = _fmi_access("fmi2SetReal", Fmi2Slave.set_real)
+    _get_reals = fmi_access("fmi2GetReal", Fmi2Slave.get_real)
+    get_integer = fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
+    get_boolean = fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
+    get_string = fmi_access("fmi2GetString", Fmi2Slave.get_string)
+    _set_reals = fmi_access("fmi2SetReal", Fmi2Slave.set_real)
 
     def get_real(self, vrs: list[int]) -> list[float]:
         """fmi2GetReal: the values of ``vrs``, in their declared units.
@@ -408,9 +323,9 @@ class CoreFacade(Fmi2Slave):
             return None
         return tuple(v.name for v in found)
 
-    set_integer = _fmi_access("fmi2SetInteger", Fmi2Slave.set_integer)
-    set_boolean = _fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean)
-    set_string = _fmi_access("fmi2SetString", Fmi2Slave.set_string)
+    set_integer = fmi_access("fmi2SetInteger", Fmi2Slave.set_integer)
+    set_boolean = fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean)
+    set_string = fmi_access("fmi2SetString", Fmi2Slave.set_string)
 
     # -- life cycle ---------------------------------------------------------------
     @fmi_entry("fmi2SetupExperiment")
@@ -504,78 +419,3 @@ class CoreFacade(Fmi2Slave):
         unit.values.update(values)
         unit.configure()
         self.unit = unit
-
-    # -- FMU state --------------------------------------------------------------
-    @fmi_entry("fmi2GetFMUstate")
-    def _get_fmu_state(self) -> dict[str, Any]:
-        settled = self._phase in (Phase.step, Phase.terminated)
-        raw = {
-            "format": STATE_FORMAT,
-            "unit": self.unit.NAME,
-            "phase": self._phase.value,
-            "start_time": self._start_time,
-            "time": self._time,
-            "reconfigure": self._reconfigure,
-            "inputs_changed": self._inputs_changed,
-            "values": self.unit.values,
-            "core": self.unit.get_state() if settled else None,
-        }
-        try:
-            return json_copy(raw)
-        except (TypeError, ValueError) as exc:
-            raise FacadeError(
-                f"FMU state is not JSON-compatible ({exc}); {type(self.unit).__name__}"
-                ".get_state() and unit.values must hold JSON data"
-            ) from exc
-
-    @fmi_entry("fmi2SetFMUstate")
-    def _set_fmu_state(self, state: dict[str, Any]) -> None:
-        self._check_state(state)
-        values = copy.deepcopy(state["values"])
-        phase = Phase(state["phase"])
-        if phase is Phase.instantiated:
-            self.unit = self._unit_class()(instance_name=self.instance_name)
-            self.unit.values.update(values)
-        elif phase is Phase.initialization:
-            self._rebuild_unit(values)
-        else:
-            if self._needs_configure(values):
-                self._rebuild_unit(values)
-            self.unit.values.update(values)
-            self.unit.set_state(copy.deepcopy(state["core"]))
-            self.unit.values.update(values)  # exactly the saved outputs
-        self._phase = phase
-        self._start_time = float(state["start_time"])
-        self._time = float(state.get("time", self._start_time))
-        self._reconfigure = bool(state["reconfigure"])
-        self._inputs_changed = bool(state["inputs_changed"])
-
-    @staticmethod
-    def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:
-        # Unreadable bytes become a state that _set_fmu_state refuses with a
-        # logged message (fmi2SetFMUstate), so deserialising never fails.
-        try:
-            return json.loads(state.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            return {"format": None, "unreadable": f"not a serialised wire_fmu state ({exc})"}
-
-    def _needs_configure(self, values: Mapping[str, Any]) -> bool:
-        if self._phase not in (Phase.step, Phase.terminated):
-            return True
-        names = [v.name for v in self.unit.VARIABLES if v.causality is Causality.parameter]
-        return any(self.unit.values[n] != values[n] for n in names)
-
-    def _check_state(self, state: Any) -> None:
-        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
-            reason = state.get("unreadable", "") if isinstance(state, dict) else ""
-            raise FacadeError(f"not an FMU state of format {STATE_FORMAT!r} {reason}".strip())
-        if state.get("unit") != self.unit.NAME:
-            raise FacadeError(
-                f"the FMU state belongs to unit {state.get('unit')!r}, not {self.unit.NAME!r}"
-            )
-        times = [state.get("start_time"), state.get("time", state.get("start_time"))]
-        if not all(isinstance(t, int | float) and math.isfinite(t) for t in times):
-            raise FacadeError(f"the FMU state's times {times} are not finite numbers")
-        expected = {v.name for v in self.unit.VARIABLES}
-        if set(state["values"]) != expected:
-            raise FacadeError("the FMU state's variables differ from this FMU's variables")
