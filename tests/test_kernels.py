@@ -136,8 +136,8 @@ def test_hard_cases_agree(fmus, tmp_path, monkeypatch, case):
 
 
 def test_block_train_runs_the_compiled_kernel_only_where_it_applies(monkeypatch):
-    """Fixed geometry and planar moving geometry without friction links compile; moving
-    spatial geometry, bearing friction and rope slip run the Python kernel;
+    """Fixed geometry and planar moving geometry compile, with or without friction links
+    (bearing friction, rope slip); moving spatial geometry runs the Python kernel;
     ``WIRE_FMU_KERNEL=python`` turns compiling off."""
     from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
 
@@ -148,9 +148,10 @@ def test_block_train_runs_the_compiled_kernel_only_where_it_applies(monkeypatch)
     assert make_unit(reeving, "moving_geometry").model.compiled
     assert make_unit(sheaves, "sheave_inertia,moving_geometry").model.compiled
     assert not make_unit(reeving, "moving_geometry,spatial_geometry").model.compiled
-    assert not make_unit(sheaves, "sheave_inertia,bearing_friction").model.compiled
-    assert not make_unit(sheaves, "sheave_inertia,rope_slip").model.compiled
+    assert make_unit(sheaves, "sheave_inertia,bearing_friction").model.compiled
+    assert make_unit(sheaves, "sheave_inertia,rope_slip,moving_geometry").model.compiled
     monkeypatch.setenv(KERNEL_ENV, "python")
+    assert not make_unit(sheaves, "sheave_inertia,bearing_friction,rope_slip").model.compiled
     assert not make_unit(reeving, "rope_damping").model.compiled
     assert not make_unit(reeving, "moving_geometry").model.compiled
 

@@ -87,8 +87,9 @@ class StickSlip:
     def __init__(self, masses: np.ndarray, links: tuple[FrictionLink, ...]) -> None:
         self.masses = np.asarray(masses, dtype=float)
         self.links = tuple(links)
-        self.mode = np.zeros(len(self.links), dtype=int)  # all stuck at rest
+        self.mode = np.zeros(len(self.links), dtype=np.int64)  # all stuck at rest
         self._plan = None
+        self._arrays = None
 
     # -- state ---------------------------------------------------------------
     def get_mode(self) -> list[int]:
@@ -103,7 +104,7 @@ class StickSlip:
         mode : list of int
             Per link: 0 stuck, +1 or -1 the sliding direction.
         """
-        self.mode = np.array(mode, dtype=int)
+        self.mode = np.array(mode, dtype=np.int64)
         self._plan = None
 
     # -- dynamics --------------------------------------------------------------
@@ -284,6 +285,45 @@ class StickSlip:
             if grounded:
                 held.extend(members)
         return np.array(sorted(held), dtype=int)
+
+    def plan_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The groups of coordinates joined by stuck links, as flat integer arrays.
+
+        The same plan :meth:`accelerations` follows, for compiled kernels; made
+        again only after the modes change.
+
+        Returns
+        -------
+        clusters : numpy.ndarray, shape (n_groups, 5)
+            Per group: first and end index into ``members``, first and end index
+            into ``edges``, 1 if the group is held by the ground.
+        members : numpy.ndarray
+            The groups' coordinates, each group sorted.
+        edges : numpy.ndarray, shape (n_stuck, 3)
+            Per stuck link: the link, the child and the parent coordinate (-1: the
+            ground), leaves first within each group.
+        grounded : numpy.ndarray
+            The coordinates held to the ground, sorted (:meth:`stuck_to_ground`).
+        """
+        plan = self._plan_for(self.mode)
+        if self._arrays is not None and self._arrays[0] is plan:
+            return self._arrays[1]
+        clusters = np.zeros((len(plan), 5), dtype=np.int64)
+        members: list[int] = []
+        edges: list[tuple[int, int, int]] = []
+        for c, (group, grounded, group_edges) in enumerate(plan):
+            clusters[c] = len(members), len(members) + len(group), len(edges), 0, int(grounded)
+            members.extend(int(i) for i in group)
+            edges.extend(group_edges)
+            clusters[c, 3] = len(edges)
+        arrays = (
+            clusters,
+            np.array(members, dtype=np.int64),
+            np.array(edges, dtype=np.int64).reshape(len(edges), 3),
+            self.stuck_to_ground().astype(np.int64),
+        )
+        self._arrays = (plan, arrays)
+        return arrays
 
     # -- structure of the stuck links -----------------------------------------
     def _plan_for(self, mode: np.ndarray):

@@ -12,8 +12,9 @@ variable ``WIRE_FMU_KERNEL`` chooses:
     the Python kernel everywhere.
 
 Compiled code is cached on disk so that compiling is paid once per machine:
-by content (the kernel's own source and the shared loop every entry point
-inlines, :data:`SHARED_KERNEL_SOURCES`), not by file path, in ``WIRE_FMU_CACHE_DIR`` (default
+by content (the kernel's own source, the shared loop every entry point
+inlines, :data:`SHARED_KERNEL_SOURCES`, and every ``wire_fmu`` module they
+import, followed through their imports), not by file path, in ``WIRE_FMU_CACHE_DIR`` (default
 ``~/.cache/wire_fmu/numba``). Every copy of the ``wire_fmu`` sources with the
 same text shares one cache, so FMUs extracted to new temporary folders and FMUs
 loaded by a C++ host start warm. The cache locator is registered with numba
@@ -25,6 +26,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -123,13 +125,40 @@ SHARED_KERNEL_SOURCES = ("core/framework/compiled.py", "core/framework/compiled_
 """Sources (relative to the package) that every unit's entry point inlines: part of every key."""
 
 
-def _shared_sources(py_file: str) -> list[Path]:
-    """The :data:`SHARED_KERNEL_SOURCES` of the package copy ``py_file`` belongs to."""
+def _package_root(py_file: str) -> Path | None:
+    """The folder holding the copy of ``wire_fmu`` that ``py_file`` belongs to, or None."""
     parts = Path(py_file).resolve().parts
     if "wire_fmu" not in parts:
-        return []
-    root = Path(*parts[: len(parts) - parts[::-1].index("wire_fmu")])
-    return [root / name for name in SHARED_KERNEL_SOURCES if (root / name).is_file()]
+        return None
+    return Path(*parts[: len(parts) - 1 - parts[::-1].index("wire_fmu")])
+
+
+_IMPORT = re.compile(r"^from (wire_fmu(?:\.\w+)+) import", re.MULTILINE)
+
+
+def _kernel_sources(py_file: str) -> list[Path]:
+    """``py_file``, the :data:`SHARED_KERNEL_SOURCES` and every ``wire_fmu`` module it imports.
+
+    Followed through imports, so that a kernel whose compiled helpers or constants
+    live in another module is compiled afresh when that module changes (numba's
+    own cache only looks at the file the function is in). Modules missing from
+    this copy of the package are skipped.
+    """
+    root = _package_root(py_file)
+    first = Path(py_file).resolve()
+    if root is None:
+        return [first]
+    shared = [root / "wire_fmu" / name for name in SHARED_KERNEL_SOURCES]
+    sources = [first, *(path for path in shared if path.is_file())]
+    pending = list(sources)
+    while pending:
+        text = pending.pop().read_text(encoding="utf-8")
+        for module in _IMPORT.findall(text):
+            path = root.joinpath(*module.split(".")).with_suffix(".py")
+            if path.is_file() and path not in sources:
+                sources.append(path)
+                pending.append(path)
+    return sources
 
 
 if _numba_caching is not None:
@@ -148,7 +177,7 @@ if _numba_caching is not None:
             self._lineno = py_func.__code__.co_firstlineno
             relative = _package_relative(py_file) or Path(py_file).name
             digest = hashlib.sha256(relative.encode())
-            for source in (Path(py_file), *_shared_sources(py_file)):
+            for source in _kernel_sources(py_file):
                 digest.update(b"\0" + source.read_bytes())
             digest = digest.hexdigest()[:16]
             folder = relative.replace("/", "_").removesuffix(".py")

@@ -1,12 +1,13 @@
 """The block train's compiled kernel: its equations as plain functions over flat arrays.
 
 The same physics as :meth:`BlockTrainModel.evaluate
-<wire_fmu.core.units.block_train.model.BlockTrainModel.evaluate>` (the readable
-numpy reference), for block trains without friction links (no
-``bearing_friction``, no ``rope_slip``) whose segment lengths are either linear in
-the body motion (no ``moving_geometry``) or follow the planar tangent geometry
-(``moving_geometry`` without ``spatial_geometry``); other block trains run the
-Python kernel. Everything a step needs is in one tuple of arrays, built by
+<wire_fmu.core.units.block_train.model.BlockTrainModel.evaluate>` and ``rhs`` (the
+readable numpy reference), for block trains whose segment lengths are either linear
+in the body motion (no ``moving_geometry``) or follow the planar tangent geometry
+(``moving_geometry`` without ``spatial_geometry``, :mod:`.kernel_geometry`), with or
+without friction links (``bearing_friction``, ``rope_slip``:
+:mod:`.kernel_friction`); block trains with spatial moving geometry run the Python
+kernel. Everything a step needs is in one tuple of arrays, built by
 :func:`kernel_data`:
 
 =====  ==================  ==================================================
@@ -39,21 +40,13 @@ index  name                contents
 15     ``segment_span``    int, per segment: the span it belongs to
 16     ``geometry_step``   float: the central-difference step of the lengths
                            with respect to the body motion, m
+17-24  friction links      see :mod:`.kernel_friction`
 =====  ==================  ==================================================
 
-With moving geometry, :func:`segment_lengths` is
-:meth:`ReevedPath._planar_segment_lengths
-<wire_fmu.core.units.block_train.path.ReevedPath._planar_segment_lengths>` (the
-closed form of :func:`~wire_fmu.core.components.sheave_geometry.planar_path.planar_path_lengths`)
-and :func:`span_geometry` is :meth:`BlockTrainModel.span_lengths
-<wire_fmu.core.units.block_train.model.BlockTrainModel.span_lengths>`, operation
-for operation: the central differences of the lengths amplify any rounding by
-``L / (2 h)``, so the two kernels agree only if each segment length is computed
-with the same operations in the same order.
-
 The guards are in the order of :meth:`ModeSwitching.guards
-<wire_fmu.core.units.block_train.modes.ModeSwitching.guards>` (friction links
-first: none here).
+<wire_fmu.core.units.block_train.modes.ModeSwitching.guards>`: friction links
+first, then spans, floors and breaking loads. Mode switches are Python's: the
+kernel reads the present modes from the tuple.
 """
 
 from __future__ import annotations
@@ -64,6 +57,14 @@ import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
+from wire_fmu.core.units.block_train.kernel_friction import (
+    accelerations,
+    capacities,
+    friction_data,
+    link_guards,
+    loss_power,
+)
+from wire_fmu.core.units.block_train.kernel_geometry import segment_lengths, span_geometry
 
 __all__ = [
     "advance",
@@ -79,8 +80,6 @@ __all__ = [
 ]
 
 N_LINES = 2
-_POS_TOL = 1e-9  # m: tangent existence, as ``sheave_geometry.circles._POS_TOL``
-_TWO_PI = 2.0 * math.pi
 
 
 def kernel_data(model) -> tuple:
@@ -109,6 +108,7 @@ def kernel_data(model) -> tuple:
         model.kernel_body_dirs,
         model.kernel_segment_span,
         model.kernel_geometry_step,
+        *friction_data(model),
     )
 
 
@@ -130,138 +130,6 @@ def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
         for j in range(a.shape[1]):
             out[j] += v[i] * a[i, j]
     return out
-
-
-@jit
-def _wrap_2pi(angle: float) -> float:
-    """Map an angle from atan2 into [0, 2 pi), rad (as ``sheave_geometry.circles``)."""
-    if angle < 0.0:
-        angle += _TWO_PI
-    return 0.0 if angle >= _TWO_PI else angle
-
-
-@jit
-def segment_lengths(y: np.ndarray, path_nodes, carriers, body_dirs):
-    """Segment lengths of a planar path, straight part plus half of each adjoining arc.
-
-    :meth:`ReevedPath._planar_segment_lengths
-    <wire_fmu.core.units.block_train.path.ReevedPath._planar_segment_lengths>` with
-    the same operations in the same order.
-
-    Parameters
-    ----------
-    y : numpy.ndarray
-        Body displacements along their directions, m: the blocks, then the driven bodies.
-    path_nodes, carriers, body_dirs : numpy.ndarray
-        See the module docstring (indices 12-14).
-
-    Returns
-    -------
-    lengths : numpy.ndarray
-        Length of each segment, m.
-    ok : bool
-        False when a segment has no tangent (circles overlap, or a point lies inside
-        a sheave); the lengths are then meaningless.
-    """
-    n_nodes = path_nodes.shape[0]
-    xs = np.empty(n_nodes)
-    zs = np.empty(n_nodes)
-    for k in range(n_nodes):
-        shift_x = 0.0
-        shift_z = 0.0
-        for c in range(carriers.shape[1]):
-            b = carriers[k, c]
-            if b < 0:
-                break
-            shift_x += y[b] * body_dirs[b, 0]
-            shift_z += y[b] * body_dirs[b, 1]
-        xs[k] = path_nodes[k, 0] + shift_x
-        zs[k] = path_nodes[k, 1] + shift_z
-    n_seg = n_nodes - 1
-    seg = np.empty(n_seg)
-    dir_x = np.empty(n_seg)
-    dir_z = np.empty(n_seg)
-    for i in range(n_seg):
-        dx = xs[i + 1] - xs[i]
-        dy = zs[i + 1] - zs[i]
-        k = path_nodes[i + 1, 2] - path_nodes[i, 2]
-        l2 = dx * dx + dy * dy
-        if math.sqrt(l2) - abs(k) <= _POS_TOL:
-            return seg, False
-        lt = math.sqrt(l2 - k * k)
-        seg[i] = lt
-        dir_x[i] = (lt * dx + k * dy) / l2
-        dir_z[i] = (lt * dy - k * dx) / l2
-    half_arcs = np.empty(max(n_nodes - 2, 0))
-    for j in range(1, n_nodes - 1):
-        ax, ay, bx, by = dir_x[j - 1], dir_z[j - 1], dir_x[j], dir_z[j]
-        cr = ax * by - ay * bx
-        dt = ax * bx + ay * by
-        rho = path_nodes[j, 2]
-        if rho == 0.0:
-            wrap = abs(math.atan2(cr, dt))
-        else:
-            wrap = _wrap_2pi(math.atan2(cr if rho > 0.0 else -cr, dt))
-        half_arcs[j - 1] = 0.5 * abs(rho) * wrap
-    for i in range(n_seg - 1):
-        seg[i] += half_arcs[i]
-    for i in range(n_seg - 1):
-        seg[i + 1] += half_arcs[i]
-    return seg, True
-
-
-@jit
-def span_geometry(y: np.ndarray, data):
-    """Geometric span lengths (m) and their Jacobian w.r.t. body motion, moving geometry.
-
-    :meth:`BlockTrainModel.span_lengths
-    <wire_fmu.core.units.block_train.model.BlockTrainModel.span_lengths>`: central
-    differences of :func:`segment_lengths` with the step ``data[16][0]``, then the
-    segments summed into their spans.
-
-    Parameters
-    ----------
-    y : numpy.ndarray
-        Body displacements along their directions, m: the blocks, then the driven bodies.
-    data : tuple
-        See the module docstring.
-
-    Returns
-    -------
-    lengths : numpy.ndarray
-        Length of each span, m.
-    jacobian : numpy.ndarray
-        ``d lengths / d y``, one row per span and one column per body, 1.
-    ok : bool
-        False when a segment has no tangent at ``y`` or at a differencing point.
-    """
-    path_nodes, carriers, body_dirs, segment_span = data[12], data[13], data[14], data[15]
-    h = data[16][0]
-    n_spans = data[3].size
-    n_bodies = y.size
-    seg, ok = segment_lengths(y, path_nodes, carriers, body_dirs)
-    n_seg = seg.size
-    jac = np.zeros((n_seg, n_bodies))
-    y_plus = np.empty(n_bodies)
-    y_minus = np.empty(n_bodies)
-    for b in range(n_bodies):
-        for j in range(n_bodies):
-            step = h if j == b else 0.0
-            y_plus[j] = y[j] + step
-            y_minus[j] = y[j] - step
-        plus, ok_plus = segment_lengths(y_plus, path_nodes, carriers, body_dirs)
-        minus, ok_minus = segment_lengths(y_minus, path_nodes, carriers, body_dirs)
-        ok = ok and ok_plus and ok_minus
-        for i in range(n_seg):
-            jac[i, b] = (plus[i] - minus[i]) / (2.0 * h)
-    lengths = np.zeros(n_spans)
-    span_jac = np.zeros((n_spans, n_bodies))
-    for i in range(n_seg):
-        span = segment_span[i]
-        lengths[span] += seg[i]
-        for b in range(n_bodies):
-            span_jac[span, b] += jac[i, b]
-    return lengths, span_jac, ok
 
 
 @jit
@@ -412,7 +280,17 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     out = np.empty_like(x)
     for i in range(n):
         out[i] = x[n + i]
-        out[n + i] = forces[i] / masses[i]
+    if data[17].shape[0] == 0:
+        for i in range(n):
+            out[n + i] = forces[i] / masses[i]
+    else:
+        caps = capacities(result[1], data)
+        acc, link_force = accelerations(forces, caps, masses, data)
+        for i in range(n):
+            out[n + i] = acc[i]
+        for i in data[24]:
+            out[i] = 0.0
+        loss = loss + loss_power(x, n, link_force, data)
     out[2 * n] = loss
     out[2 * n + 1] = power
     if not result[13]:
@@ -422,7 +300,7 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
 
 @jit
 def guards(t: float, x: np.ndarray, data) -> np.ndarray:
-    """Slack/taut ropes, floor contact and rope break, each firing below zero (N).
+    """Friction links, slack/taut ropes, floor contact and rope break, each firing below zero.
 
     Parameters
     ----------
@@ -434,7 +312,7 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
         See the module docstring.
     """
     breaking_load = data[1][2]
-    blocks, taut, broken, contact = data[6], data[8], data[9], data[10]
+    masses, blocks, taut, broken, contact = data[2], data[6], data[8], data[9], data[10]
     result = evaluate(t, x, data)
     tension, trial, elastic, depth, trial_contact = (
         result[1],
@@ -443,25 +321,29 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
         result[7],
         result[8],
     )
-    n_spans, nb = tension.size, depth.size
-    out = np.empty(2 * n_spans + nb)
+    n_links, n_spans, nb = data[17].shape[0], tension.size, depth.size
+    out = np.empty(n_links + 2 * n_spans + nb)
+    if n_links:
+        caps = capacities(tension, data)
+        link_force = accelerations(result[0], caps, masses, data)[1]
+        link_guards(x, data[0][0], link_force, caps, out, data)
     for i in range(n_spans):
         if broken[i]:
-            out[i] = 1.0
+            out[n_links + i] = 1.0
         elif taut[i]:
-            out[i] = trial[i]
+            out[n_links + i] = trial[i]
         else:
-            out[i] = max(-elastic[i], -trial[i])
+            out[n_links + i] = max(-elastic[i], -trial[i])
         margin = breaking_load - tension[i]
-        out[n_spans + nb + i] = margin if math.isfinite(margin) else 1.0
+        out[n_links + n_spans + nb + i] = margin if math.isfinite(margin) else 1.0
     for j in range(nb):
         stiffness = blocks[j, 3]
         if stiffness <= 0.0:
-            out[n_spans + j] = 1.0
+            out[n_links + n_spans + j] = 1.0
         elif contact[j]:
-            out[n_spans + j] = trial_contact[j]
+            out[n_links + n_spans + j] = trial_contact[j]
         else:
-            out[n_spans + j] = max(-stiffness * depth[j], -trial_contact[j])
+            out[n_links + n_spans + j] = max(-stiffness * depth[j], -trial_contact[j])
     return out
 
 
@@ -497,7 +379,7 @@ def summary(t: float, x: np.ndarray, data) -> np.ndarray:
 
 @jit
 def project(x: np.ndarray, data) -> np.ndarray:
-    """No invariants without friction links: ``x`` as it is.
+    """Hold the coordinates stuck to the ground where they stuck, at rest (in place).
 
     Parameters
     ----------
@@ -506,6 +388,11 @@ def project(x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
+    n = data[0][0]
+    held_positions = data[23]
+    for i in data[24]:
+        x[i] = held_positions[i]
+        x[n + i] = 0.0
     return x
 
 
@@ -528,7 +415,8 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     What :meth:`BlockTrainModel.advance
     <wire_fmu.core.units.block_train.model.BlockTrainModel.advance>` does, in the same
     order and with the same arithmetic: the strain energy the inputs' jump puts into
-    the rope booked as external work, then the loop of :func:`advance` up to the end
+    the rope booked as external work, the coordinates stuck to the ground held where
+    they are, then the loop of :func:`advance` up to the end
     of the step or its first event, then the outputs' :func:`summary` at the end.
     It changes nothing it was given.
 
@@ -550,9 +438,11 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)`` and the
         :func:`summary` at ``t1`` (empty unless the status is ``STATUS_DONE``). The
         status is :data:`STATUS_PYTHON`, and nothing else meaningful, when a span or
-        floor is in the wrong mode for the new inputs, a span has no unstretched
-        rope or a segment no tangent: Python then takes the step.
+        floor is in the wrong mode for the new inputs, a stuck link cannot hold under
+        them, a span has no unstretched rope or a segment no tangent: Python then
+        takes the step.
     """
+    n_coords, n_links = data[0][0], data[17].shape[0]
     new = (
         data[0],
         data[1],
@@ -571,6 +461,14 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         data[14],
         data[15],
         data[16],
+        data[17],
+        data[18],
+        data[19],
+        data[20],
+        data[21],
+        data[22],
+        x[:n_coords].copy(),  # a stuck coordinate is held where the step starts
+        data[24],
     )
     no_fire = np.zeros(directions.size, dtype=np.bool_)
     no_summary = np.zeros(0)
@@ -579,11 +477,12 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     if not (before[13] and after[13]):
         return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
     g = guards(t0, x, new)
-    for i in range(data[3].size + data[0][1]):  # the spans' and floors' mode guards
-        if g[i] < 0.0:
+    for i in range(n_links + data[3].size + data[0][1]):  # links, spans and floors
+        if g[i] < 0.0 and (i >= n_links or data[19][i] == 0):
             return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
     x = x.copy()
-    x[2 * data[0][0] + 1] += after[9].sum() - before[9].sum()
+    x[2 * n_coords + 1] += after[9].sum() - before[9].sum()
+    x = project(x, new)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
         rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, new
     )

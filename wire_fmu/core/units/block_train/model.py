@@ -151,11 +151,11 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
     def kernel_applies(self) -> bool:
         """Whether the compiled kernel covers this block train's effects.
 
-        It does without friction links, with lengths linear in the body motion or
-        recomputed by the planar path (``moving_geometry`` without
-        ``spatial_geometry``); see :mod:`~wire_fmu.core.units.block_train.kernel`.
+        It does with lengths linear in the body motion or recomputed by the planar
+        path (``moving_geometry`` without ``spatial_geometry``), with or without
+        friction links; see :mod:`~wire_fmu.core.units.block_train.kernel`.
         """
-        return not self.friction.links and (not self.moving or self._planar is not None)
+        return not self.moving or self._planar is not None
 
     def _build_kernel_arrays(self) -> None:
         """The parameters of :mod:`~wire_fmu.core.units.block_train.kernel` as flat arrays."""
@@ -224,6 +224,16 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         self._link_span_out = np.array(
             [self.span_of_segment[k] for _, k in self.link_kind], dtype=int
         )
+        self.kernel_link_index = np.array(
+            [
+                (link.body, link.other, self._link_span_in[i], self._link_span_out[i])
+                for i, link in enumerate(links)
+            ],
+            dtype=np.int64,
+        ).reshape(len(links), 4)
+        self.kernel_link_params = np.column_stack(
+            (self._bearing_m0, self._bearing_c, self._capstan)
+        ).reshape(len(links), 3)
 
     @property
     def broken(self) -> list[bool]:
@@ -564,6 +574,8 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         if result[0] == STATUS_PYTHON:
             return False
         self._hold(t, inputs, held)
+        if self.friction.links:
+            self._held_positions = self.state[: self.n_coords].copy()
         self.state, self._quiet_events, values = solver.finish_quiet_step(
             self, t, self.state, t1, result
         )
