@@ -156,6 +156,37 @@ def test_block_train_runs_the_compiled_kernel_only_where_it_applies(monkeypatch)
     assert not make_unit(reeving, "moving_geometry").model.compiled
 
 
+def test_a_change_in_a_module_a_kernel_imports_compiles_it_afresh(tmp_path, monkeypatch):
+    """The block-train kernel calls compiled helpers in ``kernel_friction``: a change there
+    (a changed capacity formula would otherwise run stale machine code) gives the kernel's
+    entry points a new cache, while an unrelated module of the unit does not."""
+    import wire_fmu.core.units.block_train.kernel as kernel
+
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "cache"))
+    package = Path(compiled.__file__).parents[2]
+    unit = "core/units/block_train/"
+    sources = [unit + "kernel.py", unit + "kernel_friction.py", unit + "kernel_geometry.py"]
+    sources += [unit + "model.py", *compiled.SHARED_KERNEL_SOURCES]
+    root = tmp_path / "fmu" / "resources" / "wire_fmu"
+    for source in sources:
+        (root / source).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(package / source, root / source)
+
+    def cache_path() -> str:
+        locator = compiled._ContentCacheLocator.from_function(
+            kernel.rhs.py_func, str(root / sources[0])
+        )
+        return locator.get_cache_path()
+
+    first = cache_path()
+    model = root / unit / "model.py"
+    model.write_text(model.read_text() + "\n# changed\n")
+    assert cache_path() == first
+    helper = root / unit / "kernel_friction.py"
+    helper.write_text(helper.read_text() + "\n# changed\n")
+    assert cache_path() != first
+
+
 def test_a_misspelt_kernel_choice_is_a_clear_error(monkeypatch):
     """``WIRE_FMU_KERNEL=numba`` names the variable and the choices."""
     monkeypatch.setenv(KERNEL_ENV, "numba")
