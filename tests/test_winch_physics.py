@@ -16,16 +16,8 @@ from scipy.integrate import solve_ivp
 from wire_fmu.core.components.drive_train import DriveChain
 from wire_fmu.core.units.winch.brake import BandBrake
 
-from .winch_helpers import make_unit, one_mass, run, two_mass
+from .winch_helpers import BRAKE, make_unit, one_mass, run, two_mass
 
-# a test brake: capacity 22.6 N m per newton of lever force paying out, 4.36 hauling in
-BRAKE = {
-    "brake_rim_radius": 0.6,
-    "brake_lever_ratio": 10.0,
-    "brake_efficiency": 0.9,
-    "brake_friction": 0.35,
-    "brake_wrap_angle": 4.7,
-}
 R = 0.5  # drum radius, m
 J = 1000.0  # drum inertia, kg m^2
 RIGID = {"drive_train": one_mass(J), "drum_radius": R, **BRAKE}

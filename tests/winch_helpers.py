@@ -1,4 +1,4 @@
-"""Small helpers shared by the winch tests: chains, a configured unit, a run loop."""
+"""Small helpers shared by the winch tests: chains, a test brake, a configured unit, a run loop."""
 
 from __future__ import annotations
 
@@ -8,6 +8,16 @@ from collections.abc import Callable
 import numpy as np
 
 from wire_fmu.core.units.winch.unit import WinchUnit
+
+BRAKE = {
+    "brake_rim_radius": 0.6,
+    "brake_lever_ratio": 10.0,
+    "brake_efficiency": 0.9,
+    "brake_friction": 0.35,
+    "brake_wrap_angle": 4.7,
+}
+"""A test band brake's parameters: capacity 22.6 N m per newton of lever force paying out,
+4.36 hauling in."""
 
 
 def one_mass(inertia: float, damping: float = 0.0, motor_ratio: float = 1.0) -> str:
