@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -18,6 +19,15 @@ BRAKE = {
 }
 """A test band brake's parameters: capacity 22.6 N m per newton of lever force paying out,
 4.36 hauling in."""
+
+
+def capacities(lever_force: float) -> tuple[float, float]:
+    """:data:`BRAKE`'s capacities paying out and hauling in, N m, at ``lever_force`` (N).
+
+    Eq. (34) and its reverse, written out here.
+    """
+    base = 0.6 * lever_force * 10.0 * 0.9
+    return base * (math.exp(0.35 * 4.7) - 1.0), base * (1.0 - math.exp(-0.35 * 4.7))
 
 
 def one_mass(inertia: float, damping: float = 0.0, motor_ratio: float = 1.0) -> str:
