@@ -1,7 +1,9 @@
-"""Small helpers shared by the hydraulics tests: make a unit, run it, find periods."""
+"""Small helpers shared by the hydraulics tests: make a unit, a gas spring at rest, run it, find
+periods."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -46,6 +48,33 @@ def quiet_cylinder(**params) -> dict:
     )
     base.update(params)
     return base
+
+
+AREA = math.pi * 0.2**2 / 4  # bore of quiet_cylinder, m^2
+P_EQ = 1.0e7  # Pa, working pressure of the gas-spring tests
+F_EQ = -P_EQ * AREA  # rod force that P_EQ holds, N
+V_EQ = 0.2 * 8.0e6 / P_EQ  # gas volume after charging from 8 MPa (Boyle), m^3
+MASS = 1000.0
+DAMPED_LINE = dict(
+    line_diameter=0.028,
+    line_length=5.0,
+    oil_viscosity=0.025,
+    line_friction_factor=0.0,
+    line_loss_coefficient=0.0,
+)
+"""A laminar line giving the gas spring about half its critical damping."""
+
+
+def gas_spring(effects: str = "", **params) -> HydraulicsUnit:
+    """quiet_cylinder at rest in equilibrium at 10 MPa."""
+    return make_unit(effects, force=F_EQ, **quiet_cylinder(**params))
+
+
+def settled_displacement(n: float, extra_force: float) -> float:
+    """Exact static displacement after the rod force changes by ``extra_force`` (N), m."""
+    p1 = P_EQ - extra_force / AREA
+    v1 = V_EQ * (P_EQ / p1) ** (1.0 / n)
+    return (v1 - V_EQ) / AREA
 
 
 def constant_force_cylinder(**params) -> dict:
