@@ -258,36 +258,20 @@ def measure(fmu_path: Path, case: Case, steps: int) -> Row:
 
 
 def table(rows: list[Row]) -> str:
-    """Markdown table of the figures.
+    """Markdown table of the figures, a row per case.
 
     Parameters
     ----------
     rows : list of Row
-        One per case.
+        The cases' figures.
     """
-    headings = (
-        "effects",
-        "states",
-        "Python kernel ms/step",
-        "compiled ms/step",
-        "ratio",
-        "FMU ms/step",
-        "FMI overhead ms",
-        "share",
-    )
     return markdown_table(
-        headings,
+        "effects | states | Python kernel ms/step | compiled ms/step | ratio | FMU ms/step "
+        "| FMI overhead ms | share",
         (
-            (
-                r.label,
-                f"{r.states}",
-                f"{r.python_ms:.3f}",
-                f"{r.core_ms:.3f}",
-                f"{r.kernel_ratio:.1f}",
-                f"{r.fmu_ms:.3f}",
-                f"{r.overhead_ms:.3f}",
-                f"{100 * r.overhead_share:.1f} %",
-            )
+            f"{r.label} | {r.states} | {r.python_ms:.3f} | {r.core_ms:.3f} | "
+            f"{r.kernel_ratio:.1f} | {r.fmu_ms:.3f} | {r.overhead_ms:.3f} | "
+            f"{100 * r.overhead_share:.1f} %"
             for r in rows
         ),
     )

@@ -94,36 +94,22 @@ def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
 
 
 def table(rows: list[SceneFigures]) -> str:
-    """Markdown table of the figures.
+    """Markdown table of the figures: one row per scene.
 
     Parameters
     ----------
     rows : list of SceneFigures
         One per scene.
     """
-    headings = (
-        "scene",
-        "units",
-        "macro steps",
-        "simulated s",
-        "wall s",
-        "real-time factor",
-        "master overhead per unit per step",
-        "set-up and clean-up",
+    header = (
+        "scene | units | macro steps | simulated s | wall s | real-time factor | "
+        "master overhead per unit per step | set-up and clean-up"
     )
     return markdown_table(
-        headings,
+        header,
         (
-            (
-                r.scene,
-                f"{r.units}",
-                f"{r.steps}",
-                f"{r.simulated:g}",
-                f"{r.wall:.2f}",
-                f"{r.real_time_factor:.3g}",
-                f"{r.overhead_us:.1f} µs",
-                f"{r.setup_ms:.0f} ms",
-            )
+            f"{r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
+            f"{r.real_time_factor:.3g} | {r.overhead_us:.1f} µs | {r.setup_ms:.0f} ms"
             for r in rows
         ),
     )

@@ -2,26 +2,27 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 
 __all__ = ["markdown_table"]
 
 
-def markdown_table(headings: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
+def markdown_table(header: str, rows: Iterable[str]) -> str:
     """A Markdown table: the first column aligned left, the others right.
 
     Parameters
     ----------
-    headings : sequence of str
-        The columns' headings.
-    rows : iterable of sequence of str
-        Each row's cells, formatted (with their units where they have any).
+    header : str
+        The columns' headings, separated by ``" | "``.
+    rows : iterable of str
+        Each row's cells, formatted (with their units where they have any) and
+        separated by ``" | "``.
 
     Returns
     -------
     str
         The table's lines, joined by newlines (no newline after the last).
     """
-    lines = ["| " + " | ".join(headings) + " |", "|---|" + "---:|" * (len(headings) - 1)]
-    lines += ["| " + " | ".join(cells) + " |" for cells in rows]
+    lines = [f"| {header} |", "|---|" + "---:|" * header.count(" | ")]
+    lines += [f"| {row} |" for row in rows]
     return "\n".join(lines)
