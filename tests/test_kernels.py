@@ -31,7 +31,7 @@ from wire_fmu.master.validate import validate_scene
 
 from .block_train_helpers import make_unit
 from .hard_case_helpers import build_our_fmus, run_case
-from .test_hard_cases import (
+from .hard_case_scenes import (
     brake_scene,
     break_scene,
     impact_scene,
