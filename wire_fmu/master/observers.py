@@ -8,9 +8,12 @@
     fraction of a second), with energy channels: each bond's
     accumulated energy residual (energy its coupling created), the energy it
     carried, its power, and the sum of the units' ledger residuals.
-    pandas reads it with ``pandas.read_csv``, fmpy with ``fmpy.util.read_csv``.
-    ``metadata.json`` beside it gives units, descriptions, settings and, at
-    the end, the summary (status, per-unit call counts and time).
+    :func:`~wire_fmu.master.results_frame.read_results_frame` reads it as a
+    pandas DataFrame with units, fmpy with ``fmpy.util.read_csv``.
+    ``metadata.json`` beside it gives the unit of every column
+    (``column_units``, see :mod:`~wire_fmu.master.column_units`), the units'
+    variables with their units and descriptions, the settings and, at the end,
+    the summary (status, per-unit call counts and time).
 :class:`Progress`
     a one-line progress bar on stderr.
 """
@@ -25,6 +28,14 @@ import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
+
+from .column_units import (
+    BOND_CHANNEL_UNITS,
+    LEDGER_UNIT,
+    TIME_UNIT,
+    ledger_unit_problems,
+    variable_unit,
+)
 
 if TYPE_CHECKING:
     from .run_result import RunResult
@@ -122,6 +133,8 @@ class CsvRecorder:
         self._rows: list[tuple] = []  # recorded, not yet written (see _row)
         self._written = -math.inf  # wall-clock time of the last write, s
         self.columns: list[str] = []
+        self.units: dict[str, str] = {}
+        """Unit of each column, by column (see :mod:`~wire_fmu.master.column_units`)."""
 
     # -- observer protocol -----------------------------------------------------
     def on_start(self, sim: Simulation) -> None:
@@ -143,6 +156,7 @@ class CsvRecorder:
         self._ledger_of = [self._ledger_at.get(u) for u in self._read_units]
         kinds = [sim.slaves[u].variables[n].type for u, names in self._plan.items() for n in names]
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
+        self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
         self._file = self.csv_path.open("w", newline="")
         self._writer = csv.writer(self._file)
@@ -199,6 +213,23 @@ class CsvRecorder:
             if "energy_balance" in slave.variables and "energy_balance" not in plan[name]:
                 plan[name].append("energy_balance")
         return plan
+
+    def _column_units(self, sim: Simulation) -> dict[str, str]:
+        """Unit of each column: the unit variables' as their FMUs declare them, the master's own."""
+        units = {"time": TIME_UNIT}
+        for unit, names in self._plan.items():
+            variables = sim.slaves[unit].variables
+            units.update({f"{unit}.{n}": variable_unit(variables[n]) for n in names})
+        for channel in BOND_CHANNELS:
+            units.update(
+                {f"bond.{b}.{channel}": BOND_CHANNEL_UNITS[channel] for b in sim.energy.bonds}
+            )
+        if self._ledger_units:
+            units[LEDGER_CHANNEL] = LEDGER_UNIT
+            ledgers = {u: sim.slaves[u].variables["energy_balance"] for u in self._ledger_units}
+            for problem in ledger_unit_problems(ledgers):
+                logger.warning(problem)
+        return units
 
     def _row(self, sim: Simulation) -> None:
         """Record a row; it is put together and written with the next batch (:meth:`_write_rows`).
@@ -261,7 +292,7 @@ class CsvRecorder:
         for unit, slave in sim.slaves.items():
             for v in slave.model_description.modelVariables:
                 variables[f"{unit}.{v.name}"] = {
-                    "unit": v.unit or "",
+                    "unit": variable_unit(v),
                     "description": v.description or "",
                     "causality": v.causality,
                 }
@@ -271,6 +302,7 @@ class CsvRecorder:
             "run": {k: getattr(sim.run_settings, k) for k in sim.run_settings.__dataclass_fields__},
             "order": sim.algorithm.order,
             "columns": self.columns,
+            "column_units": self.units,
             "variables": variables,
         }
         if result is not None:

@@ -3,6 +3,9 @@
 >>> from wire_fmu.master.run import run_scene          # doctest: +SKIP
 >>> outcome = run_scene("riser_tensioner")             # doctest: +SKIP
 >>> outcome.csv_path                                   # doctest: +SKIP
+>>> frame = outcome.frame()                            # doctest: +SKIP
+>>> frame.attrs["units"]["rope.path_end.tension"]      # doctest: +SKIP
+'N'
 
 A scene is named (one we ship, see :func:`shipped_scenes`) or given by path.
 """
@@ -12,13 +15,18 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .catalog import DEFAULT_FMU_DIR
 from .observers import CsvRecorder, Progress
+from .results_frame import IncompleteResultsWarning, ResultsError, read_results_frame
 from .run_result import RunResult
 from .scene import Scene, SceneError, read_scene
 from .simulation import Simulation
 from .validate import validate_scene
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "SCENE_DIR",
@@ -30,6 +38,9 @@ __all__ = [
     "load_scene_file",
     "read_scene_file",
     "check_scene",
+    "read_results_frame",
+    "ResultsError",
+    "IncompleteResultsWarning",
 ]
 
 logger = logging.getLogger(__name__)
@@ -161,6 +172,27 @@ class Outcome:
     csv_path: Path
     plots: list[Path] = field(default_factory=list)
     simulation: Simulation | None = None
+
+    def frame(self) -> pd.DataFrame:
+        """The run's results as a DataFrame indexed by time (s), with units.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per recorded column, ``attrs["units"]`` the unit of each
+            (see :func:`~wire_fmu.master.results_frame.read_results_frame`).
+
+        Raises
+        ------
+        ResultsError
+            When the run recorded nothing (it failed in its initialisation).
+
+        Warns
+        -----
+        IncompleteResultsWarning
+            When the run did not finish: the rows it recorded are read.
+        """
+        return read_results_frame(self.directory)
 
 
 def with_run_settings(scene: Scene, **changes) -> Scene:
