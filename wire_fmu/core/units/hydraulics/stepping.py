@@ -159,7 +159,6 @@ class RefinedStepping:
             max(1, math.ceil(count - 1e-9)),  # the grid of CompiledFixedStep
             self.state,
             self._directions,
-            settings.event_time_tolerance,
             self.kernel_data(),
         )
         if taken:

@@ -1,0 +1,257 @@
+"""A communication step in which nothing happens, compiled in one call that allocates once.
+
+What :meth:`RefinedStepping._quiet_step
+<wire_fmu.core.units.hydraulics.stepping.RefinedStepping._quiet_step>` asks of the
+kernel: check the limits, settle the seal (project), integrate over ``[t0, t1]`` as
+:class:`~wire_fmu.core.framework.compiled_step.CompiledFixedStep` would (``n`` equal
+steps of RK4 or ROS2, ROS2's finite-difference Jacobian at the start and its
+``(I - g h J)^-1`` made again whenever the step length changes), and report the end. As
+soon as anything happens (a limit, a breakaway, a guard crossing, a non-finite step) it
+gives up and leaves the step to the general path, which locates events.
+
+The steps are those of :func:`~wire_fmu.core.framework.compiled_step.advance_to_event`,
+with the same stage arithmetic element for element, but
+
+* the arrays are made once per call and every stage writes into them;
+* the few step lengths of the grid (``t_next - t`` differs between steps in its last
+  bits) each get their ``(I - g h J)^-1`` once, kept while the call lasts, instead of
+  once every time the length changes: the same matrices, made fewer times;
+* every state is evaluated once: the guards at the end of a step, the first stage of the
+  next (the right-hand side does not depend on time) and the report at the end of the
+  communication step come from one evaluation, as do the limits, the Jacobian's base
+  point, the first guards and the first stage at the start;
+* the products with ``(I - g h J)^-1`` go into those arrays (the same BLAS ``gemv``).
+
+The results are those of the shared loop to the last bit: the same numbers in the same
+operations in the same order (the products and the inverse through the same BLAS and
+LAPACK routines). That matters beyond rounding: the located events, and so everything
+after the next event, depend on every bit of the state the quiet steps leave.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
+from wire_fmu.core.framework.fixed_step import ROS2
+from wire_fmu.core.units.hydraulics.kernel_arrays import REPORT
+from wire_fmu.core.units.hydraulics.kernel_hybrid import (
+    breaks_away,
+    derivative_into,
+    first_limit,
+    guard_count,
+    guards_into,
+    hold,
+    report_into,
+)
+from wire_fmu.core.units.hydraulics.kernel_physics import (
+    Cylinder,
+    accelerate,
+    cylinder,
+    evaluate,
+    seal_stuck,
+)
+
+__all__ = ["quiet_step"]
+
+_ROS2 = COMPILED_METHODS["ros2"]
+_GAMMA = ROS2.GAMMA
+_VECTORS = 7
+"""Rows of the work vectors: state, next state, slope at the state, stage state and three
+stage slopes (ROS2: ``k1``, ``f(stage) - 2 k1``, ``k2``; RK4: ``k2``, ``k3``, ``k4``)."""
+_KEPT = 4
+"""How many ``(I - g h J)^-1`` a call keeps, one per step length (the grid of a
+communication step has two or three)."""
+
+
+@jit
+def _slope_into(x: np.ndarray, out: np.ndarray, c: Cylinder) -> None:
+    """The state derivative at ``x`` into ``out`` (what ``kernel_hybrid.rhs`` returns)."""
+    point = evaluate(x, c)
+    acc, _, friction_loss = accelerate(point, c)
+    derivative_into(out, point, acc, friction_loss, c)
+
+
+@jit
+def _evaluate_into(x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cylinder):
+    """Evaluate at ``x`` once: its derivative into ``slope``, its guards into ``values``.
+
+    Returns the point, the acceleration (m/s^2) and the seal force (N), for the report.
+    """
+    point = evaluate(x, c)
+    acc, link, friction_loss = accelerate(point, c)
+    derivative_into(slope, point, acc, friction_loss, c)
+    guards_into(values, point, acc, link, c)
+    return point, acc, link
+
+
+@jit
+def _jacobian_into(jac, x, f0, probe, slope, c: Cylinder) -> None:
+    """Forward-difference Jacobian at ``x`` with ``f0`` the slope there (``_jacobian``)."""
+    n = x.size
+    for j in range(n):
+        dx = 1e-7 * max(1.0, abs(x[j]))
+        probe[:] = x
+        probe[j] += dx
+        _slope_into(probe, slope, c)
+        for i in range(n):
+            jac[i, j] = (slope[i] - f0[i]) / dx
+
+
+@jit
+def _w_inverse_into(w_inv, jac, h: float, w, identity) -> None:
+    """``(I - g h J)^-1`` into ``w_inv`` as the shared loop makes it (``w``: work).
+
+    LAPACK's ``gesv`` solves ``W X = I``, as ``compiled_step._w_inverse`` and numpy's
+    ``inv`` do, so that the steps are the same to the last bit.
+    """
+    n = jac.shape[0]
+    gh = _GAMMA * h
+    for i in range(n):
+        for j in range(n):
+            w[i, j] = identity[i, j] - gh * jac[i, j]
+    w_inv[:, :] = np.linalg.solve(w, identity)
+
+
+@jit
+def _kept(lengths: np.ndarray, h: float) -> int:
+    """Which kept inverse is for the step length ``h`` (s), -1 if none."""
+    for i in range(lengths.size):
+        if lengths[i] == h:
+            return i
+    return -1
+
+
+@jit
+def _ros2_step(out, state, slope, h, w_inv, stage, k1, rest, k2, c: Cylinder) -> None:
+    """One ROS2 step of length ``h`` from ``state`` (slope there: ``slope``) into ``out``."""
+    n = state.size
+    np.dot(w_inv, slope, k1)
+    for i in range(n):
+        stage[i] = state[i] + h * k1[i]
+    _slope_into(stage, rest, c)
+    for i in range(n):
+        rest[i] = rest[i] - 2.0 * k1[i]
+    np.dot(w_inv, rest, k2)
+    for i in range(n):
+        out[i] = state[i] + h * (1.5 * k1[i] + 0.5 * k2[i])
+
+
+@jit
+def _rk4_step(out, state, slope, h, stage, k2, k3, k4, c: Cylinder) -> None:
+    """One RK4 step of length ``h`` from ``state`` (slope there: ``slope``) into ``out``."""
+    n = state.size
+    half = 0.5 * h
+    for i in range(n):
+        stage[i] = state[i] + half * slope[i]
+    _slope_into(stage, k2, c)
+    for i in range(n):
+        stage[i] = state[i] + half * k2[i]
+    _slope_into(stage, k3, c)
+    for i in range(n):
+        stage[i] = state[i] + h * k3[i]
+    _slope_into(stage, k4, c)
+    sixth = h / 6.0
+    for i in range(n):
+        out[i] = state[i] + sixth * (slope[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+
+
+@jit
+def _finite(x: np.ndarray) -> bool:
+    for value in x:
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+@jit
+def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
+    """Whether a guard crossed between two evaluations (``compiled_step._fired``)."""
+    for i in range(g0.size):
+        if directions[i] < 0:
+            if g0[i] >= 0.0 and g1[i] < 0.0:
+                return True
+        elif np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0:
+            return True
+    return False
+
+
+@jit
+def quiet_step(method, t0, t1, n, x, directions, data):
+    """A communication step in which nothing happens, in one call.
+
+    Parameters
+    ----------
+    method : int
+        A value of ``COMPILED_METHODS``.
+    t0, t1 : float
+        The communication step, s.
+    n : int
+        Number of equal internal steps over ``[t0, t1]``.
+    x : numpy.ndarray
+        State at ``t0`` (not changed).
+    directions : numpy.ndarray
+        Guard directions.
+    data : tuple
+        ``(parameters, layout, held)`` (see :mod:`.kernel_arrays`), the seal held where
+        ``x`` is.
+
+    Returns
+    -------
+    tuple
+        ``(True, state at t1, report)`` (``kernel_hybrid.report``), or ``(False, x,
+        empty)`` when a limit is reached, the seal lets go, a guard fires or a step is not
+        finite.
+    """
+    nothing = np.empty(0)
+    c = cylinder(data)
+    size = x.size
+    vectors = np.empty((_VECTORS, size))
+    state, following, slope = vectors[0], vectors[1], vectors[2]
+    stage, first, second, third = vectors[3], vectors[4], vectors[5], vectors[6]
+    matrices = np.empty((2 + _KEPT, size, size))
+    jac, w = matrices[0], matrices[1]
+    identity = np.eye(size)
+    lengths = np.full(_KEPT, math.nan)  # the step length each kept inverse is for, s
+    made = 0
+    values = np.empty((2, guard_count(data[1])))
+    g0, g1 = values[0], values[1]
+    point, acc, link = _evaluate_into(x, slope, g0, c)
+    if first_limit(g0, c) >= 0 or breaks_away(point.force, c):
+        return False, x, nothing
+    state[:] = x
+    if seal_stuck(c):  # the rod is held where it stuck, at rest: evaluate it there
+        hold(state, c)
+        point, acc, link = _evaluate_into(state, slope, g0, c)
+    if method == _ROS2:
+        _jacobian_into(jac, state, slope, stage, first, c)
+    t = t0
+    for k in range(n):
+        t_next = t0 + (t1 - t0) * (k + 1) / n
+        h = t_next - t
+        if method == _ROS2:
+            kept = _kept(lengths, h)
+            if kept < 0:
+                kept = made % _KEPT
+                _w_inverse_into(matrices[2 + kept], jac, h, w, identity)
+                lengths[kept] = h
+                made += 1
+            w_inv = matrices[2 + kept]
+            _ros2_step(following, state, slope, h, w_inv, stage, first, second, third, c)
+        else:
+            _rk4_step(following, state, slope, h, stage, first, second, third, c)
+        hold(following, c)
+        if not _finite(following):
+            return False, x, nothing
+        point, acc, link = _evaluate_into(following, slope, g1, c)
+        if _fired(g0, g1, directions):
+            return False, x, nothing
+        state, following = following, state
+        g0, g1 = g1, g0
+        t = t_next
+    out = np.empty(len(REPORT))
+    report_into(out, point, acc, link, c)
+    return True, state.copy(), out
