@@ -45,10 +45,11 @@ SI = {"s": Counter(s=1), "J": Counter(kg=1, m=2, s=-2), "W": Counter(kg=1, m=2, 
 
 @pytest.fixture(scope="module")
 def outcome(tmp_path_factory) -> Outcome:
-    """The drawworks scene run for :data:`STOP_TIME` on FMUs built for this module."""
+    """The drawworks scene run for :data:`STOP_TIME` on FMUs built for this module (the
+    FMU folder given as a string, as a user would type it)."""
     fmu_dir = tmp_path_factory.mktemp("results_frame_fmus")
     out = tmp_path_factory.mktemp("results_frame_run") / "drawworks"
-    done = run_scene("drawworks", out, fmu_dir=fmu_dir, stop_time=STOP_TIME, plots=False)
+    done = run_scene("drawworks", out, fmu_dir=str(fmu_dir), stop_time=STOP_TIME, plots=False)
     assert done.result.status == "finished", done.result.message
     return done
 

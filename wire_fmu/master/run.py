@@ -227,7 +227,7 @@ def run_scene(
     *,
     progress: bool = False,
     plots: bool = True,
-    fmu_dir: Path = DEFAULT_FMU_DIR,
+    fmu_dir: str | Path = DEFAULT_FMU_DIR,
     observers=(),
     **run_overrides,
 ) -> Outcome:
@@ -243,7 +243,7 @@ def run_scene(
         Show a progress bar on stderr.
     plots : bool
         Draw the scene's plots as PNG files after the run.
-    fmu_dir : Path
+    fmu_dir : str or Path
         Where our FMUs are built and cached.
     observers : sequence
         More observers (see :class:`~wire_fmu.master.observers.Observer`).
@@ -261,7 +261,7 @@ def run_scene(
         scene = with_run_settings(scene, **run_overrides)
     directory = Path(results) if results else Path("results") / scene.name
     make_results_folder(directory)
-    structure = validate_scene(scene, fmu_dir)
+    structure = validate_scene(scene, Path(fmu_dir))
     recorder = CsvRecorder(directory, scene.run.output_interval)
     chain = [recorder, *observers] + ([Progress()] if progress else [])
     sim = Simulation(scene, structure, chain)
