@@ -205,8 +205,8 @@ Point = namedtuple(
         "stored",
     ),
 )
-"""The model at one state (see ``hydraulics.model._Point``; ``stored`` without the gas,
-kinetic, pad and potential terms, which :func:`stored_energy` adds)."""
+"""The model at one state (see ``hydraulics.reference_physics._Point``; ``stored`` without
+the gas, kinetic, pad and potential terms, which :func:`stored_energy` adds)."""
 
 
 @jit
