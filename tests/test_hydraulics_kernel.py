@@ -10,7 +10,9 @@ with the load let go (the rod runs out until the oil cavitates behind a line or 
 meets the extension end). Every Real output must agree to a relative 1e-10 of its
 largest magnitude over the run, and a refused step must be refused at the same step
 with the same message. The kernel's functions are also compared one by one in every
-mode, at states the manoeuvres do not visit.
+mode, at states the manoeuvres do not visit, and the one-call quiet step must give the
+shared fixed-step loop's numbers to the last bit (the events located after it depend on
+every bit of the state it leaves).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import pytest
 
 from wire_fmu.core.framework import compiled
 from wire_fmu.core.framework.compiled import KERNEL_ENV
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, STATUS_DONE
 from wire_fmu.core.units.hydraulics import kernel
 from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 from wire_fmu.core.units.hydraulics.unit import DEFAULT_ROD_FORCE, HydraulicsUnit
@@ -198,3 +201,37 @@ def test_kernel_functions_match_in_every_mode(monkeypatch, effects):
                 np.testing.assert_allclose(got, want, rtol=1e-13, atol=0.0)
             for name, want in python_report.items():
                 assert fast_report[name] == pytest.approx(want, rel=1e-13, abs=0.0), name
+
+
+@pytest.mark.parametrize("method", sorted(COMPILED_METHODS))
+@pytest.mark.parametrize("effects", COMBINATIONS, ids=lambda e: e or "none")
+def test_quiet_step_gives_the_shared_loop_to_the_last_bit(monkeypatch, effects, method):
+    """The quiet step and the shared loop (``kernel.advance``) from the same start: the same
+    end state and report, bit for bit, wherever nothing happens in the step."""
+    monkeypatch.setenv(KERNEL_ENV, "compiled")
+    unit = make_unit(effects, force=DEFAULT_ROD_FORCE, initial_position=0.25, solver=method)
+    model, step, code = unit.model, 0.01, COMPILED_METHODS[method]
+    force, taken = swinging(0.30), 0
+    for i in range(60):
+        t0, t1 = i * step, (i + 1) * step
+        model.force = unit.values["rod.force"] = force(5 * i)
+        if model.seal is not None:
+            model.seal.held_position = float(model.state[0])  # as the quiet step does
+        x, data, directions = model.state, model.kernel_data(), model.guard_directions()
+        n = model.solver.internal_count(t0, t1)
+        quiet, end, values = kernel.quiet_step(code, t0, t1, n, x, directions, data)
+        start = kernel.project(x.copy(), data)
+        tol = model.settings.event_time_tolerance
+        shared = kernel.advance(code, t0, t1, n, 0, t0, start, directions, tol, data)
+        violated, rod_force = kernel.limits_and_force(x, data)
+        held = model.seal is not None and model.seal.stuck
+        breaks_away = held and abs(rod_force) > model.seal.spec.static
+        if violated < 0 and not breaks_away:
+            assert quiet == (shared[0] == STATUS_DONE), i
+        if quiet:
+            taken += 1
+            assert end.tobytes() == shared[1].tobytes(), i
+            assert values.tobytes() == kernel.report(shared[1], data).tobytes(), i
+        if not unit.advance(t0, step).success:
+            break
+    assert taken > 0
