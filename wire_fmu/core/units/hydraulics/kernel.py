@@ -4,18 +4,19 @@ The same physics as :class:`~wire_fmu.core.units.hydraulics.model.HydraulicsMode
 (``evaluate``, ``rhs``, ``guards``, ``project``, ``report``: the readable
 reference), for every effect set of the package, in four modules:
 
-=======================  ===========================================================
-module                   what it holds
-=======================  ===========================================================
-:mod:`.kernel_arrays`    the tuple ``data = (parameters, layout, held)`` every
-                         function takes: its indices and how it is built from the
-                         model (:func:`kernel_data`)
-:mod:`.kernel_physics`   the model at one state: pressures, flow, forces, losses,
-                         acceleration and stored energy, in scalars
-:mod:`.kernel_hybrid`    derivative, guards, projection, limits and report, each
-                         written from one evaluation into an array given
+=========================  ===========================================================
+module                     what it holds
+=========================  ===========================================================
+:mod:`.kernel_arrays`      the tuple ``data = (parameters, layout, held)`` every
+                           entry point takes: its indices and how it is built from
+                           the model (:func:`kernel_data`)
+:mod:`.kernel_physics`     the model at one state: pressures, flow, forces, losses,
+                           acceleration and stored energy, in scalars read once
+                           from ``data``
+:mod:`.kernel_hybrid`      derivative, guards, projection, limits and report, each
+                           written from one evaluation into an array given
 :mod:`.kernel_quiet_step`  a whole step in which nothing happens, in one call
-=======================  ===========================================================
+=========================  ===========================================================
 
 What Python calls, all here: :func:`rhs` and :func:`guards` (the hybrid protocol, for
 the SciPy solvers and a monolithic model), :func:`limits_and_force` (at the start of a

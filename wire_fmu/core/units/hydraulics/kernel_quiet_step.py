@@ -1,4 +1,4 @@
-"""A communication step in which nothing happens, compiled in one call that allocates once.
+"""A communication step in which nothing happens, compiled in one call that makes its arrays once.
 
 What :meth:`RefinedStepping._quiet_step
 <wire_fmu.core.units.hydraulics.stepping.RefinedStepping._quiet_step>` asks of the
@@ -64,7 +64,7 @@ _VECTORS = 7
 stage slopes (ROS2: ``k1``, ``f(stage) - 2 k1``, ``k2``; RK4: ``k2``, ``k3``, ``k4``)."""
 _KEPT = 4
 """How many ``(I - g h J)^-1`` a call keeps, one per step length (the grid of a
-communication step has two or three)."""
+communication step usually has two or three)."""
 
 
 @jit
