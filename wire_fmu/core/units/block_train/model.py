@@ -34,24 +34,25 @@ The equations of motion are Lagrange's with the rope strain energy of
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.components.rope import rope_forces
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import (
-    STATUS_PYTHON,
-    CompiledFixedStep,
-    KernelModel,
-)
+from wire_fmu.core.framework.compiled_step import CompiledFixedStep, KernelModel
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.block_train import kernel
+from wire_fmu.core.units.block_train.compiled_model import CompiledBlockTrain
+from wire_fmu.core.units.block_train.friction_links import FrictionLinks
 from wire_fmu.core.units.block_train.modes import ModeSwitching
+from wire_fmu.core.units.block_train.ordered_sums import (
+    ordered_matmul,
+    ordered_matvec,
+    ordered_vecmat,
+)
 from wire_fmu.core.units.block_train.path import ReevedPath
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
 from wire_fmu.core.units.block_train.start import StartingState
@@ -93,7 +94,9 @@ class BlockTrainInputs:
     mover_velocity: dict[str, float]
 
 
-class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
+class BlockTrainModel(
+    KernelModel, CompiledBlockTrain, FrictionLinks, ReevedPath, ModeSwitching, StartingState
+):
     """Hybrid ODE of a block train; see the module docstring.
 
     Parameters
@@ -147,94 +150,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         self.compiled = self.kernel_applies() and use_compiled("block train")
         self.solver = self.kernel_solver(solver)
 
-    # ------------------------------------------------------------- kernels
-    def kernel_applies(self) -> bool:
-        """Whether the compiled kernel covers this block train's effects.
-
-        It does with lengths linear in the body motion or recomputed by the planar
-        path (``moving_geometry`` without ``spatial_geometry``), with or without
-        friction links; see :mod:`~wire_fmu.core.units.block_train.kernel`.
-        """
-        return not self.moving or self._planar is not None
-
-    def _build_kernel_arrays(self) -> None:
-        """The parameters of :mod:`~wire_fmu.core.units.block_train.kernel` as flat arrays."""
-        moving = int(self.moving and self._planar is not None)
-        self.kernel_sizes = np.array(
-            [self.n_coords, len(self.blocks), len(self.drivers), moving], dtype=np.int64
-        )
-        self.kernel_rope = np.array(
-            [self.rope.axial_stiffness, self.rope.damping, self.rope.breaking_load]
-        )
-        blocks = np.zeros((len(self.blocks), 5))
-        for j, b in enumerate(self.blocks):
-            blocks[j, :2] = self.block_weight[j], b.position
-            if b.floor is not None:
-                blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
-        self.kernel_blocks = blocks
-        self._build_kernel_geometry(bool(moving))
-
-    def _build_kernel_geometry(self, moving: bool) -> None:
-        """The planar path of :meth:`_planar_segment_lengths` as flat arrays (empty if fixed)."""
-        segment_span = [self.span_of_segment[k] for k in range(self.n_segments)]
-        self.kernel_segment_span = np.array(segment_span, dtype=np.int64)
-        self.kernel_geometry_step = np.array([self.GEOMETRY_STEP])
-        if not moving:
-            self.kernel_path_nodes = np.zeros((0, 3))
-            self.kernel_carriers = np.zeros((0, 1), dtype=np.int64)
-            self.kernel_body_dirs = np.zeros((0, 2))
-            return
-        xy0, radii, dof_of_node, dirs, _ = self._planar
-        self.kernel_path_nodes = np.array([(x, z, r) for (x, z), r in zip(xy0, radii, strict=True)])
-        width = max(1, max(len(dofs) for dofs in dof_of_node))
-        carriers = np.full((self.n_nodes, width), -1, dtype=np.int64)
-        for k, dofs in enumerate(dof_of_node):
-            carriers[k, : len(dofs)] = dofs
-        self.kernel_carriers = carriers
-        self.kernel_body_dirs = np.array(dirs, dtype=float).reshape(len(self.body_dof), 2)
-
     # ------------------------------------------------------------------ build
-    def _build_friction(self) -> None:
-        links = []
-        self.link_kind: list[tuple[str, int]] = []
-        if "bearing_friction" in self.effects:
-            for k, idx in self.rim_index.items():
-                links.append(FrictionLink(f"sheave {self.nodes[k].name!r} bearing", idx, GROUND))
-                self.link_kind.append(("bearing", k))
-        if "rope_slip" in self.effects:
-            for k, idx in self.rope_index.items():
-                name = f"rope on sheave {self.nodes[k].name!r}"
-                links.append(FrictionLink(name, idx, self.rim_index[k]))
-                self.link_kind.append(("groove", k))
-        self.friction = StickSlip(self.masses, tuple(links))
-        sheaves = self.reeving.sheaves
-        self._bearing_c = np.zeros(len(links))
-        self._bearing_m0 = np.zeros(len(links))
-        self._capstan = np.zeros(len(links))
-        for i, (kind, k) in enumerate(self.link_kind):
-            s = sheaves[self.nodes[k].name]
-            if kind == "bearing":
-                self._bearing_m0[i] = s.bearing_torque / s.radius
-                self._bearing_c[i] = (1.0 - s.efficiency) / (1.0 + s.efficiency)
-            else:
-                self._capstan[i] = math.expm1(s.groove_friction * self.wrap_angles[k])
-        self._link_span_in = np.array(
-            [self.span_of_segment[k - 1] for _, k in self.link_kind], dtype=int
-        )
-        self._link_span_out = np.array(
-            [self.span_of_segment[k] for _, k in self.link_kind], dtype=int
-        )
-        self.kernel_link_index = np.array(
-            [
-                (link.body, link.other, self._link_span_in[i], self._link_span_out[i])
-                for i, link in enumerate(links)
-            ],
-            dtype=np.int64,
-        ).reshape(len(links), 4)
-        self.kernel_link_params = np.column_stack(
-            (self._bearing_m0, self._bearing_c, self._capstan)
-        ).reshape(len(links), 3)
-
     @property
     def broken(self) -> list[bool]:
         """Whether each rope span has broken."""
@@ -337,7 +253,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             ``d lengths / d y``, one row per span and one column per body, 1.
         """
         if not self.moving:
-            return self.span_length0 + _ordered_matvec(self.span_jacobian, y), self.span_jacobian
+            return self.span_length0 + ordered_matvec(self.span_jacobian, y), self.span_jacobian
         lengths = self._planar_segment_lengths if self._planar else self._spatial_segment_lengths
         seg = lengths(y)
         jac = np.zeros((self.n_segments, len(y)))
@@ -346,7 +262,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             step = np.zeros(len(y))
             step[b] = h
             jac[:, b] = (lengths(y + step) - lengths(y - step)) / (2 * h)
-        return _ordered_matvec(self.span_matrix, seg), _ordered_matmul(self.span_matrix, jac)
+        return ordered_matvec(self.span_matrix, seg), ordered_matmul(self.span_matrix, jac)
 
     def _spatial_segment_lengths(self, y: np.ndarray) -> np.ndarray:
         return self._segment_lengths(dict(zip(self.body_dof, y, strict=True)))[0]
@@ -382,7 +298,7 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         big_l, dl_dy = self.span_lengths(y)
         flow = np.concatenate((q, self._line_s0 + self._line_rate * dt))
         flow_rate = np.concatenate((v, self._line_rate))
-        small_l = self.offsets + _ordered_matvec(self.flow_matrix, flow)
+        small_l = self.offsets + ordered_matvec(self.flow_matrix, flow)
         if np.any(small_l <= 0.0):
             i = int(np.argmin(small_l))
             raise FloatingPointError(f"rope span {i} has no unstretched rope left")
@@ -391,16 +307,16 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             self.rope,
             big_l,
             small_l,
-            _ordered_matvec(dl_dy, ydot),
-            _ordered_matvec(self.flow_matrix, flow_rate),
+            ordered_matvec(dl_dy, ydot),
+            ordered_matvec(self.flow_matrix, flow_rate),
             self.taut_mask & intact,
         )
         tension = rf.tension * intact
         g_big = rf.force_on_length * intact
         g_small = rf.force_on_unstretched * intact
         span_energy = rf.energy * intact
-        body_force = -_ordered_vecmat(g_big, dl_dy)
-        generalised = _ordered_vecmat(g_small, self.flow_matrix)  # on [q, s_line_a, s_line_b]
+        body_force = -ordered_vecmat(g_big, dl_dy)
+        generalised = ordered_vecmat(g_small, self.flow_matrix)  # on [q, s_line_a, s_line_b]
         forces = generalised[:n].copy()
         forces[:nb] += body_force[:nb] + self.block_weight
         potential = -float(self.block_weight @ q[:nb])
@@ -438,40 +354,6 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
             "y": y,
             "ydot": ydot,
         }
-
-    def _evaluate_compiled(self, t: float, x: np.ndarray) -> dict:
-        """:meth:`evaluate` by the compiled kernel (the Python one names a span run out)."""
-        result = kernel.evaluate(t, x, self.kernel_data())
-        forces, tension, stretch, line_force, body_force = (result[i] for i in (0, 1, 4, 5, 6))
-        depth, trial_contact, span_energy, potential, loss = (result[i] for i in (7, 8, 9, 10, 11))
-        if not result[13]:  # the Python kernel raises the error that names the span
-            return self._python_evaluate(t, x)
-        n, nb = self.n_coords, len(self.blocks)
-        dt = t - self._t_step
-        return {
-            "forces": forces,
-            "tension": tension,
-            "stretch": stretch,
-            "line_force": line_force,
-            "depth": depth,
-            "trial_contact": trial_contact,
-            "body_force": body_force,
-            "contact": np.where(self.contact_mask, trial_contact, 0.0),
-            "rope_energy": float(span_energy.sum()),
-            "span_energy": span_energy,
-            "potential": potential,
-            "loss": loss,
-            "y": np.concatenate((x[:nb], self._mover_y0 + self._mover_v * dt)),
-            "ydot": np.concatenate((x[n : n + nb], self._mover_v)),
-        }
-
-    def _capacities(self, tension: np.ndarray) -> np.ndarray:
-        t_in, t_out = tension[self._link_span_in], tension[self._link_span_out]
-        return (
-            self._bearing_m0
-            + self._bearing_c * (t_in + t_out)
-            + self._capstan * np.minimum(t_in, t_out)
-        )
 
     def _external_power(self, ev: dict) -> float:
         """Power delivered into the block train through its ports, W."""
@@ -550,80 +432,9 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         self.state = x
         return events
 
-    def _quiet_step(self, t: float, h: float, inputs: BlockTrainInputs) -> bool:
-        """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's.
-
-        Events inside the step are switched by :meth:`handle_events` as in any step:
-        the compiled loop goes on from the first one.
-        """
-        held = self._held(t, inputs)
-        solver = self.solver
-        t1 = t + h
-        n = solver.internal_count(t, t1)
-        result = kernel.quiet_step(
-            solver.method,
-            t,
-            t1,
-            n,
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            self.kernel_data(),
-            held,
-        )
-        if result[0] == STATUS_PYTHON:
-            return False
-        self._hold(t, inputs, held)
-        if self.friction.links:
-            self._held_positions = self.state[: self.n_coords].copy()
-        self.state, self._quiet_events, values = solver.finish_quiet_step(
-            self, t, self.state, t1, result
-        )
-        if values is not None:
-            self._step_summary = (t1, self.state, values)
-        return True
-
     def _input_energy(self, t: float) -> float:
         """The part of the stored energy that inputs can change at once (rope strain), J."""
         return self.summary(t, self.state)[0]
-
-    def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
-        """What the outputs need at ``(t, x)``.
-
-        Parameters
-        ----------
-        t : float
-            Time, s.
-        x : numpy.ndarray
-            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
-
-        Returns
-        -------
-        rope_energy : float
-            Strain energy of the rope, J.
-        potential : float
-            Gravitational and floor-contact energy, J.
-        tension : numpy.ndarray
-            Tension of each span, N.
-        body_force : numpy.ndarray
-            Force of the rope on each body along its direction (blocks, then driven), N.
-        """
-        if self.compiled:
-            done = self._step_summary
-            if done is not None and done[0] == t and done[1] is x:
-                values = done[2]
-            else:
-                values = kernel.summary(t, x, self.kernel_data())
-            if math.isfinite(values[0]):
-                n_spans = len(self.spans)
-                return values[0], values[1], values[2 : 2 + n_spans], values[2 + n_spans :]
-        ev = self.evaluate(t, x) if not self.compiled else self._python_evaluate(t, x)
-        return ev["rope_energy"], ev["potential"], ev["tension"], ev["body_force"]
-
-    def _python_evaluate(self, t: float, x: np.ndarray) -> dict:
-        """:meth:`evaluate` by the Python kernel."""
-        with self.python_kernel():
-            return self.evaluate(t, x)
 
     def held_inputs(self) -> dict:
         """The inputs held since the last step started, as plain data."""
@@ -665,33 +476,6 @@ class BlockTrainModel(KernelModel, ReevedPath, ModeSwitching, StartingState):
         rope_energy, potential, _, _ = self.summary(t, self.state)
         kinetic = 0.5 * float(self.masses @ self.v**2)
         return kinetic + rope_energy + potential
-
-
-# The products below are summed term after term, as the compiled kernel sums them, not
-# in the blocked order of BLAS: the two kernels then agree to the last bit, which matters
-# because the solvers' finite-difference Jacobians turn a last-bit difference of the
-# right-hand side into a difference of 1e-9 of the Jacobian.
-
-
-def _ordered_matvec(a: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``a @ v``, summed over the columns in order."""
-    if a.shape[1] == 0:
-        return np.zeros(a.shape[0])
-    return np.cumsum(a * v, axis=1)[:, -1]
-
-
-def _ordered_vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """``v @ a``, summed over the rows in order."""
-    if a.shape[0] == 0:
-        return np.zeros(a.shape[1])
-    return np.cumsum(v[:, None] * a, axis=0)[-1]
-
-
-def _ordered_matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a @ b``, summed over the inner index in order."""
-    if a.shape[1] == 0:
-        return np.zeros((a.shape[0], b.shape[1]))
-    return np.cumsum(a[:, :, None] * b[None, :, :], axis=1)[:, -1, :]
 
 
 def _floor_contact(floor, position: float, velocity: float):

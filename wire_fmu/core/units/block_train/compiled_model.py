@@ -1,0 +1,169 @@
+"""The block train's side of its compiled kernel: the flat arrays, the one-call step.
+
+:class:`CompiledBlockTrain` is the part of
+:class:`~wire_fmu.core.units.block_train.model.BlockTrainModel` that says whether
+:mod:`~wire_fmu.core.units.block_train.kernel` covers the model, builds the arrays the
+kernel reads, takes a quiet step in one compiled call and keeps its summary for the
+outputs.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled_step import STATUS_PYTHON
+from wire_fmu.core.units.block_train import kernel
+
+if TYPE_CHECKING:
+    from wire_fmu.core.units.block_train.model import BlockTrainInputs
+
+__all__ = ["CompiledBlockTrain"]
+
+
+class CompiledBlockTrain:
+    """Kernel arrays, compiled evaluation and the one-call step (a mixin of the model)."""
+
+    def kernel_applies(self) -> bool:
+        """Whether the compiled kernel covers this block train's effects.
+
+        It does with lengths linear in the body motion or recomputed by the planar
+        path (``moving_geometry`` without ``spatial_geometry``), with or without
+        friction links; see :mod:`~wire_fmu.core.units.block_train.kernel`.
+        """
+        return not self.moving or self._planar is not None
+
+    def _build_kernel_arrays(self) -> None:
+        """The parameters of :mod:`~wire_fmu.core.units.block_train.kernel` as flat arrays."""
+        moving = int(self.moving and self._planar is not None)
+        self.kernel_sizes = np.array(
+            [self.n_coords, len(self.blocks), len(self.drivers), moving], dtype=np.int64
+        )
+        self.kernel_rope = np.array(
+            [self.rope.axial_stiffness, self.rope.damping, self.rope.breaking_load]
+        )
+        blocks = np.zeros((len(self.blocks), 5))
+        for j, b in enumerate(self.blocks):
+            blocks[j, :2] = self.block_weight[j], b.position
+            if b.floor is not None:
+                blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
+        self.kernel_blocks = blocks
+        self._build_kernel_geometry(bool(moving))
+
+    def _build_kernel_geometry(self, moving: bool) -> None:
+        """The planar path of :meth:`_planar_segment_lengths` as flat arrays (empty if fixed)."""
+        segment_span = [self.span_of_segment[k] for k in range(self.n_segments)]
+        self.kernel_segment_span = np.array(segment_span, dtype=np.int64)
+        self.kernel_geometry_step = np.array([self.GEOMETRY_STEP])
+        if not moving:
+            self.kernel_path_nodes = np.zeros((0, 3))
+            self.kernel_carriers = np.zeros((0, 1), dtype=np.int64)
+            self.kernel_body_dirs = np.zeros((0, 2))
+            return
+        xy0, radii, dof_of_node, dirs, _ = self._planar
+        self.kernel_path_nodes = np.array([(x, z, r) for (x, z), r in zip(xy0, radii, strict=True)])
+        width = max(1, max(len(dofs) for dofs in dof_of_node))
+        carriers = np.full((self.n_nodes, width), -1, dtype=np.int64)
+        for k, dofs in enumerate(dof_of_node):
+            carriers[k, : len(dofs)] = dofs
+        self.kernel_carriers = carriers
+        self.kernel_body_dirs = np.array(dirs, dtype=float).reshape(len(self.body_dof), 2)
+
+    def _evaluate_compiled(self, t: float, x: np.ndarray) -> dict:
+        """:meth:`evaluate` by the compiled kernel (the Python one names a span run out)."""
+        result = kernel.evaluate(t, x, self.kernel_data())
+        forces, tension, stretch, line_force, body_force = (result[i] for i in (0, 1, 4, 5, 6))
+        depth, trial_contact, span_energy, potential, loss = (result[i] for i in (7, 8, 9, 10, 11))
+        if not result[13]:  # the Python kernel raises the error that names the span
+            return self._python_evaluate(t, x)
+        n, nb = self.n_coords, len(self.blocks)
+        dt = t - self._t_step
+        return {
+            "forces": forces,
+            "tension": tension,
+            "stretch": stretch,
+            "line_force": line_force,
+            "depth": depth,
+            "trial_contact": trial_contact,
+            "body_force": body_force,
+            "contact": np.where(self.contact_mask, trial_contact, 0.0),
+            "rope_energy": float(span_energy.sum()),
+            "span_energy": span_energy,
+            "potential": potential,
+            "loss": loss,
+            "y": np.concatenate((x[:nb], self._mover_y0 + self._mover_v * dt)),
+            "ydot": np.concatenate((x[n : n + nb], self._mover_v)),
+        }
+
+    def _quiet_step(self, t: float, h: float, inputs: BlockTrainInputs) -> bool:
+        """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's.
+
+        Events inside the step are switched by :meth:`handle_events` as in any step:
+        the compiled loop goes on from the first one.
+        """
+        held = self._held(t, inputs)
+        solver = self.solver
+        t1 = t + h
+        n = solver.internal_count(t, t1)
+        result = kernel.quiet_step(
+            solver.method,
+            t,
+            t1,
+            n,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            self.kernel_data(),
+            held,
+        )
+        if result[0] == STATUS_PYTHON:
+            return False
+        self._hold(t, inputs, held)
+        if self.friction.links:
+            self._held_positions = self.state[: self.n_coords].copy()
+        self.state, self._quiet_events, values = solver.finish_quiet_step(
+            self, t, self.state, t1, result
+        )
+        if values is not None:
+            self._step_summary = (t1, self.state, values)
+        return True
+
+    def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """What the outputs need at ``(t, x)``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+
+        Returns
+        -------
+        rope_energy : float
+            Strain energy of the rope, J.
+        potential : float
+            Gravitational and floor-contact energy, J.
+        tension : numpy.ndarray
+            Tension of each span, N.
+        body_force : numpy.ndarray
+            Force of the rope on each body along its direction (blocks, then driven), N.
+        """
+        if self.compiled:
+            done = self._step_summary
+            if done is not None and done[0] == t and done[1] is x:
+                values = done[2]
+            else:
+                values = kernel.summary(t, x, self.kernel_data())
+            if math.isfinite(values[0]):
+                n_spans = len(self.spans)
+                return values[0], values[1], values[2 : 2 + n_spans], values[2 + n_spans :]
+        ev = self.evaluate(t, x) if not self.compiled else self._python_evaluate(t, x)
+        return ev["rope_energy"], ev["potential"], ev["tension"], ev["body_force"]
+
+    def _python_evaluate(self, t: float, x: np.ndarray) -> dict:
+        """:meth:`evaluate` by the Python kernel."""
+        with self.python_kernel():
+            return self.evaluate(t, x)
