@@ -443,33 +443,8 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         takes the step.
     """
     n_coords, n_links = data[0][0], data[17].shape[0]
-    new = (
-        data[0],
-        data[1],
-        data[2],
-        data[3],
-        data[4],
-        data[5],
-        data[6],
-        data[7],
-        data[8],
-        data[9],
-        data[10],
-        held,
-        data[12],
-        data[13],
-        data[14],
-        data[15],
-        data[16],
-        data[17],
-        data[18],
-        data[19],
-        data[20],
-        data[21],
-        data[22],
-        x[:n_coords].copy(),  # a stuck coordinate is held where the step starts
-        data[24],
-    )
+    # the held inputs from t0 on, and a stuck coordinate held where the step starts
+    new = data[:11] + (held,) + data[12:23] + (x[:n_coords].copy(),) + data[24:]
     no_fire = np.zeros(directions.size, dtype=np.bool_)
     no_summary = np.zeros(0)
     before = evaluate(t0, x, data)
