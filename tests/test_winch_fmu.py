@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from wire_fmu.core.components.drum import Drum, LayeredDrum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.unit import Causality
 from wire_fmu.core.units.winch.unit import WinchUnit
@@ -246,6 +247,11 @@ def test_absent_effects_cost_nothing():
     rigid = make_unit("drum_inertia")
     assert len(rigid.get_state()["x"]) == 4  # drum angle, speed, two ledger integrals
     assert rigid.model.guards(0.0, rigid.model.state).size == 0
+    assert rigid.model.config.brake is None and rigid.model.friction.links == ()
+    assert type(rigid.model.drum) is Drum  # one layer: no layer edges, no rope inertia
+    braked = make_unit("drum_inertia,band_brake,rope_layers")
+    assert isinstance(braked.model.drum, LayeredDrum) and len(braked.model.friction.links) == 1
+    assert braked.model.guards(0.0, braked.model.state).size == 4  # brake 2, layer edges 2
     full = make_unit("drum_inertia,elastic_drive_train")
     assert len(full.get_state()["x"]) == 2 * 3 + 2  # the default chain has three masses
 

@@ -30,8 +30,9 @@ layer ``k``. Rope that leaves the drum keeps its kinetic energy inside the
 drum's ``I(phi) omega^2 / 2`` (the conservative Lagrangian of a variable
 reduced inertia), since the block train's rope is massless.
 
-Without layers the radius is ``radius`` everywhere and the rope adds no
-inertia.
+Without layers (:class:`Drum`) the radius is ``radius`` everywhere, the rope
+adds no inertia and there are no layer edges; the effect ``rope_layers``
+builds a :class:`LayeredDrum` instead. A winch asks its drum, never a flag.
 """
 
 from __future__ import annotations
@@ -39,13 +40,115 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
-__all__ = ["Drum"]
+import numpy as np
+
+__all__ = ["Drum", "LayeredDrum"]
+
+_NO_GUARDS = np.zeros(0)
 
 
 @dataclass(frozen=True)
 class Drum:
-    """Winding geometry of a drum and the rope on it.
+    """A drum that winds its rope in one layer: constant radius, no rope inertia.
+
+    Parameters
+    ----------
+    radius : float
+        Rope centreline radius, m.
+    """
+
+    radius: float
+
+    layer_guard_count: ClassVar[int] = 0
+    """Guards :meth:`layer_guards` gives: none, the rope never changes layer."""
+
+    @property
+    def max_layers(self) -> int:
+        """Layers the drum holds: one."""
+        return 1
+
+    def layer_radius(self, k: int) -> float:
+        """Winding radius, m: ``radius`` on every layer.
+
+        Parameters
+        ----------
+        k : int
+            The layer (only 0 occurs).
+        """
+        return self.radius
+
+    def initial_layer(self) -> int:
+        """The layer the rope leaves from at the start: 0."""
+        return 0
+
+    def phi_bounds(self, k: int) -> tuple[float, float]:
+        """Drum angles between which layer ``k`` is the outer one: all, rad.
+
+        Parameters
+        ----------
+        k : int
+            The layer (only 0 occurs).
+        """
+        return -math.inf, math.inf
+
+    def layer_guards(self, phi: float, k: int) -> np.ndarray:
+        """The layer's edge guards at drum angle ``phi``: none.
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle, rad.
+        k : int
+            The outer layer.
+        """
+        return _NO_GUARDS
+
+    def payout(self, phi: float, k: int) -> float:
+        """Rope paid out at drum angle ``phi``, m (0 at ``phi = 0``).
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle since the start, rad (positive paying out).
+        k : int
+            The layer the rope leaves from.
+        """
+        return self.radius * phi
+
+    def rope_inertia(self, phi: float, k: int) -> float:
+        """Inertia of the rope on the drum: 0 kg m^2 (its mass is not modelled).
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle since the start, rad.
+        k : int
+            The outer layer.
+        """
+        return 0.0
+
+    def rope_inertia_slope(self, k: int) -> float:
+        """``dI/dphi`` of the rope: 0 kg m^2/rad.
+
+        Parameters
+        ----------
+        k : int
+            The outer layer.
+        """
+        return 0.0
+
+    def problems(self) -> list[str]:
+        """Every problem with this geometry, as sentences naming the parameter."""
+        if self.radius > 0 and math.isfinite(self.radius):
+            return []
+        return [f"parameter 'drum_radius' must be > 0 m, got {self.radius}"]
+
+
+@dataclass(frozen=True)
+class LayeredDrum(Drum):
+    """A drum whose winding radius grows one rope diameter per layer (effect ``rope_layers``).
 
     Parameters
     ----------
@@ -54,24 +157,23 @@ class Drum:
     rope_diameter : float
         Rope diameter, m; the radius grows by this per layer.
     rope_linear_mass : float
-        Rope mass per metre, kg/m (adds to the inertia with layers).
+        Rope mass per metre, kg/m (adds to the inertia).
     wraps_per_layer : int
         Turns per layer.
     max_layers : int
         Layers the flanges allow.
     initial_rope : float
-        Rope on the drum at the start, m (layers only).
-    layered : bool
-        Whether the radius grows per layer (effect ``rope_layers``).
+        Rope on the drum at the start, m.
     """
 
-    radius: float
     rope_diameter: float = 0.0349
     rope_linear_mass: float = 5.06
     wraps_per_layer: int = 40
     max_layers: int = 4
     initial_rope: float = 150.0
-    layered: bool = False
+
+    layer_guard_count: ClassVar[int] = 2
+    """Guards :meth:`layer_guards` gives: the layer's two edges."""
 
     # ----------------------------------------------------------- geometry
     @property
@@ -87,7 +189,7 @@ class Drum:
         k : int
             The layer, 0 on the barrel.
         """
-        return self.radius + k * self.rope_diameter if self.layered else self.radius
+        return self.radius + k * self.rope_diameter
 
     def capacity(self) -> float:
         """Rope the drum holds when every layer is full, m."""
@@ -113,7 +215,7 @@ class Drum:
     @property
     def initial_wound_angle(self) -> float:
         """Wound angle at ``phi = 0``, rad."""
-        return self.wound_angle(self.initial_rope) if self.layered else 0.0
+        return self.wound_angle(self.initial_rope)
 
     def initial_layer(self) -> int:
         """The layer the rope leaves from at the start.
@@ -121,8 +223,6 @@ class Drum:
         On a layer boundary it is the full layer below (the next one starts
         empty); winding in then crosses at once into the new layer.
         """
-        if not self.layered:
-            return 0
         k = math.ceil(self.initial_wound_angle / self.layer_angle - 1e-12) - 1
         return min(max(k, 0), self.max_layers - 1)
 
@@ -131,17 +231,28 @@ class Drum:
         """Drum angles ``(low, high)`` between which layer ``k`` is the outer one, rad.
 
         Below ``low`` the rope winds onto layer ``k + 1``; above ``high`` it
-        pays out from layer ``k - 1``. Infinite without layers.
+        pays out from layer ``k - 1``.
 
         Parameters
         ----------
         k : int
             The layer, 0 on the barrel.
         """
-        if not self.layered:
-            return -math.inf, math.inf
         theta0 = self.initial_wound_angle
         return theta0 - (k + 1) * self.layer_angle, theta0 - k * self.layer_angle
+
+    def layer_guards(self, phi: float, k: int) -> np.ndarray:
+        """``[phi - low, high - phi]``: both fire on a downward crossing of a layer edge.
+
+        Parameters
+        ----------
+        phi : float
+            Drum angle, rad.
+        k : int
+            The outer layer.
+        """
+        low, high = self.phi_bounds(k)
+        return np.array([phi - low, high - phi])
 
     @cached_property
     def _lines(self) -> tuple[tuple[float, float, float, float], ...]:
@@ -179,8 +290,6 @@ class Drum:
         k : int
             The layer the rope leaves from.
         """
-        if not self.layered:
-            return self.radius * phi
         offset, radius, _, _ = self._lines[k]
         return offset + radius * phi
 
@@ -194,8 +303,6 @@ class Drum:
         k : int
             The outer layer.
         """
-        if not self.layered:
-            return 0.0
         _, _, offset, slope = self._lines[k]
         return offset + slope * phi
 
@@ -207,17 +314,11 @@ class Drum:
         k : int
             The outer layer.
         """
-        if not self.layered:
-            return 0.0
         return self._lines[k][3]
 
     def problems(self) -> list[str]:
         """Every problem with this geometry, as sentences naming the parameter."""
-        out = []
-        if not (self.radius > 0 and math.isfinite(self.radius)):
-            out.append(f"parameter 'drum_radius' must be > 0 m, got {self.radius}")
-        if not self.layered:
-            return out
+        out = super().problems()
         if not (self.rope_diameter > 0 and math.isfinite(self.rope_diameter)):
             out.append(f"parameter 'rope_diameter' must be > 0 m, got {self.rope_diameter}")
         if not (self.rope_linear_mass >= 0 and math.isfinite(self.rope_linear_mass)):

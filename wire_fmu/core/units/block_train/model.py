@@ -240,6 +240,9 @@ class BlockTrainModel(
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Geometric span lengths (m) and their Jacobian w.r.t. body motion.
 
+        The geometry is chosen once, when the path is built:
+        :meth:`_fixed_span_lengths` or :meth:`_moving_span_lengths`.
+
         Parameters
         ----------
         y : numpy.ndarray
@@ -252,9 +255,15 @@ class BlockTrainModel(
         jacobian : numpy.ndarray
             ``d lengths / d y``, one row per span and one column per body, 1.
         """
-        if not self.moving:
-            return self.span_length0 + ordered_matvec(self.span_jacobian, y), self.span_jacobian
-        lengths = self._planar_segment_lengths if self._planar else self._spatial_segment_lengths
+        return self._span_geometry(y)
+
+    def _fixed_span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`span_lengths` with fixed line directions: linear in ``y``."""
+        return self.span_length0 + ordered_matvec(self.span_jacobian, y), self.span_jacobian
+
+    def _moving_span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`span_lengths` with ``moving_geometry``: tangent points recomputed."""
+        lengths = self._moving_segment_lengths
         seg = lengths(y)
         jac = np.zeros((self.n_segments, len(y)))
         h = self.GEOMETRY_STEP

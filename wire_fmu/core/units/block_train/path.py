@@ -156,10 +156,22 @@ class ReevedPath:
         self._planar = None
         if self.moving and "spatial_geometry" not in self.effects:
             self._build_planar_fast_path()
+        self._choose_span_geometry()
         for k, idx in self.rope_index.items():
             if idx != self.rim_index[k]:
                 s = self.reeving.sheaves[self.nodes[k].name]
                 self.masses[idx] = self.rope.linear_mass * s.radius * self.wrap_angles[k]
+
+    def _choose_span_geometry(self) -> None:
+        """Choose the span geometry the effects call for, once."""
+        if not self.moving:
+            self._span_geometry = self._fixed_span_lengths
+            return
+        planar = self._planar is not None
+        self._moving_segment_lengths = (
+            self._planar_segment_lengths if planar else self._spatial_segment_lengths
+        )
+        self._span_geometry = self._moving_span_lengths
 
     def _build_planar_fast_path(self) -> None:
         """2-D coordinates for recomputing a planar path cheaply as bodies move."""

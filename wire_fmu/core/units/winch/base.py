@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -63,12 +63,13 @@ class WinchConfig:
     effects : frozenset of str
         Validated by :data:`WINCH_EFFECTS`.
     drum : Drum
-        Winding geometry (``layered`` set from the effects).
+        Winding geometry: a :class:`~wire_fmu.core.components.drum.LayeredDrum`
+        with ``rope_layers``.
     chain : DriveChain
         Drive train reduced to the drum shaft, already reduced to the masses
         the model keeps (one mass when rigid).
-    brake : BandBrake
-        Used with ``band_brake``.
+    brake : BandBrake or None
+        The band brake with ``band_brake``; None (no brake at all) without it.
     motor_slope : float
         ``b`` of the characteristic at the motor shaft, N m s/rad.
     initial_speed : float
@@ -78,14 +79,9 @@ class WinchConfig:
     effects: frozenset[str]
     drum: Drum
     chain: DriveChain
-    brake: BandBrake = field(default_factory=BandBrake)
+    brake: BandBrake | None = None
     motor_slope: float = 0.0
     initial_speed: float = 0.0
-
-    @property
-    def has_brake(self) -> bool:
-        """Whether the band brake is modelled."""
-        return "band_brake" in self.effects
 
 
 @dataclass(frozen=True)
@@ -111,6 +107,10 @@ class WinchReport:
     external_work: float
 
 
+_NO_CAPACITY = np.zeros((1, 2))
+_NO_CAPACITY.flags.writeable = False  # shared by every winch without a brake
+
+
 class _WinchBase:
     """What both winch models share: drum, brake, inputs, events, layer bookkeeping."""
 
@@ -124,7 +124,7 @@ class _WinchBase:
         self.inputs = WinchInputs()
         self.mode_changes = 0
         self.last_events: list[tuple[float, str]] = []
-        self._caps = np.zeros((1, 2))
+        self._caps = _NO_CAPACITY
 
     def set_inputs(self, inputs: WinchInputs) -> None:
         """Hold ``inputs`` from now on.
@@ -136,10 +136,8 @@ class _WinchBase:
         """
         self.inputs = inputs
         self._step_summary = None  # outputs a compiled step computed are for other inputs
-        if self.config.has_brake:
+        if self.brake is not None:
             self._caps = np.array([self.brake.capacities(inputs.lever_force)])
-        else:
-            self._caps = np.zeros((1, 2))
 
     @property
     def capacities(self) -> tuple[float, float]:

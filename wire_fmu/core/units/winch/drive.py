@@ -52,8 +52,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.base_inertia = np.array(chain.inertias, dtype=float)
         self.stiffness = chain.stiffness_matrix()
         self.damping = chain.damping_matrix()
-        links = (FrictionLink("band brake", self.n - 1, GROUND),) if config.has_brake else ()
-        self.friction = StickSlip(self.base_inertia.copy(), links)
+        brake = () if config.brake is None else (FrictionLink("band brake", self.n - 1, GROUND),)
+        self.friction = StickSlip(self.base_inertia.copy(), brake)
         self.masses = self.friction.masses  # the drum's entry follows I(phi)
         self.characteristic = "motor_characteristic" in config.effects
         self.motor_b = config.motor_slope * self.motor_ratio**2 if self.characteristic else 0.0
@@ -61,8 +61,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.state = np.zeros(2 * self.n + 2)
         self._held_angle = 0.0
         self._step_summary: tuple[np.ndarray, np.ndarray] | None = None  # (x, its summary)
-        self._n_brake_guards = 2 if config.has_brake else 0
-        self._guard_dirs = -np.ones(self._n_brake_guards + 2 * int(self.drum.layered))
+        self._n_brake_guards = 2 * len(brake)
+        self._guard_dirs = -np.ones(self._n_brake_guards + self.drum.layer_guard_count)
         self.settings = solver
         self.compiled = solver.method in COMPILED_METHODS and use_compiled("winch")
         if solver.method in ENERGY_SOLVERS:
@@ -159,6 +159,11 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         )
         return out
 
+    @property
+    def guard_counts(self) -> tuple[int, int]:
+        """Guards of the brake (0 without one, else 2) and of the layer (0 or 2)."""
+        return self._n_brake_guards, self.drum.layer_guard_count
+
     def guard_directions(self) -> np.ndarray:
         """All guards fire on a downward crossing."""
         return self._guard_dirs
@@ -181,19 +186,18 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         """
         if self.compiled:
             return kernel.guards(t, x, self.kernel_data())
-        out = []
-        if self.config.has_brake:
-            if self.engaged:
-                _, link = self._dynamics(x)
-                out.extend(self.friction.guards(x[self.n : 2 * self.n], link, self._caps))
-                out.append(self.inputs.lever_force)
-            else:
-                out += [1.0, -self.inputs.lever_force]
-        if self.drum.layered:
-            low, high = self.drum.phi_bounds(self.layer)
-            phi = x[self.n - 1]
-            out += [phi - low, high - phi]
-        return np.array(out, dtype=float)
+        layer = self.drum.layer_guards(x[self.n - 1], self.layer)
+        if not self.friction.links:
+            return layer
+        return np.concatenate((self._brake_guards(x), layer))
+
+    def _brake_guards(self, x: np.ndarray) -> list[float]:
+        """Stick/slip and engagement guards of the brake at ``x``."""
+        if not self.engaged:
+            return [1.0, -self.inputs.lever_force]
+        _, link = self._dynamics(x)
+        stick_slip = self.friction.guards(x[self.n : 2 * self.n], link, self._caps)
+        return [*stick_slip, self.inputs.lever_force]
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
         """Brake stick/slip, or the rope changing layer.

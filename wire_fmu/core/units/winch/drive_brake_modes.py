@@ -36,9 +36,10 @@ class DrumBrakeModes:
         return self.engaged, int(self.friction.mode[0]) if self.friction.links else 0
 
     def _settle_modes(self, t: float, x: np.ndarray, fired: list[int] | None = None):
-        """Make the brake's engagement and stick/slip mode fit the inputs at (t, x)."""
-        if not self.config.has_brake:
-            return x
+        """Make the brake's engagement and stick/slip mode fit the inputs at (t, x).
+
+        Without a brake the capacities are zero: it stays released, nothing changes.
+        """
         x = np.array(x, dtype=float)
         if fired is None and self.compiled and self._brake_mode_holds(x):
             self._held_angle = float(x[self.n - 1])
@@ -77,7 +78,7 @@ class DrumBrakeModes:
     def _rigid_acceleration(self, torque: float, inertia: float, omega: float) -> float:
         """Acceleration of the chain locked rigid under ``torque`` (N m) and the brake."""
         plus, minus = self.capacities
-        if not self.config.has_brake or min(plus, minus) <= 0.0:
+        if min(plus, minus) <= 0.0:  # released, or no brake at all
             return torque / inertia
         if omega == 0.0:
             if -minus <= torque <= plus:  # the brake can hold
@@ -90,15 +91,13 @@ class DrumBrakeModes:
     def _kept_brake_mode(self) -> tuple[bool, bool] | None:
         """How :func:`kernel.quiet_step` may keep the brake's mode, or None if it may not.
 
-        ``(check_stick, hold_angle)``: without a brake nothing to keep; a brake
-        released without capacity, or engaged and sliding, keeps its mode; one
+        ``(check_stick, hold_angle)``: a brake released without capacity (or no
+        brake at all), or engaged and sliding, keeps its mode; one
         that holds the drum keeps it while it can (the kernel checks); anything
         else is settled by :meth:`_settle_modes`, in Python.
         """
         if not (self.compiled and isinstance(self.solver, CompiledFixedStep)):
             return None
-        if not self.config.has_brake:
-            return False, False
         if min(self.capacities) <= 0.0:
             return None if self.engaged else (False, True)
         if not self.engaged:

@@ -8,8 +8,9 @@ one tuple, built by :func:`kernel_data`:
 =====  ===============  ====================================================
 index  name             contents
 =====  ===============  ====================================================
-0      ``modes``        int: brake modelled (0/1), brake engaged (0/1), its
-                        stick/slip mode (0 stuck, +1/-1 sliding), layers (0/1)
+0      ``modes``        int: guards of the brake (0 without one, 2), brake
+                        engaged (0/1), its stick/slip mode (0 stuck, +1/-1
+                        sliding), guards of the layer (0 without layers, 2)
 1      ``inertia``      inertia of each mass reduced to the drum shaft, kg m^2
 2      ``stiffness``    chain stiffness matrix, N m/rad
 3      ``damping``      chain damping matrix, N m s/rad
@@ -69,7 +70,8 @@ def kernel_data(model) -> tuple:
     low, high = drum.phi_bounds(k)
     offset = drum.rope_inertia(0.0, k)
     mode = int(model.friction.mode[0]) if model.friction.links else 0
-    modes = np.array([int(model.config.has_brake), int(model.engaged), mode, int(drum.layered)])
+    brake_guards, layer_guards = model.guard_counts
+    modes = np.array([brake_guards, int(model.engaged), mode, layer_guards])
     held = np.array(
         [
             model.motor_ratio * inputs.motor_command,
@@ -169,9 +171,9 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     """
     modes, inertia, _, _, held = data
     n = inertia.size
-    out = np.empty(2 * modes[0] + 2 * modes[3])
+    out = np.empty(modes[0] + modes[3])
     i = 0
-    if modes[0] == 1:
+    if modes[0] == 2:
         if modes[1] == 1:
             if modes[2] == 0:
                 brake = _dynamics(x, data)[1]
@@ -184,7 +186,7 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
             out[0] = 1.0
             out[1] = -held[3]
         i = 2
-    if modes[3] == 1:
+    if modes[3] == 2:
         phi = x[n - 1]
         out[i] = phi - held[9]
         out[i + 1] = held[10] - phi

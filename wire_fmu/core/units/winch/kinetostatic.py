@@ -59,7 +59,7 @@ class KinetostaticWinch(_WinchBase):
         self.last_events = []
 
     def _brake_state_for(self, omega: float) -> int:
-        if not self.config.has_brake or min(self.capacities) <= 0.0:
+        if min(self.capacities) <= 0.0:  # released, or no brake at all
             return BRAKE_FREE
         return BRAKE_SLIPPING if omega != 0.0 else BRAKE_HOLDING
 
@@ -150,7 +150,7 @@ class KinetostaticWinch(_WinchBase):
 
     def guard_directions(self) -> np.ndarray:
         """The layer's two edges fire on a downward crossing."""
-        return -np.ones(2 if self.drum.layered else 0)
+        return -np.ones(self.drum.layer_guard_count)
 
     def guards(self, t: float, x: np.ndarray) -> np.ndarray:
         """The layer's two edges (none without layers).
@@ -162,10 +162,7 @@ class KinetostaticWinch(_WinchBase):
         x : ndarray
             State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
         """
-        if not self.drum.layered:
-            return np.zeros(0)
-        low, high = self.drum.phi_bounds(self.layer)
-        return np.array([x[0] - low, high - x[0]])
+        return self.drum.layer_guards(x[0], self.layer)
 
     def handle_events(self, t: float, x: np.ndarray, fired: list[int]) -> np.ndarray:
         """The rope changes layer.

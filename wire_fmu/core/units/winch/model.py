@@ -48,8 +48,6 @@ Modules
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from wire_fmu.core.components.drive_train import DriveChain
@@ -123,8 +121,6 @@ def build_winch(config: WinchConfig, solver: SolverSettings) -> WinchModel | Kin
     solver : SolverSettings
         Internal solver (used with ``drum_inertia``).
     """
-    drum = replace(config.drum, layered="rope_layers" in config.effects)
-    config = replace(config, drum=drum)
     if "drum_inertia" in config.effects:
         return WinchModel(config, solver)
     return KinetostaticWinch(config)

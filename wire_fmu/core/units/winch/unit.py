@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.components.drive_train import DriveChain, parse_drive_train
-from wire_fmu.core.components.drum import Drum
+from wire_fmu.core.components.drum import Drum, LayeredDrum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
@@ -111,8 +111,8 @@ class WinchUnit(HeldInputsUnit):
         chain = self._chain(effects, problems)
         drum = self._drum(effects)
         problems += drum.problems()
-        brake = self._brake()
-        if "band_brake" in effects:
+        brake = self._brake() if "band_brake" in effects else None
+        if brake is not None:
             problems += brake.problems()
         problems += self._scalar_problems(effects)
         if chain is not None and settings.method in ENERGY_SOLVERS:
@@ -218,14 +218,15 @@ class WinchUnit(HeldInputsUnit):
 
     def _drum(self, effects: frozenset[str]) -> Drum:
         v = self.values
-        return Drum(
+        if "rope_layers" not in effects:
+            return Drum(float(v["drum_radius"]))
+        return LayeredDrum(
             float(v["drum_radius"]),
-            float(v["rope_diameter"]),
-            float(v["rope_linear_mass"]),
-            int(v["drum_wraps_per_layer"]),
-            int(v["drum_layers"]),
-            float(v["rope_on_drum"]),
-            "rope_layers" in effects,
+            rope_diameter=float(v["rope_diameter"]),
+            rope_linear_mass=float(v["rope_linear_mass"]),
+            wraps_per_layer=int(v["drum_wraps_per_layer"]),
+            max_layers=int(v["drum_layers"]),
+            initial_rope=float(v["rope_on_drum"]),
         )
 
     def _brake(self) -> BandBrake:
