@@ -16,10 +16,15 @@ from dataclasses import dataclass, field
 
 from .bond_energy import step_energy
 from .run_result import SimulationStoppedError
-from .step_size import _PI, new_h
+from .step_size import _PI, _ns, new_h
 from .unit_errors import StepRefusedError
 
-__all__ = ["MacroStep"]
+__all__ = ["MacroStep", "MODE_CHANGE_TIME", "SYNC_RESOLUTION_NS"]
+
+MODE_CHANGE_TIME = "mode_change_time"
+"""The output a unit tells the time of its first mode change inside the last step by, s."""
+SYNC_RESOLUTION_NS = 1000
+"""A mode change closer than this to either end of a step is not synchronised to (1 us)."""
 
 
 @dataclass
@@ -32,6 +37,7 @@ class _Attempt:
     new: dict[str, float] = field(default_factory=dict)
     retry_step: float = 0.0
     message: str = ""
+    event_end_ns: int | None = None  # a unit's mode changed here: step everyone to it
 
 
 class MacroStep:
@@ -112,7 +118,8 @@ class MacroStep:
         """Take one macro step, rolling back when it is refused or rejected."""
         if not self._reads:  # planned once, after the observers' watches
             self._build_plans()
-        rollback = self.run_settings.iterations > 1 or self.run_settings.adaptive
+        s = self.run_settings
+        rollback = s.iterations > 1 or s.adaptive or s.synchronise_events
         states = self._save() if rollback else None
         try:
             if states is not None:
@@ -139,6 +146,13 @@ class MacroStep:
             self._restore(states)
             self._free(states)
             return _Attempt(False, {}, sweeps, retry_step=new_h(h, 4.0), message=message)
+        if s.synchronise_events:
+            event_end_ns = self._first_mode_change_ns(t, h)
+            if event_end_ns is not None:
+                self._restore(states)
+                self._free(states)
+                message = f"a mode changed at t = {event_end_ns / 1e9:.9g} s"
+                return _Attempt(False, {}, sweeps, message=message, event_end_ns=event_end_ns)
         residuals = self.bond_residuals(new, h)
         if self.run_settings.adaptive:
             error = max((abs(r) for r in residuals.values()), default=0.0)
@@ -163,6 +177,29 @@ class MacroStep:
         if states is not None:
             self._free(states)
         return _Attempt(True, residuals, sweeps, new)
+
+    def _first_mode_change_ns(self, t: float, h: float) -> int | None:
+        """End (ns) of the step that places the earliest mode change inside ``(t, t + h)``.
+
+        Units whose ``mode_changes`` moved in the step and that tell when
+        (:data:`~wire_fmu.core.framework.unit.MODE_CHANGE_TIME`) are asked; None when no
+        such change lies more than :data:`SYNC_RESOLUTION_NS` inside the step. The end
+        is rounded up to the nanosecond, so that stepping to it takes the change in.
+        """
+        start_ns, end_ns = _ns(t), _ns(t + h)
+        earliest = None
+        for name, before in self.mode_counts.items():
+            if name not in self.event_time_units or self._mode_count(name) == before:
+                continue
+            when = float(self.slaves[name].get([MODE_CHANGE_TIME])[MODE_CHANGE_TIME])
+            if math.isfinite(when):
+                candidate = math.ceil(when * 1e9 - 1e-3)
+                earliest = candidate if earliest is None else min(earliest, candidate)
+        if earliest is None:
+            return None
+        if earliest - start_ns < SYNC_RESOLUTION_NS or end_ns - earliest < SYNC_RESOLUTION_NS:
+            return None
+        return earliest
 
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
         histories, end = self.histories, t + h

@@ -28,6 +28,7 @@ class RunResult:
     steps: int = 0
     rejected: int = 0
     iterations: int = 0
+    synchronised: int = 0  # steps shortened to a unit's mode change (synchronise_events)
     bond_residual: dict[str, float] = field(default_factory=dict)
     bond_carried: dict[str, float] = field(default_factory=dict)
     bond_error: dict[str, float] = field(default_factory=dict)

@@ -48,7 +48,7 @@ from .bond_energy import BondKeys
 from .energy_guard import EnergyGuard, _remedies
 from .exchange import MODE_OUTPUT, UnitExchange
 from .interrupts import _InterruptRequestedError, _Interrupts
-from .macro_step import MacroStep
+from .macro_step import MODE_CHANGE_TIME, MacroStep
 from .manipulators import DriverSet, ScheduledEvents
 from .run_result import RunResult, SimulationStoppedError
 from .scene import Scene
@@ -95,6 +95,7 @@ class Simulation(UnitExchange, MacroStep):
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
         self.held: dict[str, float] = {}
         self.mode_counts: dict[str, int] = {}
+        self.event_time_units: set[str] = set()  # of mode_counts, those that tell when
         self.result = RunResult("not started")
         self._error_prev = 1.0
         self._interrupts = _Interrupts()
@@ -145,6 +146,8 @@ class Simulation(UnitExchange, MacroStep):
             # a mode event resets the unit's outgoing histories: watched where there are any
             if MODE_OUTPUT in slave.variables and self.source_keys.get(name):
                 self.mode_counts[name] = int(slave.get([MODE_OUTPUT])[MODE_OUTPUT])
+                if MODE_CHANGE_TIME in slave.variables:
+                    self.event_time_units.add(name)
         self.time = start
 
     def _fire_events(self, t: float) -> list[str]:
@@ -235,6 +238,7 @@ class Simulation(UnitExchange, MacroStep):
         stop_ns = _ns(self.run_settings.stop_time)
         now_ns = _ns(self.time)
         h = self.run_settings.step
+        resume_h = None  # the step to go on with after one shortened to a mode change
         while now_ns < stop_ns:
             next_ns = min(now_ns + max(1, _ns(h)), stop_ns)
             upcoming = self.events.next_time
@@ -247,6 +251,11 @@ class Simulation(UnitExchange, MacroStep):
             self._watching = self._watched_at(next_ns / 1e9)
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps
+            if attempt.event_end_ns is not None:  # step every unit to the mode change
+                result.synchronised += 1
+                resume_h = h if resume_h is None else resume_h
+                h = (attempt.event_end_ns - now_ns) / 1e9
+                continue
             if not attempt.accepted:
                 result.rejected += 1
                 if h <= self.run_settings.min_step * (1 + 1e-9):
@@ -270,4 +279,7 @@ class Simulation(UnitExchange, MacroStep):
             blow_up = self.energy.blow_up(self.time, h)
             if blow_up:
                 raise SimulationStoppedError(blow_up)
-            h = self._next_step(h, attempt.residuals)
+            if resume_h is not None:  # after a step shortened to a mode change: the one asked
+                h, resume_h = resume_h, None
+            else:
+                h = self._next_step(h, attempt.residuals)

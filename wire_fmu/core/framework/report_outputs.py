@@ -18,7 +18,7 @@ from collections.abc import Iterable, MutableMapping
 from dataclasses import dataclass
 from typing import Any
 
-from wire_fmu.core.framework.unit import Causality, Variable
+from wire_fmu.core.framework.unit import MODE_CHANGE_TIME, Causality, Variable
 
 __all__ = ["ReportOutputs", "LEDGER_OUTPUTS"]
 
@@ -67,7 +67,9 @@ class ReportOutputs:
         names = [
             v.name
             for v in variables
-            if v.causality is Causality.output and v.name not in LEDGER_OUTPUTS
+            if v.causality is Causality.output
+            and v.name not in LEDGER_OUTPUTS
+            and v.name != MODE_CHANGE_TIME  # the unit base writes it after each step
         ]
         return cls(tuple((name, name.replace(".", "_")) for name in names), finite)
 

@@ -55,7 +55,34 @@ __all__ = [
     "ModelOdeView",
     "STEP_ERRORS",
     "HeldInputsUnit",
+    "MODE_CHANGE_TIME",
+    "mode_change_time_output",
 ]
+
+MODE_CHANGE_TIME = "mode_change_time"
+"""The output that tells when a unit's mode first changed inside its last step."""
+
+
+def mode_change_time_output(what: str) -> Variable:
+    """Declare :data:`MODE_CHANGE_TIME`, for a unit whose model notes ``first_event_time``.
+
+    Parameters
+    ----------
+    what : str
+        The unit's mode changes, for the description (``"stick/slip, slack, break"``).
+
+    Returns
+    -------
+    Variable
+        A continuous output in s: the time of the first mode change located inside
+        the last step, or the step's end if there was none. A master that
+        synchronises events steps every unit to that instant.
+    """
+    return output(
+        MODE_CHANGE_TIME,
+        "s",
+        f"Time of the first mode change ({what}) located inside the last step; its end if none",
+    )
 
 
 STEP_ERRORS: tuple[type[Exception], ...] = (
@@ -203,12 +230,20 @@ class Unit(ABC):
             events = self._advance(time, step)
             self.time = time + step
             self._update_outputs()
+            if MODE_CHANGE_TIME in self.values:
+                self.values[MODE_CHANGE_TIME] = self._mode_change_time(time, step)
         except STEP_ERRORS as err:
             self._restore_snapshot(saved)
             return StepResult(
                 False, f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
             )
         return StepResult(True, events=tuple(events))
+
+    def _mode_change_time(self, time: float, step: float) -> float:
+        """The model's first located event inside ``(time, time + step)``, or the step's end, s."""
+        first = getattr(self.model, "first_event_time", math.inf)
+        end = time + step
+        return first if time < first < end else end
 
     def timed_advance(self, time: float, step: float) -> StepResult:
         """:meth:`advance`, its wall-clock time added to :attr:`physics_seconds` (timing hook).

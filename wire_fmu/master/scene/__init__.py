@@ -19,6 +19,7 @@ Format::
     iterations = 1            # > 1: iterate each step with rollback
     iteration_tolerance = 1e-6
     adaptive = false          # macro step from the bonds' energy residual
+    synchronise_events = false  # a mode change inside a step: every unit steps to it
     energy_tolerance = 10.0   # J per step, with adaptive; the energy guard's floor
     energy_guard = 0.1        # stop once a bond's coupling created this share of
                               # the energy it carried (inf: off); see energy_guard.py

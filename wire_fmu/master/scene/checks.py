@@ -127,8 +127,9 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
             f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
             "one step (a coupling that needs more does not converge)"
         )
-    if not isinstance(s.adaptive, bool):
-        problems.append(f"run.adaptive must be true or false, got {s.adaptive!r}")
+    for key in ("adaptive", "synchronise_events"):
+        if not isinstance(getattr(s, key), bool):
+            problems.append(f"run.{key} must be true or false, got {getattr(s, key)!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):
         problems.append(f"run.order must be a list of unit names, got {s.order!r}")
     elif len(set(s.order)) != len(s.order):

@@ -171,6 +171,7 @@ class RunSettings:
     iterations: int = 1
     iteration_tolerance: float = 1e-6
     adaptive: bool = False
+    synchronise_events: bool = False
     energy_tolerance: float = 10.0
     energy_guard: float = DEFAULT_SHARE
     min_step: float = 1e-5

@@ -34,6 +34,7 @@ The equations of motion are Lagrange's with the rope strain energy of
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,6 +144,7 @@ class BlockTrainModel(
         self.set_inputs(0.0, BlockTrainInputs({}, {}, {}, {}))
         self.mode_changes = 0
         self.last_events: list[str] = []
+        self.first_event_time = math.inf  # of the last step's located events, s
         self._held_positions = np.zeros(self.n_coords)
         self.taut_mask = np.ones(len(self.spans), dtype=bool)
         self.contact_mask = np.zeros(len(self.blocks), dtype=bool)
@@ -423,6 +425,7 @@ class BlockTrainModel(
             Number of events the solver located in the step.
         """
         self.last_events = []
+        self.first_event_time = math.inf
         self._step_summary = None
         quiet = self.compiled and isinstance(self.solver, CompiledFixedStep)
         if quiet and break_segment is None and self._quiet_step(t, h, inputs):

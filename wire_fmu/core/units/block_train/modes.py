@@ -84,6 +84,7 @@ class ModeSwitching:
             The state after the switches, projected; a broken span's strain energy is
             booked as dissipated.
         """
+        self.first_event_time = min(self.first_event_time, t)
         n_links = len(self.friction.links)
         n_spans = len(self.spans)
         x = np.array(x, dtype=float)

@@ -37,6 +37,7 @@ from wire_fmu.core.framework.unit import (
     OdeView,
     Unit,
     input_,
+    mode_change_time_output,
     output,
     parameter,
 )
@@ -149,6 +150,7 @@ def _variables():
             "Ledger residual: stored change + dissipated - external work",
             depends_on=deps,
         ),
+        mode_change_time_output("stick/slip, slack, break"),
         output(
             "mode_changes", "", "Number of mode events so far (stick/slip, slack, break)", type=int
         ),

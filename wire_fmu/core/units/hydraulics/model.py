@@ -13,6 +13,7 @@ evaluates instead when ``self.compiled`` (see
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -167,6 +168,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         self.external_work = 0.0
         self.initial_position = 0.0
         self.last_events: list[str] = []
+        self.first_event_time = math.inf  # of the last step's located events, s
 
     # ------------------------------------------------------------------ build
     def _read_effects(self, effects: frozenset[str]) -> None:
@@ -261,6 +263,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         HydraulicLimitError
             If a limit guard fired.
         """
+        self.first_event_time = min(self.first_event_time, t)
         x = np.array(x, dtype=float)
         seal_fired = []
         kinks_only = True

@@ -118,6 +118,7 @@ class RefinedStepping:
             At a limit (the caller restores the state and refuses the step).
         """
         self.last_events = []
+        self.first_event_time = math.inf
         self.force = float(force)
         self.step_report = None
         start = float(self.state[0])

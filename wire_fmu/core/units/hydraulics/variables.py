@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from wire_fmu.core.framework.solver_options import solver_parameters
-from wire_fmu.core.framework.unit import input_, output, parameter
+from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
 from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 
 __all__ = ["DEFAULT_ROD_FORCE", "variables"]
@@ -160,6 +160,7 @@ def variables() -> tuple:
         output(
             "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
         ),
+        mode_change_time_output("stick/slip, end stops, cushions"),
         output(
             "mode_changes",
             "",

@@ -124,6 +124,7 @@ class _WinchBase:
         self.inputs = WinchInputs()
         self.mode_changes = 0
         self.last_events: list[tuple[float, str]] = []
+        self.first_event_time = math.inf  # of the last step's located events, s
         self._caps = _NO_CAPACITY
 
     def set_inputs(self, inputs: WinchInputs) -> None:

@@ -211,6 +211,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         fired : list of int
             Indices of the guards that crossed.
         """
+        self.first_event_time = min(self.first_event_time, t)
         x = np.array(x, dtype=float)
         n_brake = self._n_brake_guards
         for i in fired:
@@ -342,6 +343,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             Inputs held over the step.
         """
         self.last_events = []
+        self.first_event_time = math.inf
         self.set_inputs(inputs)
         kept = self._kept_brake_mode()
         if kept is not None and self._quiet_step(t, h, *kept):

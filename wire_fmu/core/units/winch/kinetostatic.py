@@ -93,6 +93,7 @@ class KinetostaticWinch(_WinchBase):
             The number of events (layer changes, brake changes).
         """
         self.last_events = []
+        self.first_event_time = math.inf
         self.set_inputs(inputs)
         omega = inputs.speed_command
         phi0, k0 = float(self.state[0]), self.layer
@@ -124,7 +125,9 @@ class KinetostaticWinch(_WinchBase):
                 edge, step = high, -1
             else:
                 return
-            self._change_layer(t + (edge - phi0) / speed, step)
+            crossing = t + (edge - phi0) / speed
+            self.first_event_time = min(self.first_event_time, crossing)
+            self._change_layer(crossing, step)
             self.mode_changes += 1
 
     def stored_energy(self) -> float:

@@ -10,7 +10,7 @@ import json
 from wire_fmu.core.components.drive_train import default_drive_train
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.solver_options import solver_parameters
-from wire_fmu.core.framework.unit import input_, output, parameter
+from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS
 
 __all__ = ["winch_parameters", "winch_inputs", "winch_outputs"]
@@ -187,6 +187,7 @@ def winch_outputs():
         output(
             "energy_balance", "J", "Ledger residual: stored change + dissipated - external work"
         ),
+        mode_change_time_output("stick/slip, layer changes"),
         output(
             "mode_changes", "", "Number of mode events so far (stick/slip, layer changes)", type=int
         ),

@@ -1,0 +1,105 @@
+"""Event-synchronised macro steps: units tell when their mode changed inside a step, and
+with ``run.synchronise_events`` the master steps every unit to that instant.
+
+Unit level: the kinetostatic winch crosses a layer edge at a time known in closed form
+(``t0 + (phi_edge - phi0) / omega``); ``mode_change_time`` must say exactly that, and the
+step's end when nothing happened. Master level: on the riser tensioner, whose cylinder
+seal sticks and breaks away within the first second of heave, no unit's mode change may
+lie inside an accepted step once the steps are synchronised -- and without
+synchronisation some do (so the check can fail).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from wire_fmu.core.units.winch.unit import WinchUnit
+from wire_fmu.master.macro_step import MODE_CHANGE_TIME, SYNC_RESOLUTION_NS
+from wire_fmu.master.run import run_scene
+from wire_fmu.master.scene import SceneError, parse_scene
+
+from .winch_helpers import make_unit
+
+STOP_TIME = 1.0
+"""Simulated riser time, s: the seal's first stick/slip switches."""
+
+
+def test_a_layer_change_is_told_at_its_closed_form_time():
+    """Kinetostatic winch paying out at a constant speed: the rope leaves layer k at
+    ``phi = theta0 - k Theta``; the step that crosses it reports that time exactly."""
+    speed = 2.0  # rad/s, paying out
+    unit = make_unit("rope_layers", **{"drum.speed_command": speed})
+    model = unit.model
+    _, high = model.drum.phi_bounds(model.layer)  # paying out leaves the layer at its top
+    crossing = high / speed  # s, from phi = 0 at t = 0
+    h = 0.01
+    k = int(crossing // h)
+    for i in range(k):
+        assert unit.advance(i * h, h).success
+        assert unit.values[MODE_CHANGE_TIME] == i * h + h  # nothing happened: the end
+    assert unit.advance(k * h, h).success
+    assert k * h < crossing < (k + 1) * h
+    assert unit.values[MODE_CHANGE_TIME] == pytest.approx(crossing, rel=1e-12)
+
+
+def _mode_changes_inside_steps(out, synchronise: bool) -> tuple[int, int]:
+    """Run the riser; count the accepted steps in which a unit's mode changed strictly
+    inside (more than the synchronisation resolution from the step's end)."""
+    inside = []
+
+    class Watch:
+        def on_start(self, sim):
+            self.counts = dict(sim.mode_counts)
+            self.t = sim.time
+
+        def on_step(self, sim):
+            for name in sim.event_time_units:
+                slave = sim.slaves[name]
+                count = int(slave.get(["mode_changes"])["mode_changes"])
+                if count != self.counts[name]:
+                    when = float(slave.get([MODE_CHANGE_TIME])[MODE_CHANGE_TIME])
+                    if (sim.time - when) * 1e9 > SYNC_RESOLUTION_NS and when > self.t:
+                        inside.append((name, self.t, when, sim.time))
+                    self.counts[name] = count
+            self.t = sim.time
+
+        def on_end(self, sim, result):
+            pass
+
+    outcome = run_scene(
+        "riser_tensioner",
+        out,
+        plots=False,
+        stop_time=STOP_TIME,
+        synchronise_events=synchronise,
+        observers=[Watch()],
+    )
+    assert outcome.result.status == "finished", outcome.result.message
+    return len(inside), outcome.result.synchronised
+
+
+@pytest.mark.integration
+def test_synchronised_steps_leave_no_mode_change_inside_a_step(tmp_path):
+    """The riser's seal switches mode inside 2 ms steps; synchronised, every switch ends
+    its step (within 1 us), at the price of one shortened step per switch."""
+    free_inside, free_synchronised = _mode_changes_inside_steps(tmp_path / "free", False)
+    assert free_inside > 0 and free_synchronised == 0
+    inside, synchronised = _mode_changes_inside_steps(tmp_path / "sync", True)
+    assert inside == 0
+    assert synchronised >= free_inside
+
+
+def test_synchronise_events_must_be_true_or_false(tmp_path):
+    """A setting of the wrong type is named with what it should be."""
+    data = {"name": "x", "run": {"synchronise_events": "yes"}, "units": {}}
+    with pytest.raises(SceneError, match=r"run.synchronise_events must be true or false"):
+        parse_scene(data, base_dir=tmp_path)
+
+
+def test_mode_change_time_is_declared_on_every_unit_that_changes_mode():
+    """Declared as a continuous output in s on the winch (and read from its model)."""
+    variable = WinchUnit.variable(MODE_CHANGE_TIME)
+    assert variable.unit == "s" and variable.type is float
+    assert math.isinf(make_unit("drum_inertia").model.first_event_time)
