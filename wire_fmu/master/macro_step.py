@@ -192,13 +192,12 @@ class MacroStep:
             if name not in self.event_time_units or self._mode_count(name) == before:
                 continue
             when = float(self.slaves[name].get([MODE_CHANGE_TIME])[MODE_CHANGE_TIME])
-            if math.isfinite(when):
-                candidate = math.ceil(when * 1e9 - 1e-3)
-                earliest = candidate if earliest is None else min(earliest, candidate)
-        if earliest is None:
-            return None
-        if earliest - start_ns < SYNC_RESOLUTION_NS or end_ns - earliest < SYNC_RESOLUTION_NS:
-            return None
+            if not math.isfinite(when):
+                continue
+            candidate = math.ceil(when * 1e9 - 1e-3)  # a change at the step's start is older
+            inside = start_ns + SYNC_RESOLUTION_NS <= candidate <= end_ns - SYNC_RESOLUTION_NS
+            if inside and (earliest is None or candidate < earliest):
+                earliest = candidate
         return earliest
 
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:

@@ -74,14 +74,15 @@ def mode_change_time_output(what: str) -> Variable:
     Returns
     -------
     Variable
-        A continuous output in s: the time of the first mode change located inside
-        the last step, or the step's end if there was none. A master that
-        synchronises events steps every unit to that instant.
+        An output in s: the time of the first mode change located inside the
+        latest step that had one (a step without one leaves it as it was). A
+        master that sees ``mode_changes`` move in a step and this time inside
+        it can step every unit to that instant.
     """
     return output(
         MODE_CHANGE_TIME,
         "s",
-        f"Time of the first mode change ({what}) located inside the last step; its end if none",
+        f"Time of the first mode change ({what}) inside the latest step that had one",
     )
 
 
@@ -231,7 +232,7 @@ class Unit(ABC):
             self.time = time + step
             self._update_outputs()
             if MODE_CHANGE_TIME in self.values:
-                self.values[MODE_CHANGE_TIME] = self._mode_change_time(time, step)
+                self._note_mode_change_time(time, step)
         except STEP_ERRORS as err:
             self._restore_snapshot(saved)
             return StepResult(
@@ -239,11 +240,11 @@ class Unit(ABC):
             )
         return StepResult(True, events=tuple(events))
 
-    def _mode_change_time(self, time: float, step: float) -> float:
-        """The model's first located event inside ``(time, time + step)``, or the step's end, s."""
+    def _note_mode_change_time(self, time: float, step: float) -> None:
+        """Write the model's first located event inside ``(time, time + step)``, if any, s."""
         first = getattr(self.model, "first_event_time", math.inf)
-        end = time + step
-        return first if time < first < end else end
+        if time < first < time + step:
+            self.values[MODE_CHANGE_TIME] = first
 
     def timed_advance(self, time: float, step: float) -> StepResult:
         """:meth:`advance`, its wall-clock time added to :attr:`physics_seconds` (timing hook).
