@@ -5,6 +5,8 @@
     wire-fmu scenes                 list the shipped scenes
     wire-fmu check SCENE            validate a scene; list every problem, exit 1 if any
     wire-fmu run SCENE [-o DIR]     run it: progress bar, summary table, CSV and PNG plots
+    wire-fmu run SCENE --monolithic [--rtol RTOL]
+                                    the same units as one ODE (the accuracy reference)
     wire-fmu draw SCENE [-o DIR]    render each block train's reeving to a PNG
     wire-fmu build [-o DIR]         build our FMUs
     wire-fmu study accuracy SCENE [--quick] [-o DIR]
@@ -78,6 +80,34 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _positive_float_number(text: str) -> float:
+    """A finite number > 0 from the command line (no unit)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text}")
+    return value
+
+
+def _refuse_conflicts(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Options that contradict each other end the command as a usage error (exit 2)."""
+    if args.command != "run":
+        return
+    if args.monolithic and args.step is not None:
+        parser.error(
+            "--step sets the co-simulation's macro step; a --monolithic run has none: its "
+            "solver chooses its own steps to --rtol, and it records at the scene's "
+            "output_interval (else at its step): leave --step out"
+        )
+    if args.rtol is not None and not args.monolithic:
+        parser.error(
+            "--rtol is the tolerance of a --monolithic run; a co-simulated run's units take "
+            "their solver settings from the scene"
+        )
+
+
 def _study_parser(sub) -> None:
     p = sub.add_parser("study", help="what accuracy and effects cost in time")
     kinds = p.add_subparsers(dest="study", required=True)
@@ -143,6 +173,18 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
             p.add_argument("--stop-time", type=float, help="stop earlier (s), e.g. a quick look")
             p.add_argument("--step", type=float, help="macro step (s) instead of the scene's")
+            p.add_argument(
+                "--monolithic",
+                action="store_true",
+                help="solve the units as one ODE (no FMI, no macro step): the accuracy "
+                "reference, written as a run is",
+            )
+            p.add_argument(
+                "--rtol",
+                type=_positive_float_number,
+                help="with --monolithic: the solver's relative and absolute tolerance "
+                "(default 1e-8; the accuracy study's reference uses 1e-10)",
+            )
         p.set_defaults(func=func)
     p = sub.add_parser("sweep", help="run a parameter sweep (Dask)")
     p.add_argument("scene", help="a shipped scene's name or a scene file")
@@ -230,7 +272,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     int
         Exit status: 0 on success, 1 after an error, 130 after Ctrl-C.
     """
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    _refuse_conflicts(parser, args)
     logging.basicConfig(
         level=logging.DEBUG if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",

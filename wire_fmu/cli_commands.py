@@ -8,6 +8,7 @@ import logging
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from wire_fmu.core.errors import WireFmuError
 
@@ -92,13 +93,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed command line: ``scene``, ``output``, ``quiet``, ``fmu_dir``,
-        ``stop_time`` (s) and ``step`` (s).
+        ``stop_time`` (s), ``step`` (s), ``monolithic`` and ``rtol``.
 
     Returns
     -------
     int
         Exit status: 0 finished, 130 interrupted, 1 otherwise.
     """
+    if args.monolithic:
+        return _run_monolithic(args)
     from wire_fmu.master.observers import summary_rows
     from wire_fmu.master.run import run_scene
 
@@ -112,6 +115,39 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     _print(f"\nscene {outcome.scene.name!r}")
     _print(_table(summary_rows(outcome.simulation, outcome.result)))
+    return _run_files(outcome)
+
+
+def _run_monolithic(args: argparse.Namespace) -> int:
+    """``run --monolithic``: the scene's units as one ODE (:mod:`wire_fmu.study.monolithic_run`)."""
+    from wire_fmu.study.monolithic_run import DEFAULT_RTOL, run_scene_monolithic, summary_rows
+
+    outcome = run_scene_monolithic(
+        args.scene,
+        args.output,
+        progress=not args.quiet,
+        fmu_dir=args.fmu_dir,
+        stop_time=args.stop_time,
+        rtol=DEFAULT_RTOL if args.rtol is None else args.rtol,
+    )
+    _print(f"\nscene {outcome.scene.name!r}")
+    _print(_table(summary_rows(outcome)))
+    return _run_files(outcome)
+
+
+def _run_files(outcome: Any) -> int:
+    """Say where a run's files are and, last, how it ended unless it finished.
+
+    Parameters
+    ----------
+    outcome : Outcome or MonolithicOutcome
+        The run: its ``result``, ``directory``, ``csv_path`` and ``plots``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 finished, 130 interrupted, 1 otherwise.
+    """
     if outcome.csv_path.is_file():
         _print(f"\nresults: {outcome.csv_path.resolve()}")
     _print(f"metadata: {(outcome.directory / 'metadata.json').resolve()}")

@@ -22,6 +22,7 @@ import time
 from collections import defaultdict
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +33,13 @@ from wire_fmu.master.manipulators import DriverSet, ScheduledEvents
 from wire_fmu.master.scene import Scene, SceneError, VarRef
 from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
-__all__ = ["CORE_UNITS", "MonolithicModel", "MonolithicResult", "run_monolithic"]
+__all__ = [
+    "CORE_UNITS",
+    "MonolithicModel",
+    "MonolithicResult",
+    "advance_to",
+    "run_monolithic",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -292,6 +299,43 @@ class MonolithicModel:
         return [float(self.units[r.unit].values[r.variable]) for r in refs]
 
 
+def advance_to(
+    model: MonolithicModel, solver: Any, t: float, x: np.ndarray, t_next: float
+) -> tuple[np.ndarray, int]:
+    """Solve ``model`` from ``t`` to ``t_next``, stopping at every scheduled event between.
+
+    Parameters
+    ----------
+    model : MonolithicModel
+        The scene's units as one ODE, initialised.
+    solver : object
+        A solver of :func:`~wire_fmu.core.framework.hybrid.make_solver`.
+    t : float
+        Time of ``x``, s.
+    x : ndarray
+        Joint state at ``t``.
+    t_next : float
+        Time to reach, s (> ``t``).
+
+    Returns
+    -------
+    x : ndarray
+        Joint state at ``t_next``.
+    events : int
+        Guard events the solver located on the way.
+    """
+    events = 0
+    while t < t_next - 1e-12:
+        upcoming = model.events.next_time
+        target = min(t_next, upcoming) if upcoming is not None and upcoming > t else t_next
+        x, n = solver.advance(model, t, x, target)
+        events += n
+        t = target
+        if model.events.fire_due(t):
+            x = model.reconcile(t, x)
+    return x, events
+
+
 def _recorded(model: MonolithicModel) -> list[VarRef]:
     scene = model.scene
     if scene.outputs is not None:
@@ -344,14 +388,9 @@ def run_monolithic(
     start, events = time.perf_counter(), 0
     t = 0.0
     for t_next in times[1:]:
-        while t < t_next - 1e-12:
-            upcoming = model.events.next_time
-            target = min(t_next, upcoming) if upcoming is not None and upcoming > t else t_next
-            x, n = solver.advance(model, t, x, target)
-            events += n
-            t = target
-            if model.events.fire_due(t):
-                x = model.reconcile(t, x)
+        x, n = advance_to(model, solver, t, x, t_next)
+        events += n
+        t = t_next
         rows.append(model.outputs(t, x, refs))
     wall = time.perf_counter() - start
     data = np.array(rows)
