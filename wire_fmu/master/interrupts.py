@@ -7,14 +7,16 @@ import signal
 import threading
 from typing import Any
 
+__all__ = ["InterruptRequestedError", "Interrupts"]
+
 logger = logging.getLogger(__name__)
 
 
-class _InterruptRequestedError(Exception):
+class InterruptRequestedError(Exception):
     """Ctrl-C or SIGTERM was asked for between two macro steps."""
 
 
-class _Interrupts:
+class Interrupts:
     """While a run goes: SIGINT and SIGTERM end it between macro steps.
 
     A signal then only sets :attr:`requested`, so it never lands inside a
@@ -33,7 +35,7 @@ class _Interrupts:
         self.requested = True
         logger.warning("interrupted: the run ends after this step (Ctrl-C again to stop now)")
 
-    def __enter__(self) -> _Interrupts:
+    def __enter__(self) -> Interrupts:
         if threading.current_thread() is threading.main_thread():
             for signum in (signal.SIGINT, signal.SIGTERM):
                 self._previous[signum] = signal.signal(signum, self._handle)

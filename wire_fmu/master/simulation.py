@@ -47,7 +47,7 @@ from .algorithms import make_algorithm, step_order
 from .bond_energy import BondKeys
 from .energy_guard import EnergyGuard, _remedies
 from .exchange import MODE_OUTPUT, UnitExchange
-from .interrupts import _InterruptRequestedError, _Interrupts
+from .interrupts import InterruptRequestedError, Interrupts
 from .macro_step import MODE_CHANGE_TIME, MacroStep
 from .manipulators import DriverSet, ScheduledEvents
 from .run_result import RunResult, SimulationStoppedError
@@ -98,7 +98,7 @@ class Simulation(UnitExchange, MacroStep):
         self.event_time_units: set[str] = set()  # of mode_counts, those that tell when
         self.result = RunResult("not started")
         self._error_prev = 1.0
-        self._interrupts = _Interrupts()
+        self._interrupts = Interrupts()
         self._bond_keys = [BondKeys.of(b) for b in scene.bonds]
         self._watches: list[Watch] = []
         self._watching = False  # whether this step's end-of-step reads include the watches
@@ -170,7 +170,7 @@ class Simulation(UnitExchange, MacroStep):
         """
         wall = time.perf_counter()
         result = RunResult("finished")
-        with _Interrupts() as interrupts:
+        with Interrupts() as interrupts:
             self._interrupts = interrupts
             try:
                 self.initialize()
@@ -178,7 +178,7 @@ class Simulation(UnitExchange, MacroStep):
                 for obs in self.observers:
                     obs.on_start(self)
                 self._stepping(result)
-            except (KeyboardInterrupt, _InterruptRequestedError):
+            except (KeyboardInterrupt, InterruptRequestedError):
                 result.status = "interrupted"
                 result.message = f"interrupted at t = {self.time:.6g} s"
             except (SimulationStoppedError, StepRefusedError) as exc:
@@ -247,7 +247,7 @@ class Simulation(UnitExchange, MacroStep):
             t = now_ns / 1e9
             h = next_ns / 1e9 - t
             if self._interrupts.requested:
-                raise _InterruptRequestedError
+                raise InterruptRequestedError
             self._watching = self._watched_at(next_ns / 1e9)
             attempt = self._attempt(t, h)
             result.iterations += attempt.sweeps

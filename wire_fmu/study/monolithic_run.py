@@ -42,7 +42,7 @@ from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
 from wire_fmu.core.framework.step_limits import IntegrationError
 from wire_fmu.core.framework.unit import Unit
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
-from wire_fmu.master.interrupts import _InterruptRequestedError, _Interrupts
+from wire_fmu.master.interrupts import InterruptRequestedError, Interrupts
 from wire_fmu.master.observers import Progress
 from wire_fmu.master.run import (
     find_scene,
@@ -226,10 +226,10 @@ class _Solve:
         """Initialise and solve to the stop time, recording every output time; never raises."""
         result = RunResult("finished")
         wall = time.perf_counter()
-        with _Interrupts() as interrupts:
+        with Interrupts() as interrupts:
             try:
                 self._loop(interrupts)
-            except (KeyboardInterrupt, _InterruptRequestedError):
+            except (KeyboardInterrupt, InterruptRequestedError):
                 result.status = "interrupted"
                 result.message = f"interrupted at t = {self.clock.time:.6g} s"
             except _InitialisationError as exc:
@@ -248,7 +248,7 @@ class _Solve:
                 self._finish(result, wall)
         return result
 
-    def _loop(self, interrupts: _Interrupts) -> None:
+    def _loop(self, interrupts: Interrupts) -> None:
         settings = SolverSettings(method=METHOD, max_step=math.inf, rtol=self.rtol, atol=self.rtol)
         self.solver = make_solver(settings)
         try:
@@ -266,7 +266,7 @@ class _Solve:
             self.clock.run_settings.stop_time, record_interval(self.clock.scene)
         ):
             if interrupts.requested:
-                raise _InterruptRequestedError
+                raise InterruptRequestedError
             x, events = advance_to(self.model, self.solver, t, x, t_next)
             self.events += events
             t = self.clock.time = t_next
