@@ -35,22 +35,31 @@ multiple of every macro step, so each recorded row is a step end). For each
 key output ``k``::
 
     e_k = max_t |y_k(t) - y_ref_k(t)| / range_k,
-    range_k = max(max_t y_ref_k - min_t y_ref_k, 1e-6 max_t |y_ref_k|, 1e-300)
+    range_k = max(max_t y_ref_k - min_t y_ref_k, 1e-6 max_t |y_ref_k|)
 
-and the run's error is ``max_k e_k`` (the key output that sets it is
-recorded). A run that stops early (a refused step, a unit failure, a
-blow-up to non-finite numbers) has no error: it is recorded with its
-status and message and left out of the fits and plots.
+over the samples of the study's window (from 0 s to the stop time; a quick
+study's window may start later, :mod:`~wire_fmu.study.window`), and the
+run's error is ``max_k e_k`` (the key output that sets it is recorded). A
+run that stops early (a refused step, a unit failure, a blow-up to
+non-finite numbers) has no error: it is recorded with its status and
+message and left out of the fits and plots.
+
+A study that cannot say anything refuses (:mod:`~wire_fmu.study.key_outputs`):
+a key output that is not a physical quantity (a count, a flag, a state), or
+key outputs none of which moves in the window of the reference; a key output
+that does not move while others do is left out of the errors, with a
+warning in the summary.
 
 Families, orders, equal error
 -----------------------------
 A *family* is one (algorithm, extrapolation, solver); its runs differ only
 in the macro step. The observed order is the least-squares slope of
-``log e`` against ``log H`` over the family's runs in which coupling error
-dominates: error at most :data:`ASYMPTOTIC_LIMIT` (beyond it the run is not
-in the asymptotic range) and at least :data:`DOMINANCE` times the solver's
-floor (the smallest error any run with that solver reached, an upper bound
-of its own integration error). Theory (SPEC section 15): a held effort or
+``log e`` against ``log H`` over the family's runs in the asymptotic range
+(:mod:`~wire_fmu.study.orders`): the longest stretch of consecutive steps
+whose errors are at most :data:`ASYMPTOTIC_LIMIT`, above :data:`DOMINANCE`
+times the solver's floor (the monolithic model solved with that solver: its
+own integration error) and the reference's own error, and decrease at every
+step; with fewer than three such runs no order is fitted. Theory (SPEC section 15): a held effort or
 signal converges at order 1 held constant and at order 2 held at the
 midpoint of a linear (or the step average of a quadratic) extrapolant; a
 flow that a unit integrates into a position handed over exactly at each
@@ -76,8 +85,10 @@ The study's pieces
 :mod:`~wire_fmu.study.solvers` (the units' solver choices),
 :mod:`~wire_fmu.study.timing` (timed runs), :mod:`~wire_fmu.study.measures`
 (the error metric and the rows), :mod:`~wire_fmu.study.orders` (orders and
-equal error), :mod:`~wire_fmu.study.accuracy_report` (the files); this
-module runs the study.
+equal error), :mod:`~wire_fmu.study.window` (the compared window),
+:mod:`~wire_fmu.study.key_outputs` (physical, moving key outputs),
+:mod:`~wire_fmu.study.accuracy_report` (the files); this module runs the
+study.
 """
 
 from __future__ import annotations
@@ -96,15 +107,16 @@ from wire_fmu.core.framework.hybrid import IntegrationError
 from wire_fmu.master.scene import Scene, SceneError
 from wire_fmu.master.validate import Structure, validate_scene
 
-from .accuracy_report import AccuracyStudy, _fmt, write_accuracy_files
+from .accuracy_report import AccuracyStudy, observed_text, write_accuracy_files
+from .key_outputs import check_physical, moving_key_outputs, still_tolerance
 from .measures import (
     MONOLITHIC_RADAU,
+    Comparison,
     RunRow,
     _monolithic_row,
     _row,
     _skipped,
     one_line,
-    output_error,
 )
 from .monolithic import MonolithicResult, run_monolithic
 from .orders import default_targets, equal_error, observed_orders
@@ -121,6 +133,7 @@ from .plan import (
 )
 from .solvers import SolverChoice
 from .timing import StudyProgress, fastest_run, pinned
+from .window import first_sample
 
 __all__ = ["REFERENCE_MARGIN", "reference_run", "run_accuracy_study", "summary_text"]
 
@@ -179,7 +192,7 @@ def _run_grid(
     scene: Scene,
     structure: Structure,
     grid: Sequence[Configuration],
-    reference: MonolithicResult,
+    comparison: Comparison,
     settings: StudySettings,
     workdir: Path,
     progress: StudyProgress,
@@ -202,9 +215,7 @@ def _run_grid(
                 settings.repeats,
             )
             error, worst = (
-                output_error(run.columns, reference.values, settings.key_outputs)
-                if run.status == "finished"
-                else (math.nan, "")
+                comparison.error(run.columns) if run.status == "finished" else (math.nan, "")
             )
             row = _row(config, run, error, worst)
             if 2.0 * row.wall_time_s > settings.run_budget:
@@ -217,7 +228,7 @@ def _run_grid(
 def _monolithic_attempt(
     scene: Scene,
     settings: StudySettings,
-    reference: MonolithicResult,
+    comparison: Comparison,
     family: str,
     label: str,
     **solver,
@@ -246,7 +257,7 @@ def _monolithic_attempt(
             math.nan,
             one_line(f"{type(exc).__name__}: {exc}"),
         )
-    error, worst = output_error(result.values, reference.values, settings.key_outputs)
+    error, worst = comparison.error(result.values)
     return _monolithic_row(family, label, result, error, worst, settings.stop_time)
 
 
@@ -264,7 +275,7 @@ def _monolithic_solver(choice: SolverChoice) -> dict[str, Any] | None:
 
 
 def _monolithic_rows(
-    scene: Scene, settings: StudySettings, reference: MonolithicResult, progress: StudyProgress
+    scene: Scene, settings: StudySettings, comparison: Comparison, progress: StudyProgress
 ) -> list[RunRow]:
     """The monolithic model at looser Radau tolerances, and with each unit solver."""
     rows = []
@@ -273,7 +284,7 @@ def _monolithic_rows(
             _monolithic_attempt(
                 scene,
                 settings,
-                reference,
+                comparison,
                 MONOLITHIC_RADAU,
                 f"radau rtol={rtol:g}",
                 method="radau",
@@ -289,7 +300,7 @@ def _monolithic_rows(
                 _monolithic_attempt(
                     scene,
                     settings,
-                    reference,
+                    comparison,
                     f"monolithic / {choice.label}",
                     choice.label,
                     **solver,
@@ -336,7 +347,8 @@ def run_accuracy_study(
     SceneError
         The scene or its ``[study]`` table has problems.
     StudyError
-        No monolithic reference can be built for the scene.
+        No monolithic reference can be built for the scene; a key output is
+        not a physical quantity; no key output moves in the study's window.
     """
     started = time.perf_counter()
     opts = StudyOptions(**options)
@@ -349,6 +361,7 @@ def run_accuracy_study(
     base = study_scene(scene, settings)
     with tempfile.TemporaryDirectory(prefix="wire_fmu_study_") as tmp:
         structure = pinned(validate_scene(base, opts.fmu_dir), Path(tmp))
+        check_physical(scene.name, settings.key_outputs, structure.variable)
         study = _study(
             scene.name, base, structure, settings, Path(tmp) / "run", opts.progress, opts.stream
         )
@@ -377,13 +390,33 @@ def _study(
         f"reference: {reference.wall_time:.2f} s wall, {reference.rhs_calls} "
         f"right-hand side calls, {reference.events} events"
     )
-    rows = _run_grid(base, structure, grid, reference, settings, workdir, report)
-    rows += _monolithic_rows(base, settings, reference, report)
+    settings, notes, comparison = _compared(name, settings, reference)
+    rows = _run_grid(base, structure, grid, comparison, settings, workdir, report)
+    rows += _monolithic_rows(base, settings, comparison, report)
     orders = observed_orders(rows, base, REFERENCE_MARGIN * settings.reference_rtol)
-    comparison = equal_error(rows, default_targets(rows))
-    return AccuracyStudy(
-        name, settings, reference.wall_time / settings.stop_time, rows, orders, comparison
+    at_equal_error = equal_error(rows, default_targets(rows))
+    study = AccuracyStudy(
+        name, settings, reference.wall_time / settings.stop_time, rows, orders, at_equal_error
     )
+    study.notes = notes
+    return study
+
+
+def _compared(
+    name: str, settings: StudySettings, reference: MonolithicResult
+) -> tuple[StudySettings, list[str], Comparison]:
+    """The plan with the key outputs that move in the window, the warnings, the comparison."""
+    first = first_sample(reference.time, settings.window_start)
+    moving, notes = moving_key_outputs(
+        name,
+        reference.values,
+        settings.key_outputs,
+        settings.window,
+        first,
+        still_tolerance(settings.reference_rtol),
+    )
+    settings = replace(settings, key_outputs=moving)
+    return settings, notes, Comparison(reference.values, tuple(map(str, moving)), first)
 
 
 def summary_text(study: AccuracyStudy) -> str:
@@ -394,14 +427,17 @@ def summary_text(study: AccuracyStudy) -> str:
     study : AccuracyStudy
         What :func:`run_accuracy_study` produced.
     """
-    lines = [f"observed convergence orders ({study.scene}):"]
+    lines = [f"warning: {note}" for note in study.notes]
+    start, stop = study.settings.window
+    lines.append(
+        f"observed convergence orders ({study.scene}, errors over [{start:g}, {stop:g}] s):"
+    )
     width = max((len(o.family) for o in study.orders), default=10)
     for o in study.orders:
         theory = "-" if o.theory is None else str(o.theory)
-        lines.append(
-            f"  {o.family:<{width}}  theory {theory}  observed "
-            f"{_fmt(o.observed, '.2f'):>5}  ({o.points} runs)"
-        )
+        lines.append(f"  {o.family:<{width}}  theory {theory}  observed {observed_text(o)}")
+        if math.isfinite(o.observed):
+            lines[-1] += f"  ({o.points} runs)"
     lines.append(f"monolithic reference: {study.reference_wall_per_sim_s:.3g} s per simulated s")
     for c in study.comparison:
         if c.cheapest:

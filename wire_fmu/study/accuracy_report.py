@@ -10,12 +10,21 @@ from pathlib import Path
 import numpy as np
 
 from .measures import MONOLITHIC_RADAU, RunRow
-from .orders import ASYMPTOTIC_LIMIT, DOMINANCE, EqualErrorRow, OrderRow, _families
+from .orders import (
+    ASYMPTOTIC_LIMIT,
+    DOMINANCE,
+    MIN_ASYMPTOTIC_RUNS,
+    EqualErrorRow,
+    OrderRow,
+    _families,
+    not_fitted,
+)
 from .plan import StudySettings
 from .tables import write_tables
 
 __all__ = [
     "AccuracyStudy",
+    "observed_text",
     "accuracy_markdown",
     "plot_work_precision",
     "plot_convergence",
@@ -35,6 +44,8 @@ class AccuracyStudy:
     comparison: list[EqualErrorRow]
     files: dict[str, Path] = field(default_factory=dict)
     elapsed: float = 0.0
+    notes: list[str] = field(default_factory=list)
+    """Warnings about what the errors leave out (key outputs still in the window)."""
 
 
 # -------------------------------------------------------------------- reports
@@ -46,44 +57,74 @@ def _pct(value: float) -> str:
     return "—" if not math.isfinite(value) else f"{100 * value:.0f} %"
 
 
+def observed_text(order: OrderRow) -> str:
+    """The observed order (``"1.98"``), or ``"not fitted (n runs in the asymptotic range)"``.
+
+    Parameters
+    ----------
+    order : OrderRow
+        One family's order.
+    """
+    if math.isfinite(order.observed):
+        return f"{order.observed:.2f}"
+    return not_fitted(order.points)
+
+
+def _window_text(study: AccuracyStudy) -> str:
+    start, stop = study.settings.window
+    if start <= 0.0:
+        return f"{stop:g} s simulated"
+    return (
+        f"{stop:g} s simulated from 0 s, errors compared over the window [{start:g}, {stop:g}] s "
+        "(the lead-in is the scene's history: no unit starts mid-scene)"
+    )
+
+
 def _plan_lines(study: AccuracyStudy) -> list[str]:
     s = study.settings
     steps = ", ".join(f"{h:g}" for h in s.steps)
-    return [
-        f"# Accuracy study: {study.scene}" + (" (quick)" if s.quick else ""),
-        "",
-        f"{sum(r.algorithm != 'monolithic' for r in study.rows)} co-simulation runs of "
-        f"{s.stop_time:g} s simulated; macro steps {steps} s; errors on a grid of "
-        f"{s.output_interval:g} s; key outputs {', '.join(map(str, s.key_outputs))}.",
-        f"Reference: the monolithic model, Radau at rtol = atol = {s.reference_rtol:g}: "
-        f"**{study.reference_wall_per_sim_s:.3g} s per simulated second** (the dash-dotted "
-        "line in the diagram; the monolithic model at looser tolerances is the real floor). "
-        "The study took "
-        f"{study.elapsed:.0f} s.",
-        "",
-        "Error: for each key output, the largest deviation from the reference over the run "
-        "divided by that output's range in the reference; the run's error is the largest "
-        "of these. Cost: wall seconds per simulated second of the stepping phase.",
-        "",
-    ]
+    return (
+        [
+            f"# Accuracy study: {study.scene}" + (" (quick)" if s.quick else ""),
+            "",
+            f"{sum(r.algorithm != 'monolithic' for r in study.rows)} co-simulation runs of "
+            f"{_window_text(study)}; macro steps {steps} s; errors on a grid of "
+            f"{s.output_interval:g} s; key outputs {', '.join(map(str, s.key_outputs))}.",
+            f"Reference: the monolithic model, Radau at rtol = atol = {s.reference_rtol:g}: "
+            f"**{study.reference_wall_per_sim_s:.3g} s per simulated second** (the dash-dotted "
+            "line in the diagram; the monolithic model at looser tolerances is the real floor). "
+            "The study took "
+            f"{study.elapsed:.0f} s.",
+            "",
+            "Error: for each key output, the largest deviation from the reference over the "
+            "compared window divided by that output's range there in the reference; the run's "
+            "error is the largest "
+            "of these. Cost: wall seconds per simulated second of the stepping phase.",
+            "",
+        ]
+        + [f"**Warning:** {note}." for note in study.notes]
+        + ([""] if study.notes else [])
+    )
 
 
 def _order_lines(study: AccuracyStudy) -> list[str]:
     lines = [
         "## Observed convergence orders",
         "",
-        f"Slope of log error against log macro step over the runs with an error below "
-        f"{ASYMPTOTIC_LIMIT:g} and above {DOMINANCE:g} times the solver's smallest error "
-        "(where coupling error dominates).",
+        "Slope of log error against log macro step over the runs in the asymptotic range: "
+        f"the longest stretch of consecutive steps with errors below {ASYMPTOTIC_LIMIT:g}, "
+        f"above {DOMINANCE:g} times the solver's own error and the reference's, decreasing "
+        f"at every step; fitted on at least {MIN_ASYMPTOTIC_RUNS} runs.",
         "",
         "| family | theory | observed | runs used | steps used (s) |",
         "|---|---:|---:|---:|---|",
     ]
     for o in study.orders:
         theory = "—" if o.theory is None else str(o.theory)
-        used = ", ".join(f"{h:g}" for h in o.steps_used) or o.note
-        lines.append(f"| {o.family} | {theory} | {_fmt(o.observed, '.2f')} | {o.points} | {used} |")
-    return lines + [""]
+        used = ", ".join(f"{h:g}" for h in o.steps_used) or "—"
+        lines.append(f"| {o.family} | {theory} | {observed_text(o)} | {o.points} | {used} |")
+    notes = [f"- {o.family}: {o.note}." for o in study.orders if o.note]
+    return lines + ([""] + notes if notes else []) + [""]
 
 
 def _comparison_lines(study: AccuracyStudy) -> list[str]:
@@ -356,6 +397,8 @@ def write_accuracy_files(study: AccuracyStudy, directory: Path) -> dict[str, Pat
         "settings": study.settings,
         "elapsed_s": study.elapsed,
         "reference_wall_per_sim_s": study.reference_wall_per_sim_s,
+        "window_s": study.settings.window,
+        "notes": study.notes,
         "orders": study.orders,
         "equal_error": study.comparison,
         "runs": study.rows,

@@ -11,10 +11,20 @@ outputs (``[study]`` table, see :mod:`wire_fmu.study.accuracy`).
 Per effect it reports the time saved (wall seconds per simulated second,
 and as a share of the baseline's) and the change in the key outputs, with
 the accuracy study's metric taken against the baseline: the largest
-deviation over the run divided by the output's range in the baseline. It
-writes ``effects.csv``, ``effects.md`` and ``effects.png`` (time saved and
-output change side by side): the price list behind "simulate only the
-effects a scene calls for".
+deviation over the study's window divided by the output's range in the
+baseline (a quick study's window is the scene's ``quick_window``, see
+:mod:`wire_fmu.study.window`). It writes ``effects.csv``, ``effects.md``
+and ``effects.png`` (time saved and output change side by side): the price
+list behind "simulate only the effects a scene calls for"
+(:mod:`wire_fmu.study.effects_report`).
+
+A change is only ever relative to something that moves: a key output that
+is not a physical quantity is refused, and one that does not move in the
+baseline's window (swing zero or not above :func:`~wire_fmu.study.key_outputs.still_tolerance`
+of its magnitude, or not finite) is left out with a warning; if none
+moves, the study refuses (:mod:`wire_fmu.study.key_outputs`). A run
+without an effect whose key outputs are not finite numbers is
+``diverged``, with no change.
 
 Timing is the minimum over ``repeats`` runs of each case (the machine is
 shared and only ever slows a run down); a negative saving smaller than the
@@ -33,16 +43,26 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
+
 from wire_fmu.core.framework.effects import EffectCatalogue
 from wire_fmu.master.run import with_run_settings
 from wire_fmu.master.scene import Scene
 from wire_fmu.master.validate import validate_scene
 from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
-from .measures import one_line, output_error
+from .effects_report import (
+    change_text,
+    effects_markdown,
+    plot_effects,
+    summary_text,
+    write_effects_files,
+)
+from .key_outputs import check_physical, moving_key_outputs, still_tolerance
+from .measures import Comparison, one_line
 from .plan import StudyError, StudyOptions, StudySettings
-from .tables import write_tables
 from .timing import StudyProgress, TimedRun, fastest_run, pinned
+from .window import first_sample
 
 __all__ = [
     "EFFECT_CATALOGUES",
@@ -52,7 +72,10 @@ __all__ = [
     "effect_cases",
     "catalogue",
     "run_effects_study",
+    "change_text",
     "effects_markdown",
+    "plot_effects",
+    "write_effects_files",
     "summary_text",
     "verdict",
     "without",
@@ -181,6 +204,10 @@ class EffectsStudy:
     rows: list[EffectRow]
     files: dict[str, Path] = field(default_factory=dict)
     elapsed: float = 0.0
+    window: tuple[float, float] = (0.0, 0.0)
+    """The compared window, s (runs start at 0 s and end at its end)."""
+    notes: list[str] = field(default_factory=list)
+    """Warnings about what the changes leave out (key outputs still in the baseline)."""
 
 
 # ------------------------------------------------------------------------- runs
@@ -223,51 +250,87 @@ def verdict(saved: float, noise: float) -> str:
     return "within noise" if abs(saved) <= noise else word
 
 
+def _failed_row(case: EffectCase, status: str, base_cost: float, message: str) -> EffectRow:
+    return EffectRow(
+        case.unit,
+        case.effect,
+        " ".join(case.also_removed),
+        status,
+        math.nan,
+        base_cost,
+        math.nan,
+        math.nan,
+        "—",
+        math.nan,
+        "",
+        math.nan,
+        math.nan,
+        one_line(message),
+    )
+
+
 def _effect_row(
     case: EffectCase,
     run: TimedRun,
     spread: float,
     baseline: TimedRun,
     baseline_spread: float,
-    keys: Sequence[str],
+    comparison: Comparison,
 ) -> EffectRow:
     base_cost = baseline.timing.per_simulated_second
-    also = " ".join(case.also_removed)
     if run.status != "finished":
-        return EffectRow(
-            case.unit,
-            case.effect,
-            also,
-            run.status,
-            math.nan,
+        return _failed_row(case, run.status, base_cost, run.message)
+    change, worst = comparison.error(run.columns)
+    if math.isnan(change):
+        return _failed_row(case, "failed", base_cost, f"no change to report: {worst}")
+    if not math.isfinite(change):
+        return _failed_row(
+            case,
+            "diverged",
             base_cost,
-            math.nan,
-            math.nan,
-            "—",
-            math.nan,
-            "",
-            math.nan,
-            math.nan,
-            one_line(run.message),
+            f"without it, {worst} is not a finite number in the window: no change to report",
         )
     cost = run.timing.per_simulated_second
-    change, worst = output_error(run.columns, baseline.columns, keys)
     noise = max(spread, baseline_spread) if math.isfinite(spread + baseline_spread) else math.nan
+    saved = base_cost - cost
     return EffectRow(
         case.unit,
         case.effect,
-        also,
+        " ".join(case.also_removed),
         "finished",
         cost,
         base_cost,
-        base_cost - cost,
-        (base_cost - cost) / base_cost,
-        verdict(base_cost - cost, noise),
+        saved,
+        saved / base_cost if base_cost > 0.0 else math.nan,
+        verdict(saved, noise),
         change,
         worst,
         spread,
         run.timing.shares()[0],
     )
+
+
+def _baseline_comparison(
+    name: str, baseline: TimedRun, settings: StudySettings, stop: float
+) -> tuple[Comparison, list[str]]:
+    """What the runs without an effect are compared with: the baseline's moving key outputs."""
+    if baseline.status != "finished":
+        raise StudyError(
+            f"scene {name!r}: the run with all its effects did not "
+            f"finish ({baseline.status}): {baseline.message}"
+        )
+    window = (settings.window_start, stop)
+    first = first_sample(baseline.columns.get("time", np.zeros(0)), settings.window_start)
+    moving, notes = moving_key_outputs(
+        name,
+        baseline.columns,
+        settings.key_outputs,
+        window,
+        first,
+        still_tolerance(settings.reference_rtol),
+        source="run with every effect",
+    )
+    return Comparison(baseline.columns, tuple(map(str, moving)), first), notes
 
 
 def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: Any) -> EffectsStudy:
@@ -290,7 +353,8 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: An
     Raises
     ------
     StudyError
-        If the run with every effect does not finish.
+        If a key output is not a physical quantity, if the run with every
+        effect does not finish, or if no key output moves in its window.
     """
     started = time.perf_counter()
     opts = StudyOptions(**options)
@@ -299,37 +363,38 @@ def run_effects_study(scene: Scene | str | Path, output_dir: Path, **options: An
     base = effects_scene(scene, settings)
     cases = effect_cases(base)
     report = StudyProgress(len(cases) + 1, opts.stream, opts.progress)
+    window = (settings.window_start, base.run.stop_time)
     report.note(
         f"effects of {scene.name!r}: {len(cases)} effects, {repeats} run(s) each of "
-        f"{base.run.stop_time:g} s at H = {base.run.step:g} s"
+        f"{base.run.stop_time:g} s at H = {base.run.step:g} s, changes over "
+        f"[{window[0]:g}, {window[1]:g}] s"
     )
     rows = []
-    keys = [str(k) for k in settings.key_outputs]
     with tempfile.TemporaryDirectory(prefix="wire_fmu_effects_") as tmp:
         structure = pinned(validate_scene(base, opts.fmu_dir), Path(tmp))
+        check_physical(scene.name, settings.key_outputs, structure.variable)
         baseline, spread = fastest_run(base, structure, Path(tmp) / "run", repeats)
         report.advance(
             f"all effects: {baseline.status}, {baseline.timing.per_simulated_second:.3g} s/s"
         )
-        if baseline.status != "finished":
-            raise StudyError(
-                f"scene {scene.name!r}: the run with all its effects did not "
-                f"finish ({baseline.status}): {baseline.message}"
-            )
+        comparison, notes = _baseline_comparison(scene.name, baseline, settings, window[1])
         for case in cases:
             run, case_spread = fastest_run(
                 without(base, case), structure, Path(tmp) / "run", repeats
             )
-            rows.append(_effect_row(case, run, case_spread, baseline, spread, keys))
+            rows.append(_effect_row(case, run, case_spread, baseline, spread, comparison))
             report.advance(_describe(rows[-1]))
+    moving = tuple(k for k in settings.key_outputs if str(k) in comparison.keys)
     study = EffectsStudy(
         scene.name,
-        settings,
+        replace(settings, key_outputs=moving),
         base.run.step,
         repeats,
         baseline.timing.per_simulated_second,
         spread,
         rows,
+        window=window,
+        notes=notes,
     )
     study.elapsed = time.perf_counter() - started
     study.files = write_effects_files(study, Path(output_dir))
@@ -341,125 +406,5 @@ def _describe(row: EffectRow) -> str:
         return f"without {row.label}: {row.status} {row.message[:80]}"
     return (
         f"without {row.label}: {row.wall_per_sim_s:.3g} s/s (saves "
-        f"{100 * row.saved_share:.0f} %), outputs change {row.output_change:.2e}"
+        f"{100 * row.saved_share:.0f} %), outputs change {change_text(row)}"
     )
-
-
-# ---------------------------------------------------------------------- reports
-def _fmt(value: float, spec: str = ".3g") -> str:
-    return "—" if not math.isfinite(value) else format(value, spec)
-
-
-def effects_markdown(study: EffectsStudy) -> str:
-    """The summary ``effects.md``.
-
-    Parameters
-    ----------
-    study : EffectsStudy
-        The study to summarise.
-    """
-    s = study.settings
-    lines = [
-        f"# Effects study: {study.scene}" + (" (quick)" if s.quick else ""),
-        "",
-        f"Each effect left out in turn (with the effects that need it), at the scene's own "
-        f"coupling and step H = {study.step:g} s, {s.stop_time:g} s simulated, fastest of "
-        f"{study.repeats} run(s). With every effect: **{study.baseline_wall_per_sim_s:.3g} s "
-        f"per simulated second** (spread {_fmt(study.baseline_spread)} s/s).",
-        "",
-        "Output change: the largest deviation of a key output from the run with every "
-        f"effect, over its range there ({', '.join(map(str, s.key_outputs))}).",
-        "",
-        "| left out | s/s without | saved s/s | saved | time | output change | worst output | "
-        "spread s/s | status |",
-        "|---|---:|---:|---:|---|---:|---|---:|---|",
-    ]
-    for r in study.rows:
-        lines.append(
-            f"| {r.label} | {_fmt(r.wall_per_sim_s)} | {_fmt(r.saved_per_sim_s)} | "
-            f"{_fmt(100 * r.saved_share, '.0f')} % | {r.time_verdict} | "
-            f"{_fmt(r.output_change, '.2e')} | {r.worst_output} | "
-            f"{_fmt(r.spread_per_sim_s)} | {r.status} |"
-        )
-    if not study.rows:
-        lines.append("| (the scene's units include no effect) | | | | | | | | |")
-    lines += [
-        "",
-        "Time: *within noise* when the saving is no larger than the spread between "
-        "repeats (of this case or of the run with every effect).",
-    ]
-    lines += ["", f"The study took {study.elapsed:.0f} s. Files: `effects.csv`, `effects.png`.", ""]
-    return "\n".join(lines)
-
-
-def plot_effects(study: EffectsStudy, path: Path) -> Path:
-    """Bar chart: time saved (share of the baseline) and output change, per effect.
-
-    Parameters
-    ----------
-    study : EffectsStudy
-        The study to draw.
-    path : Path
-        PNG file to write (its folder must exist).
-    """
-    from matplotlib.figure import Figure
-
-    rows = [r for r in study.rows if r.status == "finished"]
-    fig = Figure(figsize=(10, 1.2 + 0.45 * max(len(rows), 1)), dpi=110, layout="constrained")
-    left, right = fig.subplots(1, 2, sharey=True)
-    labels = [r.label for r in rows]
-    y = range(len(rows))
-    left.barh(list(y), [100 * r.saved_share for r in rows], color="C0")
-    left.set_xlabel("time saved (% of wall time per simulated second)")
-    left.axvline(0.0, color="k", lw=0.8)
-    right.barh(list(y), [max(r.output_change, 1e-16) for r in rows], color="C3")
-    right.set_xscale("log")
-    right.set_xlabel("change in key outputs (max |dy| / range)")
-    left.set_yticks(list(y), labels)
-    left.invert_yaxis()
-    for ax in (left, right):
-        ax.grid(True, axis="x", alpha=0.3)
-    fig.suptitle(
-        f"{study.scene}: leaving effects out (all effects: {study.baseline_wall_per_sim_s:.3g} s/s)"
-    )
-    fig.savefig(path)
-    return path
-
-
-def write_effects_files(study: EffectsStudy, directory: Path) -> dict[str, Path]:
-    """Write the table, the summary, the JSON and the chart; return their paths.
-
-    Parameters
-    ----------
-    study : EffectsStudy
-        The study to write.
-    directory : Path
-        Folder for the files (created).
-    """
-    files = write_tables(directory, "effects", study.rows, effects_markdown(study), study)
-    files["png"] = plot_effects(study, directory / "effects.png")
-    return files
-
-
-def summary_text(study: EffectsStudy) -> str:
-    """The price list as plain text (for the command line).
-
-    Parameters
-    ----------
-    study : EffectsStudy
-        What :func:`run_effects_study` produced.
-    """
-    lines = [
-        f"effects of {study.scene!r}: all effects {study.baseline_wall_per_sim_s:.3g} s "
-        "per simulated s"
-    ]
-    width = max((len(r.label) for r in study.rows), default=10)
-    for r in study.rows:
-        lines.append(
-            f"  without {r.label:<{width}}  saves {_fmt(r.saved_per_sim_s):>6} s/s "
-            f"({_fmt(100 * r.saved_share, '.0f'):>3} %, {r.time_verdict})  outputs "
-            f"change {_fmt(r.output_change, '.2e')}  [{r.status}]"
-        )
-    if not study.rows:
-        lines.append("  the scene's units include no effect")
-    return "\n".join(lines)

@@ -18,7 +18,7 @@ from .monolithic import MonolithicResult
 from .plan import Configuration
 from .timing import TimedRun
 
-__all__ = ["MONOLITHIC_RADAU", "output_error", "RunRow", "one_line"]
+__all__ = ["MONOLITHIC_RADAU", "output_error", "Comparison", "RunRow", "one_line"]
 
 MONOLITHIC_RADAU = "monolithic / radau"
 """Family of the monolithic model at looser Radau tolerances."""
@@ -29,14 +29,16 @@ _DIVERGED = 1.0  # an error above the output's whole range: the run blew up
 
 # ---------------------------------------------------------------------- error
 def _scale(reference: np.ndarray) -> float:
+    """The output's swing, at least :data:`_RANGE_FLOOR` of its magnitude; 0 if neither."""
     span = float(np.ptp(reference)) if reference.size else 0.0
-    return max(span, _RANGE_FLOOR * float(np.max(np.abs(reference), initial=0.0)), 1e-300)
+    return max(span, _RANGE_FLOOR * float(np.max(np.abs(reference), initial=0.0)))
 
 
 def output_error(
     values: Mapping[str, np.ndarray],
     reference: Mapping[str, np.ndarray],
     keys: Sequence[VarRef | str],
+    first: int = 0,
 ) -> tuple[float, str]:
     """The study's error metric (module docstring) and the key output that sets it.
 
@@ -50,6 +52,16 @@ def output_error(
         The reference's columns on the same grid.
     keys : sequence of VarRef or str
         The key outputs compared.
+    first : int
+        Index of the first compared sample (the study window's start);
+        earlier samples are not compared.
+
+    Raises
+    ------
+    ValueError
+        If a key output is zero throughout the window of the reference: no
+        deviation can be scaled by its swing (the studies leave such outputs
+        out first, :mod:`wire_fmu.study.key_outputs`).
     """
     worst, which = 0.0, ""
     for key in map(str, keys):
@@ -57,12 +69,46 @@ def output_error(
         got = np.asarray(values.get(key, ()), dtype=float)
         if got.shape != ref.shape:
             return math.nan, f"{key}: {got.size} samples, the reference has {ref.size}"
-        error = float(np.max(np.abs(got - ref))) / _scale(ref)
+        scale = _scale(ref[first:])
+        if not (scale > 0.0 and math.isfinite(scale)):
+            raise ValueError(
+                f"{key} is {scale:g} in the reference's window: no error can be scaled by its swing"
+            )
+        error = float(np.max(np.abs(got[first:] - ref[first:]), initial=0.0)) / scale
         if not math.isfinite(error):
             return math.inf, key
         if error >= worst:
             worst, which = error, key
     return worst, which
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """What every run of a study is compared with: reference columns, key outputs, window.
+
+    Attributes
+    ----------
+    reference : mapping of str to ndarray
+        The reference's columns by name, on the study's output grid from 0 s.
+    keys : tuple of str
+        The key outputs measured (those that move in the window).
+    first : int
+        Index of the window's first sample.
+    """
+
+    reference: Mapping[str, np.ndarray]
+    keys: tuple[str, ...]
+    first: int = 0
+
+    def error(self, values: Mapping[str, np.ndarray]) -> tuple[float, str]:
+        """The run's error and the key output that sets it (see :func:`output_error`).
+
+        Parameters
+        ----------
+        values : mapping of str to ndarray
+            The run's columns by name, on the same grid.
+        """
+        return output_error(values, self.reference, self.keys, self.first)
 
 
 # ---------------------------------------------------------------------- rows

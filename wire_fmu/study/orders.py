@@ -2,6 +2,29 @@
 
 See the accuracy study (:mod:`wire_fmu.study.accuracy`, "Families, orders,
 equal error") for what is fitted and compared.
+
+The asymptotic range
+--------------------
+An order is a slope fitted where the error behaves like ``C H^p``: over a
+family's runs in the *asymptotic range* (:func:`asymptotic_runs`), the
+longest stretch of consecutive macro steps (no failed or skipped run in
+between) in which
+
+* each run finished with an error at most :data:`ASYMPTOTIC_LIMIT` (a
+  larger error is the pre-asymptotic, or blown-up, regime);
+* each error is above :data:`DOMINANCE` times the solver's own error and
+  above the reference's own (below them the solver or the reference, not
+  the coupling, sets the error); the solver's own error is the monolithic
+  model's with that solver, unless a run of the family is more accurate
+  than that (the estimate is then no floor and is not used, and the row
+  says so);
+* the error decreases monotonically as the step decreases (an error that
+  grows as the step halves is no convergence at all: a transient the runs
+  resolve differently, a kink, a plateau).
+
+With fewer than :data:`MIN_ASYMPTOTIC_RUNS` runs in that range no order is
+fitted: two points always lie on a line, and the table says "not fitted (n
+runs in the asymptotic range)" instead of a number.
 """
 
 from __future__ import annotations
@@ -21,7 +44,10 @@ __all__ = [
     "THEORY",
     "ASYMPTOTIC_LIMIT",
     "DOMINANCE",
+    "MIN_ASYMPTOTIC_RUNS",
     "OrderRow",
+    "asymptotic_runs",
+    "not_fitted",
     "theoretical_order",
     "observed_orders",
     "EqualErrorRow",
@@ -37,6 +63,9 @@ ASYMPTOTIC_LIMIT = 0.3
 
 DOMINANCE = 4.0
 """A run counts for the order only if its error is this many times the solver's floor."""
+
+MIN_ASYMPTOTIC_RUNS = 3
+"""Fewest runs in the asymptotic range an order is fitted on."""
 
 
 # --------------------------------------------------------------------- orders
@@ -89,8 +118,46 @@ def _slope(steps: Sequence[float], errors: Sequence[float]) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
+def asymptotic_runs(runs: Sequence[RunRow], floor: float) -> list[RunRow]:
+    """A family's runs in the asymptotic range (module docstring), largest step first.
+
+    The longest stretch of consecutive runs (by decreasing macro step) that
+    are usable, have an error in ``(floor, ASYMPTOTIC_LIMIT]`` and whose error
+    decreases at every step; of two as long, the one at smaller steps.
+
+    Parameters
+    ----------
+    runs : sequence of RunRow
+        The family's co-simulation runs (any order).
+    floor : float
+        Errors at or below it are the solver's or the reference's own.
+    """
+    ordered = sorted((r for r in runs if math.isfinite(r.step)), key=lambda r: -r.step)
+    best: list[RunRow] = []
+    stretch: list[RunRow] = []
+    for r in ordered:
+        if not (r.usable and floor < r.error <= ASYMPTOTIC_LIMIT):
+            stretch = []
+            continue
+        stretch = stretch + [r] if stretch and r.error < stretch[-1].error else [r]
+        if len(stretch) >= len(best):
+            best = stretch
+    return best
+
+
+def not_fitted(points: int) -> str:
+    """``"not fitted (2 runs in the asymptotic range)"``.
+
+    Parameters
+    ----------
+    points : int
+        Runs in the asymptotic range.
+    """
+    return f"not fitted ({points} run{'' if points == 1 else 's'} in the asymptotic range)"
+
+
 def observed_orders(rows: Sequence[RunRow], scene: Scene, min_error: float = 0.0) -> list[OrderRow]:
-    """The order of every family over its runs where coupling error dominates.
+    """The order of every family over its runs in the asymptotic range.
 
     Parameters
     ----------
@@ -111,41 +178,54 @@ def observed_orders(rows: Sequence[RunRow], scene: Scene, min_error: float = 0.0
         first = runs[0]
         if first.algorithm == "monolithic":
             continue
-        floor = max(DOMINANCE * floors.get(first.solver, 0.0), min_error)
-        kept = [r for r in runs if r.usable and floor < r.error <= ASYMPTOTIC_LIMIT]
-        theory = theoretical_order(scene, first.extrapolation)
-        if len(kept) < 2:
-            note = (
-                f"{len(kept)} run(s) with an error between {DOMINANCE:g} x the solver's own "
-                f"error and {ASYMPTOTIC_LIMIT:g}: not measurable"
-            )
-            out.append(
-                OrderRow(
-                    family,
-                    first.algorithm,
-                    first.extrapolation,
-                    first.solver,
-                    theory,
-                    math.nan,
-                    len(kept),
-                    note=note,
+        own, remark = _solver_floor(runs, floors.get(first.solver, 0.0))
+        floor = max(DOMINANCE * own, min_error)
+        kept = asymptotic_runs(runs, floor)
+        order = OrderRow(
+            family,
+            first.algorithm,
+            first.extrapolation,
+            first.solver,
+            theoretical_order(scene, first.extrapolation),
+            math.nan,
+            len(kept),
+            tuple(r.step for r in kept),
+            remark,
+        )
+        if len(kept) < MIN_ASYMPTOTIC_RUNS:
+            order.note = "; ".join(
+                filter(
+                    None,
+                    [
+                        f"{not_fitted(len(kept))}: at least {MIN_ASYMPTOTIC_RUNS} consecutive "
+                        f"steps with errors decreasing between {floor:.2g} and "
+                        f"{ASYMPTOTIC_LIMIT:g} are needed",
+                        remark,
+                    ],
                 )
             )
-            continue
-        observed = _slope([r.step for r in kept], [r.error for r in kept])
-        out.append(
-            OrderRow(
-                family,
-                first.algorithm,
-                first.extrapolation,
-                first.solver,
-                theory,
-                observed,
-                len(kept),
-                tuple(r.step for r in kept),
-            )
-        )
+        else:
+            order.observed = _slope([r.step for r in kept], [r.error for r in kept])
+        out.append(order)
     return out
+
+
+def _solver_floor(runs: Sequence[RunRow], own: float) -> tuple[float, str]:
+    """The solver's own error, unless the family's runs contradict it (then 0, and why).
+
+    The monolithic model solved with a unit's solver estimates that solver's
+    own error on the scene. A co-simulation run with a smaller error shows
+    that the estimate is no floor for these runs (one solver over the whole
+    stiff system is not the units' solvers each over its own part); the
+    monotone decrease of the errors then says where coupling dominates.
+    """
+    reached = min((r.error for r in runs if r.usable and r.error > 0.0), default=math.inf)
+    if own <= reached:
+        return own, ""
+    return 0.0, (
+        f"the monolithic model with this solver (error {own:.2g}) is no floor here: "
+        f"co-simulation runs reach {reached:.2g}"
+    )
 
 
 def _families(rows: Sequence[RunRow]) -> dict[str, list[RunRow]]:

@@ -1,7 +1,9 @@
 """The plan of a study: its settings from a scene's ``[study]`` table, and its grid.
 
 :func:`study_settings` reads the plan (key outputs, stop time, macro
-steps, output grid) a scene asks for, :func:`build_grid` lists the
+steps, output grid, the quick study's window) a scene asks for
+(:mod:`~wire_fmu.study.study_table`, :mod:`~wire_fmu.study.window`),
+:func:`build_grid` lists the
 configurations of the accuracy study (:mod:`wire_fmu.study.accuracy`),
 :func:`study_scene` and :func:`configured_scene` set a scene up for the
 study and for one configuration; :class:`StudyOptions` are how a study
@@ -12,7 +14,6 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TextIO
@@ -24,13 +25,20 @@ from wire_fmu.master.scene import (
     ALGORITHMS,
     EXTRAPOLATIONS,
     Scene,
-    SceneError,
     VarRef,
     load_scene,
 )
 from wire_fmu.master.validate import Structure
 
 from .solvers import DEFAULT_SOLVERS, SolverChoice, scene_solver
+from .study_table import (
+    STUDY_KEYS,
+    read_key_outputs,
+    read_output_interval,
+    read_steps,
+    read_study_table,
+)
+from .window import QUICK_WINDOW, quick_window
 
 __all__ = [
     "StudyError",
@@ -51,14 +59,12 @@ __all__ = [
     "StudyOptions",
 ]
 
-STUDY_KEYS = ("key_outputs", "stop_time", "steps", "output_interval")
-"""Keys of a scene's optional ``[study]`` table."""
-
 DEFAULT_STOP_TIME = 10.0
 """Study stop time, s, unless ``[study] stop_time`` says otherwise (capped by the scene's)."""
 
 QUICK_STOP_TIME = 1.0
-"""Stop time of the quick mode, s (capped by the study's)."""
+"""Stop time of the quick mode, s (capped by the study's), unless ``[study] quick_window``
+names a window (:mod:`wire_fmu.study.window`)."""
 
 
 class StudyError(WireFmuError):
@@ -106,6 +112,10 @@ class StudySettings:
         Runs per configuration; the fastest one's time counts.
     quick : bool
         Whether this is the reduced plan for CI.
+    window_start : float
+        Start of the compared window, s: every run starts at 0 s and stops at
+        ``stop_time``; samples before ``window_start`` are not compared
+        (:mod:`wire_fmu.study.window`).
     """
 
     key_outputs: tuple[VarRef, ...]
@@ -122,88 +132,17 @@ class StudySettings:
     solver_floors: bool = True
     repeats: int = 1
     quick: bool = False
+    window_start: float = 0.0
+
+    @property
+    def window(self) -> tuple[float, float]:
+        """The compared window, ``(window_start, stop_time)`` in s."""
+        return self.window_start, self.stop_time
 
 
-def _multiple(big: float, small: float) -> bool:
-    ratio = big / small
-    return abs(ratio - round(ratio)) < 1e-6 * max(1.0, ratio) and round(ratio) >= 1
-
-
-def _study_table(scene: Scene) -> Mapping[str, Any]:
-    table = getattr(scene, "study", None) or {}
-    unknown = sorted(set(table) - set(STUDY_KEYS))
-    if unknown:
-        raise SceneError(
-            f"scene {scene.name!r} [study]",
-            [f"unknown keys {unknown}; known: {', '.join(STUDY_KEYS)}"],
-        )
-    return table
-
-
-def _key_outputs(scene: Scene, table: Mapping[str, Any]) -> tuple[VarRef, ...]:
-    raw = table.get("key_outputs")
-    if raw is None:
-        refs = [r for plot in scene.plots for r in plot.variables]
-        refs = refs or list(scene.outputs or ())
-        if not refs:
-            raise SceneError(
-                f"scene {scene.name!r}",
-                [
-                    'no key outputs: give [study] key_outputs = ["unit.variable", ...] or '
-                    "[[plots]] variables"
-                ],
-            )
-        return tuple(dict.fromkeys(refs))
-    if not isinstance(raw, list) or not raw:
-        raise SceneError(
-            f"scene {scene.name!r} [study]",
-            ["key_outputs must be a non-empty list of 'unit.variable'"],
-        )
-    refs = [VarRef.parse(text) for text in raw]
-    bad = [text for text, ref in zip(raw, refs, strict=True) if ref is None]
-    if bad:
-        raise SceneError(
-            f"scene {scene.name!r} [study]",
-            [f"key_outputs: {text!r} is not 'unit.variable'" for text in bad],
-        )
-    return tuple(dict.fromkeys(refs))
-
-
-def _steps(scene: Scene, table: Mapping[str, Any], quick: bool) -> tuple[float, ...]:
-    raw = table.get("steps")
-    if raw is None:
-        exponents = (1, 0, -1) if quick else (2, 1, 0, -1, -2)
-        return tuple(scene.run.step * 2.0**k for k in exponents)
-    if (
-        not isinstance(raw, list)
-        or not raw
-        or not all(isinstance(h, int | float) and not isinstance(h, bool) and h > 0 for h in raw)
-    ):
-        raise SceneError(
-            f"scene {scene.name!r} [study]",
-            ["steps must be a non-empty list of positive macro steps (s)"],
-        )
-    steps = tuple(sorted((float(h) for h in raw), reverse=True))
-    if quick and len(steps) > 3:
-        middle = len(steps) // 2
-        steps = steps[middle - 1 : middle + 2]
-    return steps
-
-
-def _output_interval(scene: Scene, table: Mapping[str, Any], steps: Sequence[float]) -> float:
-    interval = float(table.get("output_interval", steps[0]))
-    problems = [
-        f"output_interval {interval:g} s is not a multiple of the macro step {h:g} s"
-        for h in steps
-        if not _multiple(interval, h)
-    ]
-    if problems:
-        raise SceneError(
-            f"scene {scene.name!r} [study]",
-            problems
-            + ["every run is compared on one grid of step ends: choose steps that divide it"],
-        )
-    return interval
+def _on_grid(stop: float, interval: float) -> float:
+    """``stop`` rounded down to a multiple of ``interval`` (at least one interval), s."""
+    return max(1, math.floor(stop / interval + 1e-9)) * interval
 
 
 def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
@@ -213,26 +152,28 @@ def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
     ----------
     scene : Scene
         The scene; its optional ``[study]`` table may give ``key_outputs``,
-        ``stop_time``, ``steps`` and ``output_interval``.
+        ``stop_time``, ``steps``, ``output_interval`` and ``quick_window``.
     quick : bool
         The reduced plan for CI: three macro steps, constant and linear
-        extrapolation, the scene's own solvers only, at most
-        :data:`QUICK_STOP_TIME` seconds, no monolithic curve.
+        extrapolation, the scene's own solvers only, no monolithic curve,
+        over the scene's ``quick_window`` (runs from 0 s to its end, samples
+        compared within it), else the first :data:`QUICK_STOP_TIME` seconds.
 
     Raises
     ------
     SceneError
         Listing the problems of the ``[study]`` table.
     """
-    table = _study_table(scene)
-    keys = _key_outputs(scene, table)
-    steps = _steps(scene, table, quick)
-    interval = _output_interval(scene, table, steps)
+    table = read_study_table(scene)
+    keys = read_key_outputs(scene, table)
+    steps = read_steps(scene, table, quick)
+    interval = read_output_interval(scene, table, steps)
+    window = quick_window(scene, table, interval)
     stop = float(table.get("stop_time", min(scene.run.stop_time, DEFAULT_STOP_TIME)))
+    start = 0.0
     if quick:
-        stop = min(stop, QUICK_STOP_TIME)
-    stop = max(1, math.floor(stop / interval + 1e-9)) * interval
-    settings = StudySettings(keys, stop, steps, interval)
+        start, stop = window if window is not None else (0.0, min(stop, QUICK_STOP_TIME))
+    settings = StudySettings(keys, _on_grid(stop, interval), steps, interval, window_start=start)
     if quick:
         settings = replace(
             settings,
@@ -248,6 +189,9 @@ def study_settings(scene: Scene, *, quick: bool = False) -> StudySettings:
 def with_stop_time(settings: StudySettings, stop_time: float | None) -> StudySettings:
     """``settings`` with another stop time (a multiple of the output interval); None: as is.
 
+    The window keeps its start: a quick study of a window ``[a, b]`` given
+    ``stop_time`` compares ``[a, stop_time]``.
+
     Parameters
     ----------
     settings : StudySettings
@@ -260,13 +204,21 @@ def with_stop_time(settings: StudySettings, stop_time: float | None) -> StudySet
     ------
     ValueError
         If ``stop_time`` is not a positive finite number.
+    StudyError
+        If it leaves fewer than two samples after the window's start.
     """
     if stop_time is None:
         return settings
     if not (math.isfinite(stop_time) and stop_time > 0):
         raise ValueError(f"stop_time must be a positive number of seconds, got {stop_time!r}")
-    interval = settings.output_interval
-    return replace(settings, stop_time=max(1, math.floor(stop_time / interval + 1e-9)) * interval)
+    stop = _on_grid(stop_time, settings.output_interval)
+    if stop < settings.window_start + settings.output_interval * (1.0 - 1e-9):
+        raise StudyError(
+            f"a stop time of {stop_time:g} s leaves no window to compare: the study's window "
+            f"starts at {settings.window_start:g} s ([study] {QUICK_WINDOW}); give a stop "
+            f"time of at least {settings.window_start + settings.output_interval:g} s, or none"
+        )
+    return replace(settings, stop_time=stop)
 
 
 # ----------------------------------------------------------------------- the grid
@@ -457,7 +409,19 @@ class StudyOptions:
         ------
         SceneError
             The scene or its ``[study]`` table has problems.
+        StudyError
+            The plan's window holds fewer than two samples.
         """
         scene = load_study_scene(scene)
         settings = self.settings or study_settings(scene, quick=self.quick)
-        return scene, with_stop_time(settings, self.stop_time)
+        try:
+            settings = with_stop_time(settings, self.stop_time)
+        except StudyError as exc:
+            raise StudyError(f"scene {scene.name!r}: {exc}") from None
+        start, stop = settings.window
+        if not 0.0 <= start <= stop - settings.output_interval * (1.0 - 1e-9):
+            raise StudyError(
+                f"scene {scene.name!r}: the study's window [{start:g}, {stop:g}] s holds "
+                f"fewer than two samples of its {settings.output_interval:g} s grid"
+            )
+        return scene, settings
