@@ -134,7 +134,7 @@ def _study_parser(sub) -> None:
             type=_positive_float,
             default=None,
             help="simulated seconds per run (default: [study] stop_time, else the "
-            "scene's, at most 10 s; 1 s with --quick)",
+            "scene's, at most 10 s; with --quick the end of [study] quick_window, else 1 s)",
         )
         if name == "accuracy":
             q.add_argument(

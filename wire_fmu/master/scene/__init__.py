@@ -73,6 +73,7 @@ Format::
     stop_time = 10.0          # s, of every study run
     steps = [0.02, 0.01, 0.005]              # macro steps, s
     output_interval = 0.02    # s, a multiple of every step
+    quick_window = [3.8, 4.8] # s, what --quick compares: where the scene's action is
 
 Modules: :mod:`.data` (what a scene holds), :mod:`.reading` (files and
 plain data to a scene), :mod:`.sections` (one parser per section of the
