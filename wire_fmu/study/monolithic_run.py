@@ -318,14 +318,9 @@ def run_scene_monolithic(
 
     Parameters
     ----------
-    scene : str, Path or Scene
-        A shipped scene's name, a scene file, or a parsed scene.
-    results : Path, optional
-        Results folder (default ``results/<scene name>`` in the working folder).
-    progress : bool
-        Show a progress bar on stderr.
-    plots : bool
-        Draw the scene's plots as PNG files after the run.
+    scene, results, progress, plots
+        As :func:`~wire_fmu.master.run.run_scene` takes them: the scene (name, file or
+        parsed), the results folder, a progress bar on stderr, the scene's plots.
     fmu_dir : str or Path
         Where our FMUs are built and cached (their model descriptions check the
         scene and give the columns' units).
