@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from .extrapolation import History
     from .scene import Bond
 
-__all__ = ["BondKeys", "bond_step_energy", "step_energy"]
+__all__ = ["BondKeys", "step_energy"]
 
 
 @dataclass(frozen=True)
@@ -69,19 +69,19 @@ class BondKeys:
         )
 
 
-def bond_step_energy(
-    bond: Bond,
+def step_energy(
+    keys: BondKeys,
     histories: Mapping[str, History],
     held: Mapping[str, float],
     new: Mapping[str, float],
     h: float,
 ) -> tuple[float, float]:
-    """Energy the coupling of ``bond`` created over the step just taken, and its power.
+    """Energy the coupling of a bond created over the step just taken, and its power.
 
     Parameters
     ----------
-    bond : Bond
-        The bond, with its effort, flow and (optional) position links.
+    keys : BondKeys
+        The bond's link names (:meth:`BondKeys.of`).
     histories : mapping of str to History
         Each source output's history (``"unit.variable"``); its latest point is
         the value at the start of the step.
@@ -100,34 +100,6 @@ def bond_step_energy(
     power : float
         Power the bond transmitted over the step (held effort times the mean
         flow), W.
-    """
-    return step_energy(BondKeys.of(bond), histories, held, new, h)
-
-
-def step_energy(
-    keys: BondKeys,
-    histories: Mapping[str, History],
-    held: Mapping[str, float],
-    new: Mapping[str, float],
-    h: float,
-) -> tuple[float, float]:
-    """:func:`bond_step_energy` of a bond given by the names of its links.
-
-    Parameters
-    ----------
-    keys : BondKeys
-        The bond's link names (:meth:`BondKeys.of`).
-    histories, held, new : mapping
-        As for :func:`bond_step_energy`.
-    h : float
-        The step just taken, s.
-
-    Returns
-    -------
-    residual : float
-        Energy the coupling created (positive) or destroyed, J.
-    power : float
-        Power the bond transmitted over the step, W.
     """
     e_key, f_key = keys.effort, keys.flow
     e0, e1 = histories[e_key].latest, new[e_key]

@@ -307,15 +307,9 @@ class CsvRecorder:
         }
         if result is not None:
             meta["result"] = {
-                "status": result.status,
-                "message": result.message,
-                "end_time": result.end_time,
-                "wall_time": result.wall_time,
-                "real_time_factor": result.end_time / result.wall_time
-                if result.wall_time
-                else None,
-                "steps": result.steps,
+                **result.summary(),
                 "rejected_steps": result.rejected,
+                "synchronised_steps": result.synchronised,
                 "sweeps": result.iterations,
                 "bond_energy_residual": result.bond_residual,
                 "bond_energy_carried": result.bond_carried,

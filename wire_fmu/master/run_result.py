@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 __all__ = ["RunResult", "SimulationStoppedError", "STATUSES"]
 
@@ -36,3 +37,21 @@ class RunResult:
     """Wall time of the stepping loop alone (no instantiation, initialisation or clean-up), s."""
     stepping_fmi_time: float = 0.0
     """Time inside the FMI calls made by the stepping loop, s."""
+
+    def summary(self) -> dict[str, Any]:
+        """How the run ended, as ``metadata.json`` gives it (every kind of run alike).
+
+        Returns
+        -------
+        dict
+            Status and message, simulated end time (s), wall time (s), real-time
+            factor (None before any wall time) and accepted macro steps.
+        """
+        return {
+            "status": self.status,
+            "message": self.message,
+            "end_time": self.end_time,
+            "wall_time": self.wall_time,
+            "real_time_factor": self.end_time / self.wall_time if self.wall_time else None,
+            "steps": self.steps,
+        }

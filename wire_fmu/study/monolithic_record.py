@@ -310,17 +310,7 @@ class Recorder:
         """
         meta = dict(self.meta)
         if result is not None:
-            meta["result"] = {
-                "status": result.status,
-                "message": result.message,
-                "end_time": result.end_time,
-                "wall_time": result.wall_time,
-                "real_time_factor": result.end_time / result.wall_time
-                if result.wall_time
-                else None,
-                "steps": result.steps,
-                **solver,
-            }
+            meta["result"] = {**result.summary(), **solver}
         self.meta_path.write_text(json.dumps(meta, indent=2, default=str) + "\n")
 
 
