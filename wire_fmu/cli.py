@@ -1,4 +1,4 @@
-"""The ``wire-fmu`` command.
+"""The wire-fmu command: run, check, draw, study and export co-simulation scenes.
 
 ::
 
@@ -22,7 +22,8 @@ SCENE is a shipped scene's name or a path to a scene file; check, run and
 export also take an SSP package (.ssp).
 
 Exit status: 0 done (a run finished); 1 a problem (every one is listed), or a
-run that ended ``stopped`` or ``failed``; 130 interrupted by Ctrl-C. No command
+run that ended ``stopped`` or ``failed``; 130 interrupted by Ctrl-C; 141 the
+reader of the output went away (``wire-fmu scenes | head -1``). No command
 prints a traceback unless ``--verbose`` is given.
 """
 
@@ -38,6 +39,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from wire_fmu.cli_commands import (
+    EXIT_BROKEN_PIPE,
     EXIT_INTERRUPTED,
     _print,
     cmd_build,
@@ -280,7 +282,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     with _CtrlC() as ctrl_c:
-        code = _command(args, ctrl_c)
+        try:
+            code = _command(args, ctrl_c)
+            sys.stdout.flush()
+        except BrokenPipeError:
+            return _closed_pipe()
     if code == EXIT_INTERRUPTED and argv is None:
         # The command line itself: end now with 130. A Ctrl-C a unit caught is delivered to
         # this process once more by the FMU binary, and would otherwise end it by SIGINT.
@@ -290,10 +296,30 @@ def main(argv: Sequence[str] | None = None) -> int:
     return code
 
 
+def _closed_pipe() -> int:
+    """The reader of our output went away (``wire-fmu scenes | head -1``): end quietly.
+
+    Standard output is pointed at the null device so that the interpreter's own
+    flush at exit finds nothing to write to the closed pipe.
+
+    Returns
+    -------
+    int
+        Exit status 141 (128 + SIGPIPE), what a shell reports for a command
+        ended by a closed pipe.
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return EXIT_BROKEN_PIPE
+
+
 def _command(args: argparse.Namespace, ctrl_c: _CtrlC) -> int:
     """Run the chosen command; every ending is an exit status and a message, no traceback."""
     try:
         return args.func(args)
+    except BrokenPipeError:
+        raise  # the reader went away: nothing more can be said (see _closed_pipe)
     except KeyboardInterrupt:
         _print("\ninterrupted")
         return EXIT_INTERRUPTED

@@ -5,7 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import re
+import shutil
 import sys
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -22,10 +25,18 @@ __all__ = [
     "cmd_export",
     "cmd_study",
     "EXIT_INTERRUPTED",
+    "EXIT_BROKEN_PIPE",
+    "plural",
+    "first_sentence",
 ]
 
 EXIT_INTERRUPTED = 130
 """Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
+
+EXIT_BROKEN_PIPE = 141
+"""Exit status when the reader of the output went away (128 + SIGPIPE), as shells report it."""
+
+_SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=[A-Z('\"])")
 
 
 def _print(text: str = "") -> None:
@@ -35,6 +46,61 @@ def _print(text: str = "") -> None:
 def _table(rows: Sequence[tuple[str, str]]) -> str:
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)
+
+
+def plural(count: int, noun: str, plural_form: str | None = None) -> str:
+    """``count`` and ``noun``, the noun in the plural unless the count is one.
+
+    Parameters
+    ----------
+    count : int
+        How many.
+    noun : str
+        The noun in the singular (``"bond"``).
+    plural_form : str, optional
+        The plural when it is not ``noun + "s"``.
+
+    Returns
+    -------
+    str
+        ``"1 bond"``, ``"0 bonds"``, ``"3 bonds"``.
+    """
+    return f"{count} {noun if count == 1 else plural_form or noun + 's'}"
+
+
+def first_sentence(text: str) -> str:
+    """The first sentence of ``text``, whole, its lines joined.
+
+    A sentence ends at ``.``, ``!`` or ``?`` followed by white space and a
+    capital letter, a parenthesis or a quote (so ``Fig. 6`` does not end one).
+
+    Parameters
+    ----------
+    text : str
+        A description, possibly over several lines.
+
+    Returns
+    -------
+    str
+        The first sentence, or the whole text if it has one sentence.
+    """
+    joined = " ".join(text.split())
+    return _SENTENCE_END.split(joined, maxsplit=1)[0]
+
+
+def _wrapped_table(rows: Sequence[tuple[str, str]], width: int) -> str:
+    """A two-column table whose second column wraps under itself at ``width`` characters."""
+    key_width = max(len(k) for k, _ in rows)
+    indent = " " * (key_width + 4)
+    lines = []
+    for key, text in rows:
+        lines += textwrap.wrap(
+            text,
+            width=max(width, len(indent) + 30),
+            initial_indent=f"  {key:<{key_width}}  ",
+            subsequent_indent=indent,
+        ) or [f"  {key}"]
+    return "\n".join(lines)
 
 
 def cmd_scenes(args: argparse.Namespace) -> int:
@@ -56,10 +122,11 @@ def cmd_scenes(args: argparse.Namespace) -> int:
     rows = []
     for name, path in shipped_scenes().items():
         try:
-            rows.append((name, load_scene(path).description.strip().splitlines()[0]))
-        except (WireFmuError, IndexError):
+            rows.append((name, first_sentence(load_scene(path).description) or "-"))
+        except WireFmuError:
             rows.append((name, "(cannot be read)"))
-    _print(_table(rows) if rows else "no shipped scenes")
+    width = shutil.get_terminal_size((100, 24)).columns - 1
+    _print(_wrapped_table(rows, width) if rows else "no shipped scenes")
     return 0
 
 
@@ -80,8 +147,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     scene = check_scene(args.scene, args.fmu_dir)
     _print(
-        f"scene {scene.name!r}: no problems ({len(scene.units)} units, "
-        f"{len(scene.bonds)} bonds, {len(scene.connections)} connections)"
+        f"scene {scene.name!r}: no problems ({plural(len(scene.units), 'unit')}, "
+        f"{plural(len(scene.bonds), 'bond')}, {plural(len(scene.connections), 'connection')})"
     )
     return 0
 
@@ -273,7 +340,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     counts = ", ".join(f"{n} {status}" for status, n in sorted(result.counts.items()))
     _print(
-        f"\nsweep {spec.name!r} of scene {scene.name!r}: {len(result.rows)} cases ({counts}); "
+        f"\nsweep {spec.name!r} of scene {scene.name!r}: {plural(len(result.rows), 'case')} "
+        f"({counts}); "
         f"{result.executed} run now, {result.reused} from earlier, {result.wall_time:.3g} s"
     )
     _print(f"summary: {result.summary_path.resolve()}")

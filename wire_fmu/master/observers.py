@@ -15,7 +15,8 @@
     variables with their units and descriptions, the settings and, at the end,
     the summary (status, per-unit call counts and time).
 :class:`Progress`
-    a one-line progress bar on stderr.
+    a progress bar on stderr with the time left: one line redrawn in place on a
+    terminal, plain lines (a tenth of the run each) when redirected.
 """
 
 from __future__ import annotations
@@ -334,7 +335,22 @@ def _cell(value: Any) -> Any:
 
 
 class Progress:
-    """A one-line progress bar on a stream (stderr by default)."""
+    """A progress bar on a stream (stderr by default): done, simulated time, speed, time left.
+
+    On a terminal the bar is one line redrawn in place (carriage return) at most
+    every ``every`` seconds. On anything else (a file, a pipe, a CI log) it
+    writes plain lines, one as each tenth of the run is done and one at the end,
+    so that a redirected log holds readable lines and no carriage returns.
+
+    Parameters
+    ----------
+    stream : text stream, optional
+        Where to write (default ``sys.stderr``).
+    width : int
+        Characters of the bar.
+    every : float
+        Shortest wall-clock time between redraws on a terminal, s.
+    """
 
     def __init__(self, stream=None, width: int = 30, every: float = 0.2) -> None:
         self.stream = stream or sys.stderr
@@ -342,6 +358,8 @@ class Progress:
         self.every = every
         self._last = 0.0
         self._start = 0.0
+        self._tenths = 0  # tenths of the run written as plain lines so far
+        self._terminal = _is_terminal(self.stream)
 
     def on_start(self, sim: Simulation) -> None:
         """Start the clock.
@@ -349,37 +367,82 @@ class Progress:
         Parameters as in :meth:`Observer.on_start`.
         """
         self._start = time.perf_counter()
+        self._last = 0.0
+        self._tenths = 0
 
     def on_step(self, sim: Simulation) -> None:
-        """Redraw at most every ``every`` seconds.
+        """Redraw (terminal) at most every ``every`` seconds, or write a line per tenth done.
 
         Parameters as in :meth:`Observer.on_step`.
         """
         now = time.perf_counter()
-        if now - self._last >= self.every:
-            self._last = now
-            self._draw(sim, now)
+        if self._terminal:
+            if now - self._last >= self.every:
+                self._last = now
+                self._write("\r" + self._text(sim, now))
+            return
+        tenths = int(10 * _done(sim) + 1e-9)
+        if tenths > self._tenths and tenths < 10:  # the end is written by on_end
+            self._tenths = tenths
+            self._write(self._text(sim, now) + "\n")
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
-        """Final state of the bar.
+        """Final state of the bar, ended by a new line.
 
         Parameters as in :meth:`Observer.on_end`.
         """
-        self._draw(sim, time.perf_counter())
-        self.stream.write("\n")
+        text = self._text(sim, time.perf_counter())
+        self._write(("\r" if self._terminal else "") + text + "\n")
+
+    def _write(self, text: str) -> None:
+        self.stream.write(text)
         self.stream.flush()
 
-    def _draw(self, sim: Simulation, now: float) -> None:
-        stop = sim.run_settings.stop_time
-        done = min(1.0, sim.time / stop) if stop else 1.0
+    def _text(self, sim: Simulation, now: float) -> str:
+        """The bar: scene, bar, per cent, simulated time, real-time factor, time left."""
+        done = _done(sim)
         bar = "#" * int(done * self.width)
         elapsed = now - self._start
         rtf = sim.time / elapsed if elapsed > 0 else 0.0
-        self.stream.write(
-            f"\r{sim.scene.name}: [{bar:<{self.width}}] {100 * done:5.1f} % "
-            f"t = {sim.time:8.3f} s  {rtf:6.2f}x real time"
+        return (
+            f"{sim.scene.name}: [{bar:<{self.width}}] {100 * done:5.1f} % "
+            f"t = {sim.time:8.3f} s  {rtf:6.2f}x real time  {_time_left(done, elapsed)}"
         )
-        self.stream.flush()
+
+
+def _done(sim: Simulation) -> float:
+    """Fraction of the run done, 0 to 1."""
+    stop = sim.run_settings.stop_time
+    return min(1.0, max(0.0, sim.time / stop)) if stop else 1.0
+
+
+def _time_left(done: float, elapsed: float) -> str:
+    """Wall-clock time left at the speed so far (``left 1 min 05 s``); unknown before 1 %."""
+    if done >= 1.0:
+        return f"took {_duration(elapsed)}"
+    if done < 0.01 or elapsed <= 0.0:
+        return "left --"
+    return f"left {_duration(elapsed * (1.0 - done) / done)}"
+
+
+def _duration(seconds: float) -> str:
+    """A wall-clock duration for people: ``42 s``, ``3 min 05 s``, ``1 h 02 min``."""
+    seconds = max(0.0, seconds)
+    if seconds < 60.0:
+        return f"{seconds:.0f} s" if seconds >= 9.5 else f"{seconds:.1f} s"
+    minutes, secs = divmod(int(round(seconds)), 60)
+    if minutes < 60:
+        return f"{minutes} min {secs:02d} s"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours} h {minutes:02d} min"
+
+
+def _is_terminal(stream: Any) -> bool:
+    """Whether ``stream`` is a terminal (a stream without ``isatty`` is taken as none)."""
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):
+        return False
 
 
 def summary_rows(sim: Simulation, result: RunResult) -> list[tuple[str, str]]:
