@@ -81,8 +81,18 @@ UNIT_TYPES = (
         f"{_UNITS}.hydraulics.unit:HydraulicsUnit",
         f"{_UNITS}.hydraulics.model:HYDRAULICS_EFFECTS",
     ),
-    UnitType("ScissorJack", "scissor_jack.py", f"{_UNITS}.scissor_jack.unit:ScissorJackUnit"),
-    UnitType("MultiMassDrive", "drive.py", f"{_UNITS}.multimass_drive.unit:DriveUnit"),
+    UnitType(
+        "ScissorJack",
+        "scissor_jack.py",
+        f"{_UNITS}.scissor_jack.unit:ScissorJackUnit",
+        f"{_UNITS}.scissor_jack.unit:JACK_EFFECTS",
+    ),
+    UnitType(
+        "MultiMassDrive",
+        "drive.py",
+        f"{_UNITS}.multimass_drive.unit:DriveUnit",
+        f"{_UNITS}.multimass_drive.unit:DRIVE_EFFECTS",
+    ),
     UnitType("MachineUnit", "machine_unit.py", f"{_UNITS}.machine.unit:MachineDriveUnit"),
 )
 """Every unit type we ship, in the order they are built and listed."""

@@ -25,6 +25,7 @@ def solver_parameters(
     atol: float = 1e-9,
     also: Collection[str] = (),
     note: str = "",
+    acts_with: tuple[str, ...] = (),
 ) -> tuple[Variable, ...]:
     """Declarations of the solver parameters with a unit's defaults.
 
@@ -40,14 +41,20 @@ def solver_parameters(
         Solvers the unit offers beyond :data:`~wire_fmu.core.framework.hybrid.SOLVERS`.
     note : str
         Appended to the description of ``solver``.
+    acts_with : tuple of str
+        Effects without which the unit integrates nothing (the solver then has no
+        influence); empty when it always integrates.
     """
     names = ", ".join(sorted(set(SOLVERS) | set(also)))
     text = f"Internal solver: {names}" + (f" ({note})" if note else "")
+    positive = {"min": 0.0, "min_exclusive": True, "acts_with": acts_with}
     return (
-        parameter("solver", method, "", text, type=str),
-        parameter("solver_max_step", max_step, "s", "Largest internal step", min=0.0),
-        parameter("solver_rtol", rtol, "1", "Relative tolerance of adaptive solvers", min=0.0),
-        parameter("solver_atol", atol, "1", "Absolute tolerance of adaptive solvers", min=0.0),
+        parameter("solver", method, "", text, type=str, acts_with=acts_with),
+        parameter("solver_max_step", max_step, "s", "Largest internal step", **positive),
+        parameter(
+            "solver_rtol", rtol, "1", "Relative tolerance of adaptive solvers", max=1.0, **positive
+        ),
+        parameter("solver_atol", atol, "1", "Absolute tolerance of adaptive solvers", **positive),
     )
 
 

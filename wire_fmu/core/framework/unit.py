@@ -27,9 +27,11 @@ import time as clock
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any, ClassVar
 
 from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.data_fields import DataField
 from wire_fmu.core.framework.hybrid import IntegrationError
 from wire_fmu.core.framework.ode_view import ModelOdeView, OdeView
 from wire_fmu.core.framework.ports import Port
@@ -129,6 +131,9 @@ class Unit(ABC):
     VARIABLES: ClassVar[tuple[Variable, ...]] = ()
     PORTS: ClassVar[tuple[Port, ...]] = ()
     """The unit's power ports (:mod:`~wire_fmu.core.framework.ports`), over its variables."""
+    DATA_FIELDS: ClassVar[Mapping[str, tuple[DataField, ...]]] = MappingProxyType({})
+    """The fields inside each structured (JSON text) parameter, by parameter name
+    (:mod:`~wire_fmu.core.framework.data_fields`)."""
 
     def __init__(self, instance_name: str = "unit") -> None:
         self.instance_name = instance_name

@@ -8,9 +8,12 @@ are the short ways to declare one.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
+
+from wire_fmu.core.framework.data_fields import acts_with_effects
 
 __all__ = ["Causality", "Variability", "Variable", "input_", "output", "parameter"]
 
@@ -61,7 +64,17 @@ class Variable:
         one step (direct feedthrough). An output of a state of an inertia
         depends on no input. Ignored for non-outputs.
     min, max, nominal : float or None
-        Optional bounds and scale for Reals.
+        Optional bounds (inclusive unless ``min_exclusive``) and scale, in ``unit``.
+    min_exclusive : bool
+        The value must be strictly greater than ``min`` (a length, a mass);
+        the model description can only say ``min``, the unit refuses ``min`` itself.
+    acts_with : tuple of str
+        Effects of which at least one must be chosen for this variable to have
+        any influence (``bearing_torque`` acts only with ``bearing_friction``);
+        empty when it always acts.
+    acts_without : tuple of str
+        Effects none of which may be chosen for it to act (a speed command that
+        only a drum without inertia follows); empty when none silences it.
     """
 
     name: str
@@ -75,6 +88,9 @@ class Variable:
     min: float | None = None
     max: float | None = None
     nominal: float | None = None
+    min_exclusive: bool = False
+    acts_with: tuple[str, ...] = ()
+    acts_without: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.type not in _TYPES:
@@ -83,6 +99,23 @@ class Variable:
             raise ValueError(f"variable {self.name!r}: a description is required")
         if self.type is float and not self.unit:
             raise ValueError(f"variable {self.name!r}: a Real needs a unit ('1' if none)")
+        both = set(self.acts_with) & set(self.acts_without)
+        if both:
+            raise ValueError(
+                f"variable {self.name!r}: effects {sorted(both)} in both acts_with and acts_without"
+            )
+        if self.min_exclusive and self.min is None:
+            raise ValueError(f"variable {self.name!r}: min_exclusive needs a min")
+
+    def acts(self, effects: Iterable[str]) -> bool:
+        """Whether the variable has any influence with the effects chosen.
+
+        Parameters
+        ----------
+        effects : iterable of str
+            The effects chosen for the unit.
+        """
+        return acts_with_effects(self.acts_with, self.acts_without, effects)
 
 
 def parameter(
@@ -95,6 +128,9 @@ def parameter(
     fixed: bool = True,
     min: float | None = None,  # noqa: A002
     max: float | None = None,  # noqa: A002
+    min_exclusive: bool = False,
+    acts_with: tuple[str, ...] = (),
+    acts_without: tuple[str, ...] = (),
 ) -> Variable:
     """Declare a parameter (``fixed`` unless ``fixed=False``).
 
@@ -113,7 +149,11 @@ def parameter(
     fixed : bool
         True: settable only before initialisation; False: tunable.
     min, max : float or None
-        Bounds of a Real, in ``unit``; None for none.
+        Bounds of a Real or an Integer, in ``unit``; None for none.
+    min_exclusive : bool
+        The value must be strictly greater than ``min``.
+    acts_with, acts_without : tuple of str
+        The effects without which (with which) it has no influence; see :class:`Variable`.
 
     Returns
     -------
@@ -130,6 +170,9 @@ def parameter(
         variability=Variability.fixed if fixed else Variability.tunable,
         min=min,
         max=max,
+        min_exclusive=min_exclusive,
+        acts_with=tuple(acts_with),
+        acts_without=tuple(acts_without),
     )
 
 
@@ -140,13 +183,20 @@ def input_(
     description: str,
     *,
     type: type = float,  # noqa: A002
+    acts_with: tuple[str, ...] = (),
+    acts_without: tuple[str, ...] = (),
 ) -> Variable:
     """Declare an input: continuous for a Real, discrete otherwise.
 
     Parameters
     ----------
-    name, start, unit, description, type
+    name, start, unit, description, type, acts_with, acts_without
         As for :func:`parameter`.
+
+    Returns
+    -------
+    Variable
+        The declaration.
     """
     variability = Variability.continuous if type is float else Variability.discrete
     return Variable(
@@ -157,6 +207,8 @@ def input_(
         unit=unit if type is float else "",
         description=description,
         variability=variability,
+        acts_with=tuple(acts_with),
+        acts_without=tuple(acts_without),
     )
 
 

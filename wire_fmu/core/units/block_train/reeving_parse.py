@@ -26,6 +26,7 @@ from wire_fmu.core.units.block_train.reeving import (
     SheaveSpec,
     Vector,
 )
+from wire_fmu.core.units.block_train.reeving_fields import FIELD
 
 __all__ = ["parse_reeving"]
 
@@ -108,6 +109,42 @@ class _Problems:
             self.add(where, f"'{key}' must be <= {at_most:g}, got {value:g}")
         return value
 
+    def declared(self, data: Mapping, path: str, where: str) -> Any:
+        """The key declared at ``path`` (:mod:`.reeving_fields`): its default and bounds.
+
+        Parameters
+        ----------
+        data : mapping
+            The table holding the key.
+        path : str
+            The key's declared path, e.g. ``"sheaves.<name>.efficiency"``.
+        where : str
+            The element, for the problem's text.
+
+        Returns
+        -------
+        float or Vector
+            The value (NaN if missing or invalid).
+        """
+        field = FIELD[path]
+        default = None if field.required else field.default
+        if field.kind == "vector":
+            return self.vector(data, field.key, where, default, unit=field.unit == "1")
+        low = field.min
+        if low not in (None, 0.0):
+            raise ValueError(f"{path}: only 0 is supported as a lower bound")
+        infinite_default = isinstance(default, float) and math.isinf(default)
+        return self.number(
+            data,
+            field.key,
+            where,
+            default,
+            positive=low is not None and field.min_exclusive,
+            nonnegative=low is not None and not field.min_exclusive,
+            at_most=field.max,
+            finite=not infinite_default,
+        )
+
     def vector(
         self, data: Mapping, key: str, where: str, default: Any = None, *, unit: bool = False
     ) -> Vector:
@@ -183,12 +220,12 @@ def parse_reeving(data: Mapping[str, Any]) -> Reeving:
         if key not in known:
             p.add("reeving", f"unknown key {key!r}; known keys: {', '.join(sorted(known))}")
     rope = _parse_rope(data.get("rope", {}), p)
-    gravity = p.vector(data, "gravity", "reeving", (0.0, -9.81, 0.0))
+    gravity = p.declared(data, "gravity", "reeving")
     bodies = _parse_bodies(data.get("bodies", {}), p)
     sheaves = _parse_sheaves(data.get("sheaves", {}), bodies, p)
     anchors = _parse_anchors(data.get("anchors", {}), bodies, p)
     path = _parse_path(data.get("path", []), sheaves, anchors, bodies, p)
-    fleet = p.number(data, "max_fleet_angle_deg", "reeving", 2.5, positive=True, at_most=45.0)
+    fleet = p.declared(data, "max_fleet_angle_deg", "reeving")
     _check_ports(bodies, path, p)
     if p.items:
         raise ConfigurationError("reeving", p.items)
@@ -201,16 +238,16 @@ def _parse_rope(data: Mapping, p: _Problems) -> RopeProperties:
         p.add(where, "must be a mapping")
         return RopeProperties(1.0)
     if "axial_stiffness" in data:
-        ea = p.number(data, "axial_stiffness", where, positive=True)
-        damping = p.number(data, "damping", where, 0.0, nonnegative=True)
+        ea = p.declared(data, "rope.axial_stiffness", where)
+        damping = p.declared(data, "rope.damping", where)
     else:
-        area = p.number(data, "metallic_area", where, positive=True)
-        modulus = p.number(data, "modulus", where, positive=True)
-        fill = p.number(data, "fill_factor", where, 1.0, positive=True, at_most=1.0)
-        viscosity = p.number(data, "viscosity", where, 0.0, nonnegative=True)
+        area = p.declared(data, "rope.metallic_area", where)
+        modulus = p.declared(data, "rope.modulus", where)
+        fill = p.declared(data, "rope.fill_factor", where)
+        viscosity = p.declared(data, "rope.viscosity", where)
         ea, damping = area * fill * modulus, area * fill * viscosity
-    breaking = p.number(data, "breaking_load", where, math.inf, positive=True, finite=False)
-    linear_mass = p.number(data, "linear_mass", where, 0.0, nonnegative=True)
+    breaking = p.declared(data, "rope.breaking_load", where)
+    linear_mass = p.declared(data, "rope.linear_mass", where)
     return RopeProperties(ea, damping, breaking, linear_mass)
 
 
@@ -228,11 +265,11 @@ def _parse_bodies(data: Mapping, p: _Problems) -> dict[str, Body]:
         if kind not in ("block", "driven"):
             p.add(where, f"'kind' must be 'block' or 'driven', got {kind!r}")
             continue
-        direction = p.vector(spec, "direction", where, (0.0, 1.0, 0.0), unit=True)
+        direction = p.declared(spec, "bodies.<name>.direction", where)
         port = spec.get("port")
         if kind == "block":
-            mass = p.number(spec, "mass", where, positive=True)
-            position = p.number(spec, "position", where, 0.0)
+            mass = p.declared(spec, "bodies.<name>.mass", where)
+            position = p.declared(spec, "bodies.<name>.position", where)
             floor = _parse_floor(spec.get("floor"), where, p)
             if port is not None and port not in BLOCK_PORTS:
                 p.add(where, f"'port' of a block must be one of {BLOCK_PORTS}, got {port!r}")
@@ -283,9 +320,9 @@ def _parse_floor(data: Any, where: str, p: _Problems) -> Floor | None:
         return None
     where = f"{where} floor"
     return Floor(
-        p.number(data, "position", where),
-        p.number(data, "stiffness", where, positive=True),
-        p.number(data, "damping", where, 0.0, nonnegative=True),
+        p.declared(data, "bodies.<name>.floor.position", where),
+        p.declared(data, "bodies.<name>.floor.stiffness", where),
+        p.declared(data, "bodies.<name>.floor.damping", where),
     )
 
 
@@ -328,21 +365,16 @@ def _parse_sheaves(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict
         return SheaveSpec(
             name,
             body,
-            p.vector(spec, "centre", where),
-            p.number(spec, "radius", where, positive=True),
-            p.vector(spec, "axis", where, (0.0, 0.0, 1.0), unit=True),
-            p.number(spec, "inertia", where, 0.0, nonnegative=True),
-            p.number(spec, "bearing_torque", where, 0.0, nonnegative=True),
-            _efficiency(spec, where, p),
-            p.number(spec, "groove_friction", where, 0.1, nonnegative=True),
+            p.declared(spec, "sheaves.<name>.centre", where),
+            p.declared(spec, "sheaves.<name>.radius", where),
+            p.declared(spec, "sheaves.<name>.axis", where),
+            p.declared(spec, "sheaves.<name>.inertia", where),
+            p.declared(spec, "sheaves.<name>.bearing_torque", where),
+            p.declared(spec, "sheaves.<name>.efficiency", where),
+            p.declared(spec, "sheaves.<name>.groove_friction", where),
         )
 
     return _parse_on_bodies(data, "sheave", bodies, p, sheave)
-
-
-def _efficiency(spec: Mapping, where: str, p: _Problems) -> float:
-    value = p.number(spec, "efficiency", where, 1.0, positive=True, at_most=1.0)
-    return value
 
 
 def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict[str, AnchorSpec]:
@@ -360,7 +392,7 @@ def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict
         where : str
             The anchor, for the problems' text.
         """
-        return AnchorSpec(name, body, p.vector(spec, "point", where))
+        return AnchorSpec(name, body, p.declared(spec, "anchors.<name>.point", where))
 
     return _parse_on_bodies(data, "anchor", bodies, p, anchor)
 
@@ -400,7 +432,7 @@ def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[Path
                 p.add(where, f"line end {port!r} must be at an end of the path")
             if body not in bodies:
                 p.add(where, f"'body' {body!r} is not a body")
-            point = p.vector(node, "point", where)
+            point = p.declared(node, "path[i].point", where)
             out.append(PathElement("line_end", str(port), 0, point, body))
         else:
             p.add(where, "must name a 'sheave', an 'anchor' or a 'line_end'")

@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -51,6 +52,7 @@ from wire_fmu.core.units.block_train.reeving import (
     LINE_PORTS,
     MOVER_PORTS,
 )
+from wire_fmu.core.units.block_train.reeving_fields import REEVING_FIELDS
 from wire_fmu.core.units.block_train.reeving_parse import parse_reeving
 from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
@@ -164,6 +166,7 @@ class BlockTrainUnit(Unit):
     NAME = "BlockTrain"
     DESCRIPTION = "Rope reeved over sheaves and anchors (block train), wire_fmu"
     VARIABLES = _variables()
+    DATA_FIELDS = MappingProxyType({"reeving": REEVING_FIELDS})
     PORTS = (
         *(port(n, "rope", PortSide.effort, "tension", "payout_rate", "payout") for n in LINE_PORTS),
         *(

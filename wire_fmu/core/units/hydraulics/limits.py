@@ -92,7 +92,7 @@ def check_start(model: HydraulicsModel, pressure: float, position: float, veloci
         problems.append(
             f"initial gas pressure {pressure:.6g} Pa is below the pre-charge "
             f"{acc.precharge_pressure:.6g} Pa: the accumulator would hold no oil; "
-            "lower 'precharge_pressure' or raise the load"
+            + _precharge_window(pressure, acc)
         )
     elif (
         isothermal_charge_volume(acc.precharge_pressure, acc.full_volume, pressure)
@@ -101,7 +101,7 @@ def check_start(model: HydraulicsModel, pressure: float, position: float, veloci
         problems.append(
             f"initial gas pressure {pressure:.6g} Pa needs more oil than the "
             f"accumulator holds (pre-charge {acc.precharge_pressure:.6g} Pa); "
-            "raise 'precharge_pressure' or lower the load"
+            + _precharge_window(pressure, acc)
         )
     if not (0.0 <= position <= model.cyl.stroke):
         problems.append(
@@ -112,3 +112,20 @@ def check_start(model: HydraulicsModel, pressure: float, position: float, veloci
         problems.append(f"parameter 'initial_velocity' must be finite, got {velocity}")
     if problems:
         raise ConfigurationError("hydraulics", problems)
+
+
+def _precharge_window(pressure: float, acc) -> str:
+    """The pre-charge pressures that start with oil in the accumulator, but not too much.
+
+    Parameters
+    ----------
+    pressure : float
+        Initial absolute gas pressure, Pa.
+    acc : AccumulatorSpec
+        The accumulator.
+    """
+    low = pressure * acc.dead_volume / acc.full_volume
+    return (
+        f"'precharge_pressure' must lie in ({low:.6g}, {pressure:.6g}] Pa for this start "
+        "(or change the load, which sets the starting pressure)"
+    )

@@ -12,11 +12,19 @@ DEFAULT_ROD_FORCE = -4.0 * 356.0e3
 """Start value of ``rod.force``: an 80 kip rope tension through a 4:1 reeving, N."""
 
 _FEEDTHROUGH = ("rod.force",)
+_LINE = ("line_losses", "line_inertance")
+_SEAL = ("seal_friction",)
+_STOPS = ("end_stops",)
 
 
-def _size(name: str, start: float, unit: str, description: str, **limits: float):
-    """A fixed physical parameter; not negative unless ``limits`` say otherwise."""
-    return parameter(name, start, unit, description, **({"min": 0.0} | limits))
+def _size(name: str, start: float, unit: str, description: str, **more):
+    """A fixed physical parameter; not negative unless ``more`` says otherwise."""
+    return parameter(name, start, unit, description, **({"min": 0.0} | more))
+
+
+def _positive(name: str, start: float, unit: str, description: str, **more):
+    """A fixed physical parameter that must be > 0."""
+    return _size(name, start, unit, description, min_exclusive=True, **more)
 
 
 def _cylinder_parameters():
@@ -27,10 +35,10 @@ def _cylinder_parameters():
     gravity = "Gravity along the extension direction (-9.81: vertical, rod extends up)"
     return (
         parameter("pressurised_side", "bore", "", side, type=str),
-        _size("bore_diameter", 0.356, "m", "Piston (bore) diameter"),
-        _size("rod_diameter", 0.229, "m", "Rod diameter"),
-        _size("stroke", 3.81, "m", "Stroke"),
-        _size("moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries"),
+        _positive("bore_diameter", 0.356, "m", "Piston (bore) diameter"),
+        _positive("rod_diameter", 0.229, "m", "Rod diameter, smaller than the bore"),
+        _positive("stroke", 3.81, "m", "Stroke"),
+        _positive("moving_mass", 3500.0, "kg", "Rod, piston and the sheave cluster it carries"),
         _size("chamber_dead_volume", 0.01, "m3", "Oil in the chamber at zero working length"),
         parameter("gravity_along_rod", -9.81, "m/s2", gravity),
         _size("ambient_pressure", 101325.0, "Pa", "Absolute pressure on the vented side and rod"),
@@ -38,14 +46,38 @@ def _cylinder_parameters():
 
 
 def _accumulator_parameters():
-    exponent = "Exponent n of p V^n = const with effect polytropic_gas (1.4: adiabatic)"
-    return (
-        _size("accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)"),
-        _size("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels"),
-        _size("accumulator_dead_volume", 0.01, "m3", "Gas left in a full accumulator"),
-        _size("precharge_pressure", 13.5e6, "Pa", "Absolute gas pressure with no oil in it"),
-        _size("polytropic_exponent", 1.4, "1", exponent, min=1.0, max=2.0),
+    exponent = "Exponent n of p V^n = const (1: isothermal, 1.4: adiabatic)"
+    precharge = (
+        "Absolute gas pressure with no oil in the accumulator. The start needs oil in it, "
+        "but not more than it holds: p_start V_dead / V_gas < precharge <= p_start, with "
+        "p_start the starting gas pressure (from rod.force with initial_equilibrium), "
+        "V_gas = accumulator_volume + gas_bank_volume, V_dead = accumulator_dead_volume "
+        "+ gas_bank_volume"
     )
+    return (
+        _positive("accumulator_volume", 0.6, "m3", "Accumulator volume (gas plus oil side)"),
+        _size("gas_bank_volume", 3.0, "m3", "Volume of the air pressure vessels"),
+        _size(
+            "accumulator_dead_volume",
+            0.01,
+            "m3",
+            "Gas left in a full accumulator, smaller than accumulator_volume",
+        ),
+        _positive("precharge_pressure", 13.5e6, "Pa", precharge),
+        _size(
+            "polytropic_exponent",
+            1.4,
+            "1",
+            exponent,
+            min=1.0,
+            max=2.0,
+            acts_with=("polytropic_gas",),
+        ),
+    )
+
+
+_LOSSES = ("line_losses",)
+_OIL = ("oil_compressibility",)
 
 
 def _oil_parameters():
@@ -53,28 +85,51 @@ def _oil_parameters():
     volume = "Oil volume whose compressibility is modelled (0: chamber at the start plus line)"
     cavitation = "Absolute chamber pressure at which the step is refused (cavitation)"
     return (
-        _size("line_length", 15.0, "m", "Length of the oil line"),
-        _size("line_diameter", 0.1524, "m", "Inner diameter of the oil line"),
-        _size("oil_density", 870.0, "kg/m3", "Oil density"),
-        _size("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity"),
-        _size("line_friction_factor", 0.025, "1", "Darcy friction factor, turbulent"),
-        _size("line_loss_coefficient", 5.0, "1", minor),
-        _size("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus"),
-        _size("oil_volume", 0.0, "m3", volume),
+        _positive("line_length", 15.0, "m", "Length of the oil line", acts_with=_LINE + _OIL),
+        _positive(
+            "line_diameter", 0.1524, "m", "Inner diameter of the oil line", acts_with=_LINE + _OIL
+        ),
+        _positive("oil_density", 870.0, "kg/m3", "Oil density", acts_with=_LINE),
+        _size("oil_viscosity", 0.028, "Pa.s", "Oil dynamic viscosity", acts_with=_LOSSES),
+        _size(
+            "line_friction_factor",
+            0.025,
+            "1",
+            "Darcy friction factor, turbulent",
+            acts_with=_LOSSES,
+        ),
+        _size("line_loss_coefficient", 5.0, "1", minor, acts_with=_LOSSES),
+        _positive("bulk_modulus", 1.5e9, "Pa", "Effective oil bulk modulus", acts_with=_OIL),
+        _size("oil_volume", 0.0, "m3", volume, acts_with=_OIL),
         _size("cavitation_pressure", 1.0e4, "Pa", cavitation),
     )
 
 
 def _seal_and_stop_parameters():
+    stribeck = "Stribeck velocity (0: no Stribeck decay)"
+    cushion = "Length of the cushion zone at each end, less than half the stroke"
+    restitution = "Coefficient of restitution at an end stop"
     return (
-        _size("seal_static_friction", 25.0e3, "N", "Seal breakaway force"),
-        _size("seal_coulomb_friction", 15.0e3, "N", "Seal sliding (Coulomb) force"),
-        _size("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient"),
-        _size("seal_stribeck_velocity", 0.01, "m/s", "Stribeck velocity (0: no Stribeck decay)"),
-        _size("cushion_length", 0.15, "m", "Length of the cushion zone at each end"),
-        _size("cushion_coefficient", 1.0e5, "N.s2/m2", "Cushion force coefficient c in F = c v^2"),
-        _size("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness"),
-        _size("stop_restitution", 0.3, "1", "Coefficient of restitution at an end stop", max=1.0),
+        _size("seal_static_friction", 25.0e3, "N", "Seal breakaway force", acts_with=_SEAL),
+        _size(
+            "seal_coulomb_friction",
+            15.0e3,
+            "N",
+            "Seal sliding (Coulomb) force, at most the breakaway force",
+            acts_with=_SEAL,
+        ),
+        _size("seal_viscous_friction", 2.0e4, "N.s/m", "Seal viscous coefficient", acts_with=_SEAL),
+        _size("seal_stribeck_velocity", 0.01, "m/s", stribeck, acts_with=_SEAL),
+        _size("cushion_length", 0.15, "m", cushion, acts_with=_STOPS),
+        _size(
+            "cushion_coefficient",
+            1.0e5,
+            "N.s2/m2",
+            "Cushion force coefficient c in F = c v^2",
+            acts_with=_STOPS,
+        ),
+        _positive("stop_stiffness", 1.0e9, "N/m", "End-stop contact stiffness", acts_with=_STOPS),
+        _positive("stop_restitution", 0.3, "1", restitution, max=1.0, acts_with=_STOPS),
     )
 
 

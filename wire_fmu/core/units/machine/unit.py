@@ -190,6 +190,10 @@ class MachineDriveUnit(Unit):
         for name in ("initial_speed", "initial_angle"):
             if not math.isfinite(float(v[name])):
                 problems.append(f"parameter {name!r} must be finite, got {v[name]}")
+        if float(v["initial_speed"]) < 0.0:
+            problems.append(
+                f"parameter 'initial_speed' must be >= 0 rad/s, got {v['initial_speed']}"
+            )
         if problems:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
         self.model = MachineDriveModel(spec, slope)

@@ -115,13 +115,15 @@ def _parameters():
             "Masses kept: 0 the full drive, 2.. a chain reduced "
             "by delta-star elimination (paper 002)",
             type=int,
+            min=0,
         ),
         parameter(
             "motor_slope",
             0.0,
             "N.m.s/rad",
-            "Slope b of each motor's characteristic a - b omega (motor_characteristic)",
+            "Slope b of each motor's characteristic a - b omega",
             min=0.0,
+            acts_with=("motor_characteristic",),
         ),
         parameter("initial_speed", 0.0, "rad/s", "Speed of every mass at the start"),
         *solver_parameters("rk4", 5e-4, rtol=1e-8, atol=1e-10),

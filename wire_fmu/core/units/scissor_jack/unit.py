@@ -70,6 +70,8 @@ JACK_EFFECTS = EffectCatalogue(
 )
 
 _INPUTS = ("handle.speed_command", "handle.torque_command")
+_FRICTION = ("thread_friction",)
+_POSITIVE = {"min": 0.0, "min_exclusive": True}
 _SPEED = ("handle.speed_command",)
 RK4_STABILITY = 2.5
 """Largest ``|lambda| h`` accepted for ``rk4`` (its real-axis limit is about 2.8)."""
@@ -100,20 +102,41 @@ def _parameters():
             "Thread friction with thread_friction: "
             "stick_slip (exact), linear (paper 003's regularised form) or tanh",
             type=str,
+            acts_with=_FRICTION,
         ),
-        parameter("rod_length", 0.130, "m", "Tie rod length (paper 003: 130 mm)", min=0.0),
+        parameter("rod_length", 0.130, "m", "Tie rod length (paper 003: 130 mm)", **_POSITIVE),
         parameter(
             "initial_height",
             0.130,
             "m",
-            "Shoe height at the start (paper 003: 130 mm, rods at 30 deg)",
-            min=0.0,
+            "Shoe height at the start, within [min_height, max_height] (paper 003: 130 mm, "
+            "rods at 30 deg)",
+            **_POSITIVE,
         ),
-        parameter("min_height", 0.04, "m", "Lowest shoe height (end of travel)", min=0.0),
-        parameter("max_height", 0.25, "m", "Highest shoe height (end of travel)", min=0.0),
-        parameter("thread_lead", 0.002, "m", "Screw travel per turn (paper 003: 2 mm)", min=0.0),
         parameter(
-            "thread_mean_radius", 0.01, "m", "Mean thread radius (paper 003: 0.01 m)", min=0.0
+            "min_height",
+            0.04,
+            "m",
+            "Lowest shoe height (end of travel), below twice rod_length",
+            **_POSITIVE,
+        ),
+        parameter(
+            "max_height",
+            0.25,
+            "m",
+            "Highest shoe height (end of travel), below twice rod_length",
+            **_POSITIVE,
+        ),
+        parameter(
+            "thread_lead", 0.002, "m", "Screw travel per turn (paper 003: 2 mm)", **_POSITIVE
+        ),
+        parameter(
+            "thread_mean_radius",
+            0.01,
+            "m",
+            "Mean thread radius r of the friction torque r mu |F| (paper 003: 0.01 m)",
+            acts_with=_FRICTION,
+            **_POSITIVE,
         ),
         parameter(
             "thread_friction",
@@ -121,18 +144,26 @@ def _parameters():
             "1",
             "Thread friction coefficient (paper 003: 0.1, steel on steel)",
             min=0.0,
+            acts_with=_FRICTION,
         ),
         parameter(
             "friction_speed_scale",
             1.0e-6,
             "rad/s",
-            "w1 of the regularised friction models (paper 003: 1e-6 rad/s)",
-            min=0.0,
+            "w1 of the regularised friction models linear and tanh (paper 003: 1e-6 rad/s)",
+            acts_with=_FRICTION,
+            **_POSITIVE,
         ),
         parameter(
-            "load_mass", 306.0, "kg", "Mass of the shoe with the load (paper 003: 306 kg)", min=0.0
+            "load_mass",
+            306.0,
+            "kg",
+            "Mass of the shoe with the load (paper 003: 306 kg)",
+            **_POSITIVE,
         ),
-        parameter("load_weight", 3000.0, "N", "Weight on the shoe (paper 003: 3000 N)", min=0.0),
+        parameter(
+            "load_weight", 3000.0, "N", "Weight on the shoe (paper 003: 3000 N)", **_POSITIVE
+        ),
         parameter(
             "handle_inertia",
             5.0e-3,
@@ -140,7 +171,7 @@ def _parameters():
             "Inertia of screw and handle about the "
             "screw axis (estimate: 20 mm x 350 mm steel screw 4e-5 plus a 0.25 kg crank "
             "at 0.14 m, 4.9e-3)",
-            min=0.0,
+            **_POSITIVE,
         ),
         parameter(
             "initial_handle_speed", 0.0, "rad/s", "Handle speed at the start with a torque drive"

@@ -16,6 +16,9 @@ from wire_fmu.core.units.winch.model import WINCH_EFFECTS
 __all__ = ["winch_parameters", "winch_inputs", "winch_outputs"]
 
 _FEEDTHROUGH = ("rope.tension", "brake.lever_force", "motor.command")
+_INERTIA = ("drum_inertia",)
+_BRAKE = ("band_brake",)
+_LAYERS = ("rope_layers",)
 
 
 def winch_parameters():
@@ -33,6 +36,7 @@ def winch_parameters():
             1e-3,
             also=ENERGY_SOLVERS,
             note="energy, energy1: paper 004's energy form, rigid drive train only",
+            acts_with=_INERTIA,
         ),
         parameter(
             "drive_train",
@@ -49,6 +53,8 @@ def winch_parameters():
             "Masses kept with elastic_drive_train: 0 the "
             "full chain, 1 rigid, 2.. reduced by delta-star elimination",
             type=int,
+            min=0,
+            acts_with=("elastic_drive_train",),
         ),
         parameter(
             "drum_radius",
@@ -57,6 +63,7 @@ def winch_parameters():
             "Rope centreline radius on the first layer (32 in "
             "barrel with 1-3/8 in line, typical 1500-2000 hp drawworks; estimate)",
             min=0.0,
+            min_exclusive=True,
         ),
         parameter(
             "rope_diameter",
@@ -65,13 +72,16 @@ def winch_parameters():
             "Rope diameter: 1-3/8 in drilling line "
             "(API 9A size); the radius grows by one diameter per layer",
             min=0.0,
+            min_exclusive=True,
+            acts_with=_LAYERS,
         ),
         parameter(
             "rope_linear_mass",
             5.06,
             "kg/m",
-            "Rope mass per metre (1-3/8 in 6x19 IWRC, about 3.4 lb/ft)",
+            "Rope mass per metre on the drum, its inertia (1-3/8 in 6x19 IWRC, about 3.4 lb/ft)",
             min=0.0,
+            acts_with=_LAYERS,
         ),
         parameter(
             "drum_wraps_per_layer",
@@ -79,10 +89,26 @@ def winch_parameters():
             "",
             "Turns per layer (about 1.4 m barrel / rope diameter)",
             type=int,
+            min=1,
+            acts_with=_LAYERS,
         ),
-        parameter("drum_layers", 4, "", "Layers the drum flanges allow", type=int),
         parameter(
-            "rope_on_drum", 150.0, "m", "Rope on the drum at the start (rope_layers)", min=0.0
+            "drum_layers",
+            4,
+            "",
+            "Layers the drum flanges allow",
+            type=int,
+            min=1,
+            acts_with=_LAYERS,
+        ),
+        parameter(
+            "rope_on_drum",
+            150.0,
+            "m",
+            "Rope on the drum at the start, at most the drum's capacity with drum_layers",
+            min=0.0,
+            min_exclusive=True,
+            acts_with=_LAYERS,
         ),
         parameter(
             "brake_rim_radius",
@@ -90,6 +116,8 @@ def winch_parameters():
             "m",
             "Brake-rim radius r_f (about 49 in rims; estimate)",
             min=0.0,
+            min_exclusive=True,
+            acts_with=_BRAKE,
         ),
         parameter(
             "brake_lever_ratio",
@@ -97,9 +125,18 @@ def winch_parameters():
             "1",
             "Lever ratio L/l of the brake handle linkage (estimate)",
             min=0.0,
+            min_exclusive=True,
+            acts_with=_BRAKE,
         ),
         parameter(
-            "brake_efficiency", 0.9, "1", "Efficiency eta of the brake linkage", min=0.0, max=1.0
+            "brake_efficiency",
+            0.9,
+            "1",
+            "Efficiency eta of the brake linkage",
+            min=0.0,
+            max=1.0,
+            min_exclusive=True,
+            acts_with=_BRAKE,
         ),
         parameter(
             "brake_friction",
@@ -107,9 +144,17 @@ def winch_parameters():
             "1",
             "Band friction coefficient mu (moulded lining on steel, 0.35-0.45)",
             min=0.0,
+            min_exclusive=True,
+            acts_with=_BRAKE,
         ),
         parameter(
-            "brake_wrap_angle", 5.24, "rad", "Band wrap angle alpha (about 300 deg)", min=0.0
+            "brake_wrap_angle",
+            5.24,
+            "rad",
+            "Band wrap angle alpha (about 300 deg)",
+            min=0.0,
+            min_exclusive=True,
+            acts_with=_BRAKE,
         ),
         parameter(
             "motor_slope",
@@ -118,8 +163,16 @@ def winch_parameters():
             "Slope b of the motor characteristic at "
             "the motor shaft (1150 hp AC motor, 1.5 % slip at 1200 rpm; estimate)",
             min=0.0,
+            acts_with=("motor_characteristic",),
         ),
-        parameter("initial_drum_speed", 0.0, "rad/s", "Drum speed at the start (drum_inertia)"),
+        parameter(
+            "initial_drum_speed",
+            0.0,
+            "rad/s",
+            "Drum speed at the start (with drum_inertia; without, the drum starts at the "
+            "speed command)",
+            acts_with=_INERTIA,
+        ),
     )
 
 
@@ -127,7 +180,13 @@ def winch_inputs():
     """The winch's inputs: rope tension, brake lever force, motor and drum speed commands."""
     return (
         input_("rope.tension", 0.0, "N", "Rope tension at the drum"),
-        input_("brake.lever_force", 0.0, "N", "Force on the brake lever (<= 0: released)"),
+        input_(
+            "brake.lever_force",
+            0.0,
+            "N",
+            "Force on the brake lever (<= 0: released)",
+            acts_with=_BRAKE,
+        ),
         input_(
             "motor.command",
             0.0,
@@ -141,6 +200,7 @@ def winch_inputs():
             "rad/s",
             "Drum speed the drive imposes without "
             "drum_inertia (kinetostatic mode), positive paying out",
+            acts_without=_INERTIA,
         ),
     )
 
