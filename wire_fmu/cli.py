@@ -3,6 +3,8 @@
 ::
 
     wire-fmu scenes                 list the shipped scenes
+    wire-fmu info UNIT [--effects E1 E2 ...] [--markdown]
+                                    a unit type's parameters, effects, ports and variables
     wire-fmu check SCENE            validate a scene; list every problem, exit 1 if any
     wire-fmu run SCENE [-o DIR]     run it: progress bar, summary table, CSV and PNG plots
     wire-fmu run SCENE --monolithic [--rtol RTOL]
@@ -52,6 +54,7 @@ from wire_fmu.cli_commands import (
     cmd_sweep,
 )
 from wire_fmu.core.errors import WireFmuError
+from wire_fmu.unit_reference.command import add_info_parser
 
 __all__ = ["main"]
 
@@ -231,6 +234,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", type=Path, help="output folder")
     p.set_defaults(func=cmd_build)
     _study_parser(sub)
+    add_info_parser(sub)
     return parser
 
 
