@@ -133,6 +133,8 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a scene and initialise its units as a run would; exit 1 listing every problem.
 
+    Settings the scene's effects leave without influence are warnings (exit 0).
+
     Parameters
     ----------
     args : argparse.Namespace
@@ -144,12 +146,15 @@ def cmd_check(args: argparse.Namespace) -> int:
         Exit status: 0 on success.
     """
     from wire_fmu.master.run import check_scene
+    from wire_fmu.unit_reference.scene_warnings import inactive_settings
 
     scene = check_scene(args.scene, args.fmu_dir)
     _print(
         f"scene {scene.name!r}: no problems ({plural(len(scene.units), 'unit')}, "
         f"{plural(len(scene.bonds), 'bond')}, {plural(len(scene.connections), 'connection')})"
     )
+    for warning in inactive_settings(scene):
+        _print(f"warning: {warning}")
     return 0
 
 
@@ -167,6 +172,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     int
         Exit status: 0 finished, 130 interrupted, 1 otherwise.
     """
+    from wire_fmu.unit_reference.scene_warnings import scene_file_warnings
+
+    for warning in scene_file_warnings(args.scene):
+        _print(f"warning: {warning}")
     if args.monolithic:
         return _run_monolithic(args)
     from wire_fmu.master.observers import summary_rows
