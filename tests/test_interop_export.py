@@ -76,6 +76,35 @@ def test_exported_ssp_validates_against_the_ssp_1_0_schemas(ssp):
     ]
 
 
+def test_the_signals_fmu_is_built_beside_the_export_never_into_the_shared_fmu_folder(
+    fmus, ssp, osp
+):
+    assert not list(fmus["osc"].parent.glob("Signals_*.fmu"))
+    assert (ssp.parent / "Signals_two_mass.fmu").is_file()
+    assert (osp.parent / "Signals_two_mass.fmu").is_file()  # in the configuration folder
+
+
+def test_declared_connectors_are_outputs_parameters_and_the_inputs_a_connection_feeds(ssp):
+    root = _ssd(ssp)
+    fed = {
+        (c.get("endElement"), c.get("endConnector"))
+        for c in root.iter(f"{{{NS['ssd']}}}Connection")
+    }
+    inputs = {
+        (component.get("name"), connector.get("name"))
+        for component in root.iter(f"{{{NS['ssd']}}}Component")
+        for connector in component.iter(f"{{{NS['ssd']}}}Connector")
+        if connector.get("kind") == "input"
+    }
+    assert inputs == fed
+    kinds = {
+        connector.get("kind")
+        for component in root.iter(f"{{{NS['ssd']}}}Component")
+        for connector in component.iter(f"{{{NS['ssd']}}}Connector")
+    }
+    assert kinds == {"input", "output", "parameter"}
+
+
 def test_fmpy_reads_the_package_with_its_own_validating_ssp_reader(ssp):
     from fmpy.ssp.ssd import read_ssd
 
@@ -257,7 +286,7 @@ def test_cli_exports_and_runs_an_ssp_package(fmus, ssp, tmp_path, capsys):
     assert main([*fmu_dir, "check", str(package)]) == 0
     assert main([*fmu_dir, "run", str(package), "-q", "-o", str(tmp_path / "res")]) == 0
     out = capsys.readouterr().out
-    assert "no problems (2 units, 1 bonds" in out and "timeseries.csv" in out
+    assert "no problems (2 units, 1 bond," in out and "timeseries.csv" in out
 
 
 def _toml(data: dict) -> str:

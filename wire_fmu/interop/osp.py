@@ -340,7 +340,8 @@ def write_osp(plan: ExportPlan, folder: Path) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     names = archive_names(plan.units)
     for source, name in names.items():
-        shutil.copyfile(source, folder / name)
+        if source.resolve() != (folder / name).resolve():  # the signals FMU is built here
+            shutil.copyfile(source, folder / name)
     by_model, _ = model_ports(plan)
     models = {u.model.modelName: u.model for u in plan.units}
     for model_name, ports in by_model.items():
@@ -362,11 +363,14 @@ def export_osp(scene: Scene, out: Path, *, fmu_dir: Path = DEFAULT_FMU_DIR) -> P
     out : Path
         Output folder (created).
     fmu_dir : Path
-        Where our FMUs are built and cached.
+        Where our FMUs are built and cached. The signals FMU of a scene with
+        drivers or events is built into ``out`` itself, never into ``fmu_dir``
+        (it belongs to this scene alone).
 
     Returns
     -------
     Path
         The ``OspSystemStructure.xml`` file.
     """
-    return write_osp(plan_export(scene, fmu_dir=fmu_dir), Path(out))
+    out = Path(out)
+    return write_osp(plan_export(scene, fmu_dir=fmu_dir, build_dir=out), out)

@@ -9,8 +9,9 @@ Layout of the package (a zip)::
 Mapping
 -------
 * Every unit is an ``ssd:Component`` (``application/x-fmu-sharedlibrary``)
-  with a typed ``ssd:Connector`` for every input, output and parameter of
-  its FMU; Reals carry their unit, and ``ssd:Units`` defines every unit
+  with a typed ``ssd:Connector`` for every output and parameter of its FMU
+  and every input a connection feeds (an input nothing feeds keeps its start
+  value and is left out); Reals carry their unit, and ``ssd:Units`` defines every unit
   used by its SI exponents (taken from the FMU's own ``UnitDefinitions``).
 * Parameters, including String parameters such as a block train's JSON
   ``reeving`` and the ``effects`` list of our units, are bound through one
@@ -101,11 +102,18 @@ def _type_element(parent: etree._Element, var) -> None:
     _sub(parent, "ssc", kind, unit=(var.unit or None) if kind == "Real" else None)
 
 
-def _connectors(component: etree._Element, unit: PlannedUnit) -> None:
+def _connectors(component: etree._Element, unit: PlannedUnit, connected: set[str]) -> None:
+    """A typed connector for every output and parameter and for each input a connection feeds.
+
+    An input nothing feeds keeps its start value (from the unit's parameter
+    set) and gets no connector: a tool that sets every declared input from
+    its connection would find none to set it from (FMPy's ``simulate_ssp``
+    fails then, see ``docs/interop.md``).
+    """
     connectors = _sub(component, "ssd", "Connectors")
     for var in unit.model.modelVariables:
         kind = _KINDS.get(var.causality)
-        if kind is None:
+        if kind is None or (kind == "input" and var.name not in connected):
             continue
         connector = _sub(
             connectors,
@@ -118,7 +126,9 @@ def _connectors(component: etree._Element, unit: PlannedUnit) -> None:
         _type_element(connector, var)
 
 
-def _component(elements: etree._Element, unit: PlannedUnit, fmu_name: str) -> None:
+def _component(
+    elements: etree._Element, unit: PlannedUnit, fmu_name: str, connected: set[str]
+) -> None:
     component = _sub(
         elements,
         "ssd",
@@ -128,7 +138,7 @@ def _component(elements: etree._Element, unit: PlannedUnit, fmu_name: str) -> No
         source=f"resources/{fmu_name}",
         description=unit.model.description or None,
     )
-    _connectors(component, unit)
+    _connectors(component, unit, connected)
     if unit.start_values:
         bindings = _sub(component, "ssd", "ParameterBindings")
         _sub(
@@ -146,6 +156,9 @@ def _annotation(parent: etree._Element, kind: str) -> etree._Element:
 
 
 def _connections(system: etree._Element, plan: ExportPlan) -> None:
+    """``ssd:Connections``, left out when there are none (the schema wants at least one)."""
+    if not plan.all_connections:
+        return
     connections = _sub(system, "ssd", "Connections")
     roles = {id(c): b for b in plan.bonds for c in b.connections}
     for c in plan.all_connections:
@@ -226,8 +239,10 @@ def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etre
         root, "ssd", "System", name=scene.name, description=scene.description.strip() or None
     )
     elements = _sub(system, "ssd", "Elements")
+    fed = {(c.target.unit, c.target.variable) for c in plan.all_connections}
     for unit in plan.units:
-        _component(elements, unit, names[unit.fmu.resolve()])
+        connected = {variable for name, variable in fed if name == unit.name}
+        _component(elements, unit, names[unit.fmu.resolve()], connected)
     _connections(system, plan)
     note = _annotation(system, SCENE_ANNOTATION)
     meta = dict(plan.metadata, signals=plan.signals)
@@ -311,8 +326,17 @@ def export_ssp(scene: Scene, out: Path, *, fmu_dir: Path = DEFAULT_FMU_DIR) -> P
     out : Path
         A ``.ssp`` file, or a folder to write ``<scene name>.ssp`` into.
     fmu_dir : Path
-        Where our FMUs are built and cached (and the signals FMU is built).
+        Where our FMUs are built and cached. The signals FMU of a scene with
+        drivers or events (``Signals_<scene>.fmu``) is built beside the
+        package, never into ``fmu_dir``: it belongs to this scene alone, and
+        the package holds a copy.
+
+    Returns
+    -------
+    Path
+        The package written.
     """
     out = Path(out)
     target = out if out.suffix == ".ssp" else out / f"{scene.name}.ssp"
-    return write_ssp(plan_export(scene, fmu_dir=fmu_dir), target)
+    plan = plan_export(scene, fmu_dir=fmu_dir, build_dir=target.parent)
+    return write_ssp(plan, target)
