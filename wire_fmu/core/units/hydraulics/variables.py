@@ -174,6 +174,7 @@ def variables() -> tuple:
             "Pa",
             "Initial absolute gas pressure when initial_equilibrium is false",
             min=0.0,
+            min_exclusive=True,
         ),
     )
     inputs = (
