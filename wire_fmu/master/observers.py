@@ -12,8 +12,10 @@
     pandas DataFrame with units, fmpy with ``fmpy.util.read_csv``.
     ``metadata.json`` beside it gives the unit of every column
     (``column_units``, see :mod:`~wire_fmu.master.column_units`), the units'
-    variables with their units and descriptions, the settings and, at the end,
-    the summary (status, per-unit call counts and time).
+    variables with their units and descriptions, the settings, the scene's
+    units with their parameter values, events, drivers and plots
+    (:mod:`~wire_fmu.master.run_record`) and, at the end, the summary
+    (status, per-unit call counts and time).
 :class:`Progress`
     a progress bar on stderr with the time left: one line redrawn in place on a
     terminal, plain lines (a tenth of the run each) when redirected.
@@ -37,6 +39,7 @@ from .column_units import (
     ledger_unit_problems,
     variable_unit,
 )
+from .run_record import scene_record
 
 if TYPE_CHECKING:
     from .run_result import RunResult
@@ -297,6 +300,7 @@ class CsvRecorder:
                     "description": v.description or "",
                     "causality": v.causality,
                 }
+        descriptions = {unit: slave.model_description for unit, slave in sim.slaves.items()}
         meta = {
             "scene": sim.scene.name,
             "description": sim.scene.description,
@@ -305,6 +309,7 @@ class CsvRecorder:
             "columns": self.columns,
             "column_units": self.units,
             "variables": variables,
+            **scene_record(sim.scene, descriptions),
         }
         if result is not None:
             meta["result"] = {

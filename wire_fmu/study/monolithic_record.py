@@ -53,6 +53,7 @@ from wire_fmu.master.column_units import (
     variable_unit,
 )
 from wire_fmu.master.observers import BOND_CHANNELS, FLUSH_EVERY, LEDGER_CHANNEL
+from wire_fmu.master.run_record import scene_record
 from wire_fmu.master.run_result import RunResult
 from wire_fmu.master.scene import Scene, VarRef
 from wire_fmu.master.validate import Structure
@@ -341,7 +342,8 @@ def run_metadata(
     dict
         The scene, ``"mode": "monolithic"``, the run settings that apply, the
         solver, the order, the columns and their units, the columns left out
-        and why, the variables.
+        and why, the variables, and the scene's units, events, drivers and
+        plots (:func:`~wire_fmu.master.run_record.scene_record`).
     """
     variables = {
         f"{unit}.{v.name}": {
@@ -363,6 +365,7 @@ def run_metadata(
         "column_units": plan.units,
         "omitted_columns": plan.omitted,
         "variables": variables,
+        **scene_record(scene, structure.descriptions),
     }
 
 
