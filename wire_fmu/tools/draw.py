@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 
 from .draw_geometry import _unit, reeving_drawing
+from .draw_labels import Label, along_line, around, around_box, drawing_points, place_labels
 from .draw_primitives import ReevingDrawing
 
 __all__ = ["draw_reeving"]
@@ -94,8 +95,9 @@ def _radial_text(direction: np.ndarray) -> tuple[float, str]:
     return (angle + 180.0 + 180.0) % 360.0 - 180.0, "right"
 
 
-def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) -> None:
+def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) -> list:
     """Sheave outlines, centres, and names running outwards opposite the wrapped rope."""
+    names = []
     for s in drawing.sheaves:
         style = "-" if s.reeved else "--"
         ax.fill(
@@ -111,7 +113,7 @@ def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) 
         away = _unit(s.centre - arcs_mid[s.name]) if s.name in arcs_mid else np.array([0.0, -1.0])
         rotation, ha = _radial_text(away)
         text = s.name if s.reeved else f"{s.name} (not reeved)"
-        ax.annotate(
+        name = ax.annotate(
             text,
             s.centre + away * s.radius * 1.15,
             rotation=rotation,
@@ -123,6 +125,8 @@ def _draw_sheaves(ax, drawing: ReevingDrawing, arcs_mid: dict[str, np.ndarray]) 
             bbox=_LABEL_BOX,
             zorder=6,
         )
+        names.append(name)
+    return names
 
 
 def _h_align(x: float) -> str:
@@ -157,8 +161,9 @@ def _draw_rope(ax, drawing: ReevingDrawing, arrow: float) -> None:
         )
 
 
-def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
-    """Anchors as triangles, line ends as labelled arrows."""
+def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> tuple[list[Label], list]:
+    """Anchors as triangles, line ends as labelled arrows; (movable labels, fixed labels)."""
+    movable, fixed = [], []
     for a in drawing.anchors:
         face = "black" if a.used else "white"
         ax.plot(
@@ -170,7 +175,7 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
             zorder=7,
         )
         label = a.name if a.used else f"{a.name} (unused)"
-        ax.annotate(
+        text = ax.annotate(
             label,
             a.point,
             xytext=(7, -10),
@@ -179,9 +184,10 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
             bbox=_LABEL_BOX,
             zorder=7,
         )
+        movable.append(Label(text, around(7.0)))
     for e in drawing.line_ends:
         tip = e.point + arrow * e.direction
-        ax.annotate(
+        arrow_text = ax.annotate(
             "",
             xy=tip,
             xytext=e.point,
@@ -189,7 +195,8 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
             arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.4},
         )
         ax.plot(*e.point, marker="o", markersize=5, color="black", zorder=7)
-        ax.annotate(
+        fixed.append(arrow_text)
+        port = ax.annotate(
             e.port,
             tip,
             xytext=(4 * e.direction[0], 4 * e.direction[1]),
@@ -200,13 +207,16 @@ def _draw_ends(ax, drawing: ReevingDrawing, arrow: float) -> None:
             fontweight="bold",
             zorder=7,
         )
+        fixed.append(port)
+    return movable, fixed
 
 
-def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
-    """Dashed boxes, labels under them, a direction-of-motion arrow after each label."""
+def _draw_bodies(ax, drawing: ReevingDrawing) -> list[Label]:
+    """Dashed boxes, labels by them, a direction-of-motion arrow after each label."""
     from matplotlib.patches import Rectangle
     from matplotlib.text import OffsetFrom
 
+    labels = []
     for b in drawing.bodies:
         size = b.upper - b.lower
         ax.add_patch(
@@ -232,7 +242,9 @@ def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
             bbox=_LABEL_BOX,
             zorder=6,
         )
-        if np.linalg.norm(b.direction) > 1e-6:
+        moves = np.linalg.norm(b.direction) > 1e-6
+        labels.append(Label(label, around_box(b.lower, b.upper), extra=34.0 if moves else 0.0))
+        if moves:
             d = _unit(b.direction)  # equal aspect: the same direction on screen
             centre = np.array([16.0, 0.0])  # points right of the label's right edge
             anchor = OffsetFrom(label, (1.0, 0.5), unit="points")
@@ -245,10 +257,12 @@ def _draw_bodies(ax, drawing: ReevingDrawing) -> None:
                 zorder=6,
                 arrowprops={"arrowstyle": "-|>", "color": _BODY_COLOUR, "lw": 1.6},
             )
+    return labels
 
 
-def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
+def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> list[Label]:
     """Floors as hatched lines, labelled with the travel to contact."""
+    labels = []
     for f in drawing.floors:
         xs, ys = np.array([f.start, f.end]).T
         ax.plot(xs, ys, color=_FLOOR_COLOUR, linewidth=2.0, zorder=3)
@@ -263,7 +277,7 @@ def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
                 linewidth=0.8,
                 zorder=3,
             )
-        ax.annotate(
+        text = ax.annotate(
             f"floor of {f.body}\ncontact after {f.travel:+.2f} m travel",
             0.5 * (f.start + f.end),
             xytext=(-4.0 * f.below[0], -4.0 * f.below[1]),
@@ -275,6 +289,8 @@ def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> None:
             bbox=_LABEL_BOX,
             zorder=6,
         )
+        labels.append(Label(text, along_line(f.start, f.end, -_unit(f.below))))
+    return labels
 
 
 def _legend(fig) -> None:
@@ -336,11 +352,10 @@ def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     arcs_mid = {a.sheave: a.points[len(a.points) // 2] for a in drawing.arcs}
-    _draw_sheaves(ax, drawing, arcs_mid)
+    fixed = _draw_sheaves(ax, drawing, arcs_mid)
     _draw_rope(ax, drawing, arrow)
-    _draw_ends(ax, drawing, arrow)
-    _draw_bodies(ax, drawing)
-    _draw_floors(ax, drawing, arrow)
+    movable, ends = _draw_ends(ax, drawing, arrow)
+    movable = _draw_bodies(ax, drawing) + _draw_floors(ax, drawing, arrow) + movable
     ax.set_aspect("equal", adjustable="datalim")
     ax.margins(0.0)
     ax.set_xlabel(drawing.axis_labels[0])
@@ -350,6 +365,10 @@ def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
     _legend(fig)
     fig.tight_layout(rect=(0.0, 0.04, 1.0, 1.0))
     _fit_limits(fig, ax, lower - 1.3 * arrow, upper + 1.3 * arrow)
+    points = drawing_points(drawing)
+    for _ in range(2):  # placing may widen the limits, which moves the labels a little
+        place_labels(fig, ax, movable, fixed + ends, points)
+        _fit_limits(fig, ax, lower - 1.3 * arrow, upper + 1.3 * arrow)
     fig.savefig(path, dpi=_DPI)
 
 
