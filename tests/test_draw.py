@@ -184,3 +184,21 @@ def test_invalid_reeving_writes_nothing(tmp_path):
     with pytest.raises(ConfigurationError):
         draw_reeving({"path": []}, tmp_path / "bad.png")
     assert not (tmp_path / "bad.png").exists()
+
+
+@pytest.mark.parametrize("scene", ["drawworks", "riser_tensioner", "heave_compensated_hoist"])
+def test_no_label_of_a_shipped_reeving_overprints_another(scene, tmp_path):
+    """Sheave names, body and floor labels, anchors and line ends: no two boxes overlap."""
+    from wire_fmu.master.run import shipped_scenes
+    from wire_fmu.master.scene import load_scene
+    from wire_fmu.tools.draw import _render
+
+    reeving = load_scene(shipped_scenes()[scene]).units["rope"].parameters["reeving"]
+    fig = _render(reeving_drawing(reeving), tmp_path / "r.png", scene)
+    renderer = fig.canvas.get_renderer()
+    (ax,) = [a for a in fig.axes if a.texts]
+    boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in ax.texts if t.get_text()]
+    assert len(boxes) >= 5
+    for i, (text, box) in enumerate(boxes):
+        for other, second in boxes[i + 1 :]:
+            assert not box.overlaps(second), f"{scene}: {text!r} overprints {other!r}"

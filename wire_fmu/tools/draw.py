@@ -342,7 +342,8 @@ def _fit_limits(fig, ax, lower: np.ndarray, upper: np.ndarray) -> None:
         ax.autoscale_view()
 
 
-def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
+def _render(drawing: ReevingDrawing, path: Path, title: str):
+    """Draw ``drawing`` and save it to ``path``; returns the figure."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -370,6 +371,7 @@ def _render(drawing: ReevingDrawing, path: Path, title: str) -> None:
         place_labels(fig, ax, movable, fixed + ends, points)
         _fit_limits(fig, ax, lower - 1.3 * arrow, upper + 1.3 * arrow)
     fig.savefig(path, dpi=_DPI)
+    return fig
 
 
 def draw_reeving(reeving: Mapping[str, Any], path: Path, *, title: str = "") -> Path:
