@@ -6,10 +6,12 @@
     wire-fmu info UNIT [--effects E1 E2 ...] [--markdown]
                                     a unit type's parameters, effects, ports and variables
     wire-fmu check SCENE            validate a scene; list every problem, exit 1 if any
-    wire-fmu run SCENE [-o DIR]     run it: progress bar, summary table, CSV and PNG plots
+    wire-fmu run SCENE [-o DIR]     run it: progress bar, summary table, CSV, plots, report
     wire-fmu run SCENE --monolithic [--rtol RTOL]
                                     the same units as one ODE (the accuracy reference)
     wire-fmu draw SCENE [-o DIR]    render each block train's reeving to a PNG
+    wire-fmu report RESULTS_DIR [-o FILE]
+                                    a run's results as one HTML page (run writes it too)
     wire-fmu build [-o DIR]         build our FMUs
     wire-fmu study accuracy SCENE [--quick] [-o DIR]
                                     work-precision study: error against cost per configuration
@@ -48,6 +50,7 @@ from wire_fmu.cli_commands import (
     cmd_check,
     cmd_draw,
     cmd_export,
+    cmd_report,
     cmd_run,
     cmd_scenes,
     cmd_study,
@@ -230,6 +233,10 @@ def _parser() -> argparse.ArgumentParser:
         "folder (default: results/export/)",
     )
     p.set_defaults(func=cmd_export)
+    p = sub.add_parser("report", help="write a run's results as one self-contained HTML page")
+    p.add_argument("results", type=Path, help="a results folder, as 'run' writes it")
+    p.add_argument("-o", "--output", type=Path, help="the HTML file (default RESULTS/report.html)")
+    p.set_defaults(func=cmd_report)
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")
     p.set_defaults(func=cmd_build)

@@ -24,6 +24,7 @@ __all__ = [
     "cmd_sweep",
     "cmd_export",
     "cmd_study",
+    "cmd_report",
     "EXIT_INTERRUPTED",
     "EXIT_BROKEN_PIPE",
     "plural",
@@ -229,10 +230,46 @@ def _run_files(outcome: Any) -> int:
     _print(f"metadata: {(outcome.directory / 'metadata.json').resolve()}")
     for path in outcome.plots:
         _print(f"plot: {path.resolve()}")
+    report = _report(outcome)
+    if report is not None:
+        _print(f"report: {report.resolve()}")
     status = outcome.result.status
     if status != "finished":  # said once, last, where it is seen
         _print(f"\nrun {status}: {outcome.result.message}")
     return EXIT_INTERRUPTED if status == "interrupted" else 0 if status == "finished" else 1
+
+
+def _report(outcome: Any) -> Path | None:
+    """Write the run's HTML report; None (with a warning) if it cannot be written."""
+    from wire_fmu.tools.report import write_report
+
+    if not (outcome.directory / "metadata.json").is_file():
+        return None
+    try:
+        return write_report(outcome.directory, plots=list(outcome.plots) or None)
+    except (WireFmuError, OSError, ValueError) as exc:
+        logging.getLogger(__name__).warning("the report could not be written: %s", exc)
+        return None
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """Write a results folder as one self-contained HTML page.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: ``results`` (the folder) and ``output``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success.
+    """
+    from wire_fmu.tools.report import write_report
+
+    path = write_report(args.results, args.output)
+    _print(f"report: {path.resolve()}")
+    return 0
 
 
 def cmd_draw(args: argparse.Namespace) -> int:

@@ -12,6 +12,7 @@ A scene is named (one we ship, see :func:`shipped_scenes`) or given by path.
 
 from __future__ import annotations
 
+import json
 import logging
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -261,15 +262,72 @@ def run_scene(
         scene = with_run_settings(scene, **run_overrides)
     directory = Path(results) if results else Path("results") / scene.name
     make_results_folder(directory)
-    structure = validate_scene(scene, Path(fmu_dir))
-    recorder = CsvRecorder(directory, scene.run.output_interval)
-    chain = [recorder, *observers] + ([Progress()] if progress else [])
-    sim = Simulation(scene, structure, chain)
-    result = sim.run()
-    outcome = Outcome(scene, result, directory, recorder.csv_path, simulation=sim)
-    if plots and scene.plots:
-        outcome.plots = _plots(scene, recorder.csv_path, directory)
+    with WarningLog() as said:
+        structure = validate_scene(scene, Path(fmu_dir))
+        recorder = CsvRecorder(directory, scene.run.output_interval)
+        chain = [recorder, *observers] + ([Progress()] if progress else [])
+        sim = Simulation(scene, structure, chain)
+        result = sim.run()
+        outcome = Outcome(scene, result, directory, recorder.csv_path, simulation=sim)
+        if plots and scene.plots:
+            outcome.plots = _plots(scene, recorder.csv_path, directory)
+    note_warnings(recorder.meta_path, said.messages)
     return outcome
+
+
+class WarningLog(logging.Handler):
+    """Collects what the package's loggers warn about while it is entered (``messages``).
+
+    Attributes
+    ----------
+    messages : list of dict
+        Each warning as ``{"level", "source", "message"}``, in order, once each.
+    """
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[dict[str, str]] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        """Keep the record's level, logger name and message (repeats kept once).
+
+        Parameters
+        ----------
+        record : logging.LogRecord
+            A warning or worse from a ``wire_fmu`` logger.
+        """
+        entry = {
+            "level": record.levelname.lower(),
+            "source": record.name,
+            "message": record.getMessage(),
+        }
+        if entry not in self.messages:
+            self.messages.append(entry)
+
+    def __enter__(self) -> WarningLog:
+        logging.getLogger("wire_fmu").addHandler(self)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        logging.getLogger("wire_fmu").removeHandler(self)
+
+
+def note_warnings(meta_path: Path, messages: list[dict[str, str]]) -> None:
+    """Add the run's warnings to its ``metadata.json`` (``"warnings"``), if it was written.
+
+    Parameters
+    ----------
+    meta_path : Path
+        The run's ``metadata.json``.
+    messages : list of dict
+        The warnings (:class:`WarningLog`).
+    """
+    try:
+        meta = json.loads(Path(meta_path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return
+    meta["warnings"] = messages
+    Path(meta_path).write_text(json.dumps(meta, indent=2, default=str) + "\n")
 
 
 def make_results_folder(directory: Path) -> Path:
