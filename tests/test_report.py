@@ -159,3 +159,26 @@ def test_run_writes_the_report_of_a_shipped_scene(tmp_path, capsys):
     images = [a for t, a in page.tags if t == "img"]
     assert len(images) == 5  # three plots, the energy plot and the rope's reeving
     assert all(a["src"].startswith("data:image/png;base64,") for a in images)
+
+
+def test_the_warnings_a_run_logs_are_kept_in_its_metadata(tmp_path):
+    import logging
+
+    from wire_fmu.master.run import WarningLog, note_warnings
+
+    meta = tmp_path / "metadata.json"
+    meta.write_text(json.dumps({"scene": "demo"}))
+    with WarningLog() as said:
+        logging.getLogger("wire_fmu.master.x").warning("parameter %r has no influence", "k")
+        logging.getLogger("wire_fmu.master.x").warning("parameter %r has no influence", "k")
+        logging.getLogger("wire_fmu.master.x").info("not a warning")
+        logging.getLogger("elsewhere").warning("not ours")
+    logging.getLogger("wire_fmu.master.x").warning("after the run")
+    note_warnings(meta, said.messages)
+    assert json.loads(meta.read_text())["warnings"] == [
+        {
+            "level": "warning",
+            "source": "wire_fmu.master.x",
+            "message": "parameter 'k' has no influence",
+        }
+    ]
