@@ -6,7 +6,7 @@ and stick again, many times. Both kernels run it and every output must agree to
 :data:`~tests.test_kernels.RELATIVE` of its largest magnitude: the compiled
 kernel's stuck groups, link forces, guards and projection are those of
 :class:`~wire_fmu.core.components.friction.StickSlip`, operation for operation.
-ROS2 runs with one ``(I - g h J)`` inverse for both kernels (see
+ROS2's Jacobian and solves are the same structured arithmetic in both kernels (see
 :mod:`tests.test_block_train_kernel`).
 """
 
@@ -22,7 +22,7 @@ from wire_fmu.core.units.block_train import kernel
 from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
 from .block_train_helpers import make_unit, run
-from .test_block_train_kernel import RECORD, SOLVERS, STEP, inclined_block_train, one_inverse
+from .test_block_train_kernel import RECORD, SOLVERS, STEP, inclined_block_train
 from .test_kernels import assert_tables_agree
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
@@ -53,8 +53,6 @@ def run_case(name: str, solver: str, mutate=None) -> tuple[dict, object]:
 
 def both_kernels(monkeypatch, name: str, solver: str, mutate=None):
     """Case ``name`` with the Python kernel, then compiled: both tables and both units."""
-    if solver == "ros2":
-        one_inverse(monkeypatch)
     monkeypatch.setenv(KERNEL_ENV, "python")
     python, python_unit = run_case(name, solver)
     assert not python_unit.model.compiled

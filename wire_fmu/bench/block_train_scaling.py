@@ -17,7 +17,8 @@ compiled kernel covers, so that its cost exponent shows where it applies. A
 train outside the compiled kernel's cover runs the Python kernel). Under the
 table, the fitted cost exponent of each kernel and row set: the slope of the
 least-squares line through ``log(ms)`` against ``log(lines)`` over the whole
-range.
+range, and the compiled kernel's slope between the two largest block trains
+(where fixed costs per step no longer flatten it).
 
 The Python kernel at many lines with every effect takes a large fraction of a
 second per step, so it is timed over fewer steps there (see
@@ -247,14 +248,19 @@ def table(sets: Sequence[list[ScalingRow]]) -> str:
                 f"{r.compiled_ms:.3f} | {r.ratio:.1f} | {'compiled' if r.compiled else 'Python'} |"
             )
     lines.append("")
-    lines.append("| effects | lines | Python exponent | compiled exponent |")
-    lines.append("|---|---|---:|---:|")
+    lines.append(
+        "| effects | lines | Python exponent | compiled exponent | compiled, largest two |"
+    )
+    lines.append("|---|---|---:|---:|---:|")
     for rows in sets:
         n = [r.lines for r in rows]
         python = exponent(n, [r.python_ms for r in rows])
         fitted = exponent(n, [r.compiled_ms for r in rows])
+        last = exponent(n[-2:], [r.compiled_ms for r in rows[-2:]])
         span = f"{min(n)}-{max(n)}"
-        lines.append(f"| {rows[0].effects or '(none)'} | {span} | {python:.2f} | {fitted:.2f} |")
+        lines.append(
+            f"| {rows[0].effects or '(none)'} | {span} | {python:.2f} | {fitted:.2f} | {last:.2f} |"
+        )
     return "\n".join(lines)
 
 

@@ -39,6 +39,8 @@ import numpy as np
 __all__ = ["FrictionLink", "StickSlip", "GROUND"]
 
 GROUND = -1
+PLANS_KEPT = 256
+"""Stuck-group plans a :class:`StickSlip` keeps, one per distinct mode it has seen."""
 
 
 def _by_direction(capacities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -88,7 +90,8 @@ class StickSlip:
         self.masses = np.asarray(masses, dtype=float)
         self.links = tuple(links)
         self.mode = np.zeros(len(self.links), dtype=np.int64)  # all stuck at rest
-        self._plan = None
+        self._mass_list = self.masses.tolist()
+        self._plans: dict[bytes, list] = {}  # by mode: modes recur as links stick and slip
         self._arrays = None
 
     # -- state ---------------------------------------------------------------
@@ -105,7 +108,6 @@ class StickSlip:
             Per link: 0 stuck, +1 or -1 the sliding direction.
         """
         self.mode = np.array(mode, dtype=np.int64)
-        self._plan = None
 
     # -- dynamics --------------------------------------------------------------
     def relative_velocity(self, v: np.ndarray, k: int) -> float:
@@ -166,10 +168,17 @@ class StickSlip:
                     total[link.other] -= f
         acc = total / self.masses
         plan = self._plan_for(mode)
+        forces_on = total.tolist()  # plain floats: a group is a handful of coordinates
+        masses = self._mass_list
         for members, grounded, edges in plan:
-            a = 0.0 if grounded else total[members].sum() / self.masses[members].sum()
-            acc[members] = a
-            required = {i: self.masses[i] * a - total[i] for i in members}
+            if grounded:
+                a = 0.0
+            else:
+                a = sum(forces_on[i] for i in members) / sum(masses[i] for i in members)
+            required = {}
+            for i in members:
+                acc[i] = a
+                required[i] = masses[i] * a - forces_on[i]
             for k, child, parent in edges:  # leaves first
                 carried = required[child]
                 link_force[k] = carried if self.links[k].body == child else -carried
@@ -251,7 +260,6 @@ class StickSlip:
             if self.mode[k] != 0:
                 v = self._stop(v, k)
                 self.mode[k] = 0
-        self._plan = None
         for _ in range(2 * len(self.links) + 1):
             _, link_force = self.accelerations(forces, capacities)
             caps = _by_direction(capacities)
@@ -265,7 +273,6 @@ class StickSlip:
                 break
             worst = min(over, key=lambda k: margin[k])
             self.mode[worst] = -1 if link_force[worst] > 0 else 1
-            self._plan = None
         return v
 
     def _stop(self, v: np.ndarray, k: int) -> np.ndarray:
@@ -327,11 +334,14 @@ class StickSlip:
 
     # -- structure of the stuck links -----------------------------------------
     def _plan_for(self, mode: np.ndarray):
-        if self._plan is not None and mode is self.mode:
-            return self._plan
-        plan = _stuck_clusters(self.links, mode)
-        if mode is self.mode:
-            self._plan = plan
+        """The stuck groups for ``mode``, made once per distinct mode (at most
+        :data:`PLANS_KEPT` kept)."""
+        key = mode.tobytes()
+        plan = self._plans.get(key)
+        if plan is None:
+            if len(self._plans) >= PLANS_KEPT:
+                self._plans.clear()
+            plan = self._plans[key] = _stuck_clusters(self.links, mode)
         return plan
 
 
@@ -376,5 +386,5 @@ def _stuck_clusters(links: tuple[FrictionLink, ...], mode: np.ndarray):
                 order.append((k, nxt, node))
                 stack.append((nxt, k))
         members = sorted({c for _, c, _ in order} | ({root} - {GROUND}))
-        clusters.append((np.array(members, dtype=int), root == GROUND, list(reversed(order))))
+        clusters.append((members, root == GROUND, list(reversed(order))))
     return clusters

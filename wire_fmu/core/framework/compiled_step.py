@@ -8,8 +8,14 @@ compiled kernel gives plain functions
 
 ``rhs(t, x, data) -> x'``, ``guards(t, x, data) -> g`` and ``project(x, data) -> x``
 
-over a tuple ``data`` of arrays (parameters, modes, held inputs), and a cached
-entry point of its own that calls :func:`advance_to_event` with them. The
+over a tuple ``data`` of arrays (parameters, modes, held inputs), the linear
+algebra of ROS2 (the ``dense_*`` functions here, or a structured set of its own such as the block
+train's bordered band), and a cached entry point of its own that calls
+:func:`advance_to_event` with them. The linear algebra is four functions:
+
+``linearise(rhs, t, x, data) -> (J, evaluations)``, ``unlinearised(data) -> J``
+(an empty ``J`` of the same type), ``factor(J, g h, data) -> F`` (empty for a NaN
+``g h``) and ``solve(F, b, data) -> (I - g h J)^-1 b``. The
 compiled loop returns at the end of the step or at the first located event;
 :class:`CompiledFixedStep` then lets the Python model switch its mode (and say
 so in words) and calls the loop again. Nothing here allocates per step beyond
@@ -46,6 +52,10 @@ __all__ = [
     "STATUS_NONFINITE",
     "STATUS_PYTHON",
     "advance_to_event",
+    "dense_factor",
+    "dense_linearise",
+    "dense_solve",
+    "dense_unlinearised",
 ]
 
 COMPILED_METHODS = {"rk4": 0, "ros2": 1}
@@ -95,8 +105,36 @@ def _jacobian(rhs, t: float, x: np.ndarray, data) -> np.ndarray:
 
 
 @jit_inline
-def _step(rhs, method: int, t: float, x: np.ndarray, h: float, w_inv: np.ndarray, data):
-    """One RK4 step, or one ROS2 step with ``w_inv = (I - g h J)^-1``."""
+def dense_linearise(rhs, t: float, x: np.ndarray, data):
+    """The forward-difference Jacobian of every state and the evaluations it took."""
+    return _jacobian(rhs, t, x, data), x.size + 1
+
+
+@jit
+def dense_unlinearised(data) -> np.ndarray:
+    """No Jacobian yet (an empty matrix)."""
+    return np.zeros((0, 0))
+
+
+@jit
+def dense_factor(jac: np.ndarray, gh: float, data) -> np.ndarray:
+    """``(I - gh J)^-1`` (empty for a NaN ``gh`` or an empty ``J``)."""
+    n = jac.shape[0]
+    if n == 0 or math.isnan(gh):
+        return np.zeros((0, 0))
+    # numpy's inv solves W X = I (LAPACK gesv); so does this, for the same numbers
+    return np.ascontiguousarray(np.linalg.solve(np.eye(n) - gh * jac, np.eye(n)))
+
+
+@jit
+def dense_solve(w_inv: np.ndarray, b: np.ndarray, data) -> np.ndarray:
+    """``W^-1 b`` with the inverse of :func:`dense_factor`."""
+    return w_inv @ b
+
+
+@jit_inline
+def _step(rhs, solve, method: int, t: float, x: np.ndarray, h: float, fac, data):
+    """One RK4 step, or one ROS2 step with the factors ``fac`` of ``I - g h J``."""
     if method == _RK4:
         k1 = rhs(t, x, data)
         k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1, data)
@@ -105,19 +143,17 @@ def _step(rhs, method: int, t: float, x: np.ndarray, h: float, w_inv: np.ndarray
         return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     if x.size == 0:
         return x
-    k1 = w_inv @ rhs(t, x, data)
-    k2 = w_inv @ (rhs(t + h, x + h * k1, data) - 2.0 * k1)
+    k1 = solve(fac, rhs(t, x, data), data)
+    k2 = solve(fac, rhs(t + h, x + h * k1, data) - 2.0 * k1, data)
     return x + h * (1.5 * k1 + 0.5 * k2)
 
 
-@jit
-def _w_inverse(method: int, jac: np.ndarray, h: float, w_h: float, w_inv: np.ndarray):
-    """``(I - g h J)^-1`` for ``h``, reusing ``w_inv`` if it was made for the same ``h``."""
+@jit_inline
+def _refactor(factor, method: int, jac, h: float, w_h: float, fac, data):
+    """Factors of ``I - g h J`` for ``h``, reusing ``fac`` if it was made for the same ``h``."""
     if method != _ROS2 or h == w_h:
-        return w_inv, w_h
-    n = jac.shape[0]
-    # numpy's inv solves W X = I (LAPACK gesv); so does this, for the same numbers
-    return np.ascontiguousarray(np.linalg.solve(np.eye(n) - _GAMMA * h * jac, np.eye(n))), h
+        return fac, w_h
+    return factor(jac, _GAMMA * h, data), h
 
 
 @jit
@@ -137,13 +173,33 @@ def _stage_calls(method: int, x: np.ndarray) -> int:
 
 
 @jit_inline
-def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data):
+def advance_to_event(
+    rhs,
+    guards,
+    project,
+    linearise,
+    unlinearised,
+    factor,
+    solve,
+    method,
+    t0,
+    t1,
+    n,
+    k,
+    t,
+    x,
+    directions,
+    tol,
+    data,
+):
     """Integrate from ``(t, x)`` on interval ``k`` of ``n`` equal steps of ``[t0, t1]``.
 
     Parameters
     ----------
     rhs, guards, project : compiled functions
         The unit's kernel (see the module docstring).
+    linearise, unlinearised, factor, solve : compiled functions
+        ROS2's linear algebra (see the module docstring), e.g. the ``dense_*`` functions.
     method : int
         A value of :data:`COMPILED_METHODS`.
     t0, t1 : float
@@ -173,19 +229,19 @@ def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, direction
     """
     steps = 0
     calls = 0
-    jac = np.zeros((0, 0))
+    jac = unlinearised(data)
     if method == _ROS2:
-        jac = _jacobian(rhs, t, x, data)
-        calls += x.size + 1
-    w_inv = np.zeros((0, 0))
+        jac, evaluations = linearise(rhs, t, x, data)
+        calls += evaluations
     w_h = math.nan
+    fac = factor(jac, w_h, data)
     g0 = guards(t, x, data)
     no_fire = np.zeros(g0.size, dtype=np.bool_)
     while k < n:
         t_next = t0 + (t1 - t0) * (k + 1) / n
         h = t_next - t
-        w_inv, w_h = _w_inverse(method, jac, h, w_h, w_inv)
-        x1 = project(_step(rhs, method, t, x, h, w_inv, data), data)
+        fac, w_h = _refactor(factor, method, jac, h, w_h, fac, data)
+        x1 = project(_step(rhs, solve, method, t, x, h, fac, data), data)
         steps += 1
         calls += _stage_calls(method, x)
         if not _all_finite(x1):
@@ -216,8 +272,8 @@ def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, direction
                     est = lo + (hi - lo) * a / (a - b) if a != b else 0.5 * (lo + hi)
                     theta = min(theta, est)
             theta = min(max(theta, lo + 0.05 * frac_tol), hi - 0.05 * frac_tol)
-            w_inv, w_h = _w_inverse(method, jac, theta * h, w_h, w_inv)
-            x_mid = project(_step(rhs, method, t, x, theta * h, w_inv, data), data)
+            fac, w_h = _refactor(factor, method, jac, theta * h, w_h, fac, data)
+            x_mid = project(_step(rhs, solve, method, t, x, theta * h, fac, data), data)
             steps += 1
             calls += _stage_calls(method, x)
             if not _all_finite(x_mid):
@@ -313,7 +369,8 @@ class CompiledFixedStep(FixedStepSolver):
             if t >= t_next - tol:
                 t, k = t_next, k + 1
             if k >= n and self.method == COMPILED_METHODS["ros2"]:
-                self.rhs_calls += x.size + 1  # the Python solver's Jacobian after the last event
+                # the Python solver's Jacobian after the last event
+                self.rhs_calls += system.jacobian_evaluations(x)
         return x, events
 
     def finish_quiet_step(
@@ -352,6 +409,7 @@ class CompiledFixedStep(FixedStepSolver):
     def _explain_nonfinite(self, system, t: float, x: np.ndarray, h: float) -> None:
         """Re-take the failed step with the Python kernel, which raises the error it names."""
         with system.python_kernel():
+            self._python._on_new_interval(system, t, x)
             self._python._checked_step(system, t, x, h)
         raise IntegrationError(f"non-finite state after a step of {h:.3g} s at t = {t:.6g} s")
 
@@ -371,6 +429,10 @@ class KernelModel:
     def kernel_data(self) -> tuple:
         """The tuple of arrays the compiled kernel takes, for the present modes and inputs."""
         return self.KERNEL.kernel_data(self)
+
+    def jacobian_evaluations(self, x: np.ndarray) -> int:
+        """Right-hand sides ROS2 evaluates for one Jacobian at state ``x`` (all differenced)."""
+        return x.size + 1
 
     @contextmanager
     def python_kernel(self) -> Iterator[None]:

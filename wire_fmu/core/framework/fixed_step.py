@@ -10,7 +10,7 @@ solvers are chosen by name through :data:`wire_fmu.core.framework.hybrid.SOLVERS
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -23,7 +23,14 @@ from wire_fmu.core.framework.step_limits import (
 if TYPE_CHECKING:
     from wire_fmu.core.framework.hybrid import HybridSystem, SolverSettings
 
-__all__ = ["FixedStepSolver", "RK4", "ROS2", "finite_difference_jacobian"]
+__all__ = [
+    "DenseLinearAlgebra",
+    "FixedStepSolver",
+    "LinearAlgebra",
+    "RK4",
+    "ROS2",
+    "finite_difference_jacobian",
+]
 
 _MAX_LOCATE_ITERATIONS = 60
 
@@ -173,32 +180,32 @@ class ROS2(FixedStepSolver):
     ``(I - g h J) k1 = f(t, x)``;
     ``(I - g h J) k2 = f(t + h, x + h k1) - 2 k1``;
     ``x+ = x + 1.5 h k1 + 0.5 h k2``, with ``g = 1 + 1/sqrt(2)``.
+
+    ``J`` is taken at the start of every internal interval from the system's
+    ``linear_algebra()`` where it offers one (a structured Jacobian, see
+    :class:`LinearAlgebra`), else by forward differences of every state.
     """
 
     GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 
     def __init__(self, settings: SolverSettings) -> None:
         super().__init__(settings)
-        self._jac: np.ndarray | None = None
+        self._linear: LinearAlgebra = DenseLinearAlgebra(None)
+        self._jac = None
         self._inverse_h: float | None = None
-        self._inverse: np.ndarray | None = None
+        self._inverse = None
 
     def _on_new_interval(self, system, t, x):
-        self._jac = finite_difference_jacobian(system, t, x)
-        self.rhs_calls += x.size + 1
+        make = getattr(system, "linear_algebra", None)
+        self._linear = make() if make is not None else DenseLinearAlgebra(system)
+        self._jac, evaluations = self._linear.linearise(t, x)
+        self.rhs_calls += evaluations
         self._inverse_h = None
 
-    def _w_inverse(self, h: float) -> np.ndarray:
-        """``(I - g h J)^-1``, kept while ``h`` and the Jacobian stay.
-
-        For the small systems of a unit, multiplying by the inverse costs a
-        few microseconds where a LAPACK triangular solve through SciPy costs
-        about twenty; the matrix is well conditioned for any ``h`` (its
-        eigenvalues are ``1 - g h lambda`` with ``Re lambda <= 0``).
-        """
+    def _w_inverse(self, h: float):
+        """The factors of ``I - g h J``, kept while ``h`` and the Jacobian stay."""
         if self._inverse_h != h:
-            n = self._jac.shape[0]
-            self._inverse = np.linalg.inv(np.eye(n) - self.GAMMA * h * self._jac)
+            self._inverse = self._linear.factor(self._jac, self.GAMMA * h)
             self._inverse_h = h
         return self._inverse
 
@@ -206,10 +213,59 @@ class ROS2(FixedStepSolver):
         if x.size == 0:
             return x
         w_inv = self._w_inverse(h)
-        k1 = w_inv @ system.rhs(t, x)
-        k2 = w_inv @ (system.rhs(t + h, x + h * k1) - 2.0 * k1)
+        solve = self._linear.solve
+        k1 = solve(w_inv, system.rhs(t, x))
+        k2 = solve(w_inv, system.rhs(t + h, x + h * k1) - 2.0 * k1)
         self.rhs_calls += 2
         return x + h * (1.5 * k1 + 0.5 * k2)
+
+
+class LinearAlgebra(Protocol):
+    """ROS2's Jacobian and ``(I - g h J)`` solves, as a system offers them.
+
+    A system with a structured Jacobian returns one from ``linear_algebra()``;
+    others get :class:`DenseLinearAlgebra`.
+    """
+
+    def linearise(self, t: float, x: np.ndarray) -> tuple[Any, int]:
+        """The Jacobian at ``(t, x)`` in the form :meth:`factor` takes, and the
+        right-hand sides evaluated for it."""
+
+    def factor(self, jac: Any, gh: float) -> Any:
+        """Factors of ``I - gh J`` (``gh`` in s)."""
+
+    def solve(self, factors: Any, b: np.ndarray) -> np.ndarray:
+        """``(I - gh J)^-1 b``."""
+
+
+class DenseLinearAlgebra:
+    """Every state differenced, ``I - g h J`` inverted.
+
+    For the small systems of a unit, multiplying by the inverse costs a few
+    microseconds where a LAPACK triangular solve through SciPy costs about twenty;
+    the matrix is well conditioned for any ``h`` (its eigenvalues are
+    ``1 - g h lambda`` with ``Re lambda <= 0``).
+
+    Parameters
+    ----------
+    system : HybridSystem
+        The model, in its current mode.
+    """
+
+    def __init__(self, system: HybridSystem | None) -> None:
+        self.system = system
+
+    def linearise(self, t: float, x: np.ndarray) -> tuple[np.ndarray, int]:
+        """:func:`finite_difference_jacobian` and its ``x.size + 1`` evaluations."""
+        return finite_difference_jacobian(self.system, t, x), x.size + 1
+
+    def factor(self, jac: np.ndarray, gh: float) -> np.ndarray:
+        """``(I - gh J)^-1``."""
+        return np.linalg.inv(np.eye(jac.shape[0]) - gh * jac)
+
+    def solve(self, factors: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``factors @ b``."""
+        return factors @ b
 
 
 def finite_difference_jacobian(system: HybridSystem, t: float, x: np.ndarray) -> np.ndarray:

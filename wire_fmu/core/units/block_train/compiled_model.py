@@ -14,13 +14,49 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from wire_fmu.core.framework import bordered_band
 from wire_fmu.core.framework.compiled_step import STATUS_PYTHON
 from wire_fmu.core.units.block_train import kernel
+from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian, jacobian_structure
 
 if TYPE_CHECKING:
     from wire_fmu.core.units.block_train.model import BlockTrainInputs
 
-__all__ = ["CompiledBlockTrain"]
+__all__ = ["BandedLinearAlgebra", "CompiledBlockTrain"]
+
+
+class BandedLinearAlgebra:
+    """ROS2's linear algebra of a block train for the Python solver: the structured
+    Jacobian of :mod:`.kernel_jacobian` over the model's :meth:`rhs_parts
+    <wire_fmu.core.units.block_train.model.BlockTrainModel.rhs_parts>`, factored and
+    solved as a bordered band -- the compiled kernel's arithmetic, operation for
+    operation.
+
+    Parameters
+    ----------
+    model : BlockTrainModel
+        The block train, in its current mode.
+    """
+
+    def __init__(self, model) -> None:
+        self.model = model
+        self.structure = model.kernel_jacobian_structure
+
+    def linearise(self, t: float, x: np.ndarray) -> tuple[tuple, int]:
+        """The Jacobian at ``(t, x)`` and the right-hand sides evaluated for it."""
+        model = self.model
+        columns = getattr(coloured_jacobian, "py_func", coloured_jacobian)
+        return columns(
+            lambda t, x, data: model.rhs_parts(t, x), t, x, None, self.structure, model.masses
+        )
+
+    def factor(self, jac: tuple, gh: float) -> tuple:
+        """Factors of ``I - gh J`` (``gh`` in s)."""
+        return bordered_band.factor(jac, gh, self.structure)
+
+    def solve(self, factors: tuple, b: np.ndarray) -> np.ndarray:
+        """``(I - gh J)^-1 b``."""
+        return bordered_band.solve(factors, b, self.structure)
 
 
 class CompiledBlockTrain:
@@ -51,6 +87,15 @@ class CompiledBlockTrain:
                 blocks[j, 2:] = b.floor.position, b.floor.stiffness, b.floor.damping
         self.kernel_blocks = blocks
         self._build_kernel_geometry(bool(moving))
+        self.kernel_jacobian_structure = jacobian_structure(self)
+
+    def linear_algebra(self) -> BandedLinearAlgebra:
+        """ROS2's Jacobian and solves for the Python solver (see :class:`BandedLinearAlgebra`)."""
+        return BandedLinearAlgebra(self)
+
+    def jacobian_evaluations(self, x: np.ndarray) -> int:
+        """Right-hand sides one structured Jacobian takes: one per colour and one more."""
+        return int(self.kernel_jacobian_structure[0][4]) + 1
 
     def _build_kernel_geometry(self, moving: bool) -> None:
         """The planar path of :meth:`_planar_segment_lengths` as flat arrays (empty if fixed)."""

@@ -41,7 +41,12 @@ index  name                contents
 16     ``geometry_step``   float: the central-difference step of the lengths
                            with respect to the body motion, m
 17-24  friction links      see :mod:`.kernel_friction`
+25     ``jacobian``        the Jacobian's bordered band structure
+                           (:func:`.kernel_jacobian.jacobian_structure`)
 =====  ==================  ==================================================
+
+ROS2 runs on that structure (:func:`linearise`, :func:`factor`, :func:`solve`): a
+few evaluations and a banded solve per Jacobian, whatever the number of lines.
 
 The guards are in the order of :meth:`ModeSwitching.guards
 <wire_fmu.core.units.block_train.modes.ModeSwitching.guards>`: friction links
@@ -55,25 +60,32 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework import bordered_band
+from wire_fmu.core.framework.compiled import jit, jit_inline
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
 from wire_fmu.core.units.block_train.kernel_friction import (
     accelerations,
     capacities,
     friction_data,
     link_guards,
+    link_losses,
     loss_power,
 )
 from wire_fmu.core.units.block_train.kernel_geometry import segment_lengths, span_geometry
+from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian
 
 __all__ = [
     "advance",
     "evaluate",
+    "factor",
     "guards",
     "kernel_data",
+    "linearise",
     "project",
     "quiet_step",
     "rhs",
+    "rhs_parts",
+    "solve",
     "segment_lengths",
     "span_geometry",
     "summary",
@@ -109,6 +121,7 @@ def kernel_data(model) -> tuple:
         model.kernel_segment_span,
         model.kernel_geometry_step,
         *friction_data(model),
+        model.kernel_jacobian_structure,
     )
 
 
@@ -190,6 +203,7 @@ def evaluate(t: float, x: np.ndarray, data):
     elastic = np.empty(n_spans)
     on_unstretched = np.zeros(n_spans)
     energy = np.zeros(n_spans)
+    span_loss = np.zeros(n_spans)
     loss = 0.0
     for i in range(n_spans):
         if small_l[i] <= 0.0:
@@ -210,11 +224,13 @@ def evaluate(t: float, x: np.ndarray, data):
             tension[i] = t_el + t_d
             on_unstretched[i] = t_el * (1.0 + 0.5 * eps) + t_d * (1.0 + eps)
             energy[i] = 0.5 * t_el * stretch
-            loss += t_d * small_l[i] * eps_rate
+            span_loss[i] = t_d * small_l[i] * eps_rate
+            loss += span_loss[i]
         elif stretch > 0.0:  # slack but still stretched: its strain drains, never negative
             energy[i] = 0.5 * t_el * stretch
             strain_rate = t_el * big_l_rate[i] - t_el * (1.0 + 0.5 * eps) * small_l_rate[i]
-            loss += max(-strain_rate, 0.0)
+            span_loss[i] = max(-strain_rate, 0.0)
+            loss += span_loss[i]
     body_force = -_vecmat(tension, jac)
     generalised = _vecmat(on_unstretched, flow)
     forces = generalised[:n].copy()
@@ -257,6 +273,9 @@ def evaluate(t: float, x: np.ndarray, data):
         loss,
         power,
         ok,
+        jac,
+        span_loss,
+        on_unstretched,
     )
 
 
@@ -273,9 +292,56 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
+    return _rhs_of(evaluate(t, x, data), x, data)
+
+
+@jit
+def rhs_parts(t: float, x: np.ndarray, data):
+    """:func:`rhs` and the local pieces its coupled rows are sums of, from one evaluation.
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State (see :func:`evaluate`).
+    data : tuple
+        See the module docstring.
+
+    Returns
+    -------
+    tuple
+        The state derivative; per span its tension (N), its share of the dissipated
+        power and of the external power (W); ``dL/dy`` (spans x bodies); per friction
+        link the power it dissipates (W).
+    """
+    n, nb, nd = data[0][0], data[0][1], data[0][2]
+    flow, held = data[5], data[11]
+    result = evaluate(t, x, data)
+    tension, jac, on_unstretched = result[1], result[14], result[16]
+    line_rate = held[3 : 3 + N_LINES]
+    mover_v = held[3 + N_LINES + nd : 3 + N_LINES + 2 * nd]
+    span_power = np.empty(tension.size)
+    for i in range(tension.size):
+        p = 0.0
+        for line in range(N_LINES):
+            p -= on_unstretched[i] * flow[i, n + line] * line_rate[line]
+        for j in range(nd):
+            p += tension[i] * jac[i, nb + j] * mover_v[j]
+        span_power[i] = p
+    link_loss = np.zeros(data[17].shape[0])
+    if link_loss.size:
+        caps = capacities(tension, data)
+        link_force = accelerations(result[0], caps, data[2], data)[1]
+        link_losses(x, n, link_force, link_loss, data)
+    return _rhs_of(result, x, data), tension, result[15], span_power, jac, link_loss
+
+
+@jit
+def _rhs_of(result, x: np.ndarray, data) -> np.ndarray:
+    """:func:`rhs` from :func:`evaluate`'s ``result`` at state ``x``."""
     n = data[0][0]
     masses = data[2]
-    result = evaluate(t, x, data)
     forces, loss, power = result[0], result[11], result[12]
     out = np.empty_like(x)
     for i in range(n):
@@ -396,6 +462,38 @@ def project(x: np.ndarray, data) -> np.ndarray:
     return x
 
 
+@jit_inline
+def linearise(rhs_function, t: float, x: np.ndarray, data):
+    """The Jacobian in bordered band form and its evaluations (:func:`.coloured_jacobian`).
+
+    Parameters
+    ----------
+    rhs_function : callable
+        Unused: the Jacobian is taken from :func:`rhs_parts`.
+    t, x, data
+        As :func:`rhs` takes them.
+    """
+    return coloured_jacobian(rhs_parts, t, x, data, data[25], data[2])
+
+
+@jit
+def unlinearised(data) -> tuple:
+    """No Jacobian yet, of the type :func:`linearise` gives."""
+    return bordered_band.empty_jacobian()
+
+
+@jit
+def factor(jac: tuple, gh: float, data) -> tuple:
+    """Factors of ``I - gh J`` (:func:`~wire_fmu.core.framework.bordered_band.factor`)."""
+    return bordered_band.factor(jac, gh, data[25])
+
+
+@jit
+def solve(fac: tuple, b: np.ndarray, data) -> np.ndarray:
+    """``(I - gh J)^-1 b`` (:func:`~wire_fmu.core.framework.bordered_band.solve`)."""
+    return bordered_band.solve(fac, b, data[25])
+
+
 @jit
 def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     """:func:`~wire_fmu.core.framework.compiled_step.advance_to_event` over this kernel.
@@ -405,7 +503,25 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+    return advance_to_event(
+        rhs,
+        guards,
+        project,
+        linearise,
+        unlinearised,
+        factor,
+        solve,
+        method,
+        t0,
+        t1,
+        n,
+        k,
+        t,
+        x,
+        directions,
+        tol,
+        data,
+    )
 
 
 @jit
@@ -459,7 +575,23 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     x[2 * n_coords + 1] += after[9].sum() - before[9].sum()
     x = project(x, new)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, new
+        rhs,
+        guards,
+        project,
+        linearise,
+        unlinearised,
+        factor,
+        solve,
+        method,
+        t0,
+        t1,
+        n,
+        0,
+        t0,
+        x,
+        directions,
+        tol,
+        new,
     )
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(t1, x, new)

@@ -35,7 +35,14 @@ import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
 
-__all__ = ["accelerations", "capacities", "friction_data", "loss_power", "link_guards"]
+__all__ = [
+    "accelerations",
+    "capacities",
+    "friction_data",
+    "link_guards",
+    "link_losses",
+    "loss_power",
+]
 
 GROUND = -1
 
@@ -162,6 +169,30 @@ def loss_power(x: np.ndarray, n: int, link_force: np.ndarray, data) -> float:
         if mode[k] != 0:
             total -= link_force[k] * _relative_velocity(x, n, index, k)
     return total
+
+
+@jit
+def link_losses(x: np.ndarray, n: int, link_force: np.ndarray, out: np.ndarray, data) -> None:
+    """Write the power each link dissipates into ``out`` (W; 0 while stuck).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State ``[q, v, ...]``.
+    n : int
+        Number of coordinates.
+    link_force : numpy.ndarray
+        Link forces from :func:`accelerations`, N.
+    out : numpy.ndarray
+        One entry per link, written in place.
+    data : tuple
+        The kernel's tuple (see the module docstring).
+    """
+    index, mode = data[17], data[19]
+    for k in range(index.shape[0]):
+        out[k] = 0.0
+        if mode[k] != 0:
+            out[k] = -link_force[k] * _relative_velocity(x, n, index, k)
 
 
 @jit

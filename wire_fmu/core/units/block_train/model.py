@@ -297,7 +297,8 @@ class BlockTrainModel(
             the bodies (N), floor ``depth`` (m) and ``contact``/``trial_contact`` forces
             (N), ``rope_energy``/``span_energy``/``potential`` (J), ``loss`` power (W),
             the rope forces ``rope`` (Python kernel only), body displacements ``y`` (m) and
-            velocities ``ydot`` (m/s).
+            velocities ``ydot`` (m/s), and the span lengths' ``span_jacobian`` ``dL/dy``
+            (Python kernel only).
         """
         if self.compiled:
             return self._evaluate_compiled(t, x)
@@ -364,6 +365,7 @@ class BlockTrainModel(
             "loss": loss,
             "y": y,
             "ydot": ydot,
+            "span_jacobian": dl_dy,
         }
 
     def _external_power(self, ev: dict) -> float:
@@ -386,8 +388,57 @@ class BlockTrainModel(
         """
         if self.compiled:
             return kernel.rhs(t, x, self.kernel_data())
-        n = self.n_coords
+        return self._rhs_of(x, self.evaluate(t, x))
+
+    def rhs_parts(self, t: float, x: np.ndarray) -> tuple:
+        """:meth:`rhs` and the local pieces its coupled rows are sums of, from one
+        evaluation (what the structured Jacobian differences; the compiled kernel's
+        ``rhs_parts``, operation for operation).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : numpy.ndarray
+            State ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+
+        Returns
+        -------
+        tuple
+            The state derivative; per span its tension (N), its share of the
+            dissipated power and of the external power (W); ``dL/dy`` (spans x
+            bodies); per friction link the power it dissipates (W).
+        """
+        if self.compiled:
+            return kernel.rhs_parts(t, x, self.kernel_data())
+        n, nb = self.n_coords, len(self.blocks)
         ev = self.evaluate(t, x)
+        intact = ~self.broken_mask
+        on_unstretched = ev["rope"].force_on_unstretched * intact
+        tension, dl_dy = ev["tension"], ev["span_jacobian"]
+        span_power = np.empty(len(self.spans))
+        for i in range(len(self.spans)):
+            p = 0.0
+            for line, rate in enumerate(self._line_rate):
+                p -= on_unstretched[i] * self.flow_matrix[i, n + line] * rate
+            for j, velocity in enumerate(self._mover_v):
+                p += tension[i] * dl_dy[i, nb + j] * velocity
+            span_power[i] = p
+        caps = self._capacities(tension)
+        _, link_force = self.friction.accelerations(ev["forces"], caps)
+        v = x[n : 2 * n]
+        link_loss = np.array(
+            [
+                -link_force[k] * self.friction.relative_velocity(v, k) if mode != 0 else 0.0
+                for k, mode in enumerate(self.friction.mode)
+            ]
+        )
+        span_loss = ev["rope"].loss_power * intact
+        return self._rhs_of(x, ev), tension, span_loss, span_power, dl_dy, link_loss
+
+    def _rhs_of(self, x: np.ndarray, ev: dict) -> np.ndarray:
+        """:meth:`rhs` from the Python kernel's evaluation ``ev`` at state ``x``."""
+        n = self.n_coords
         v = x[n : 2 * n]
         out = np.empty_like(x)
         out[:n] = v
