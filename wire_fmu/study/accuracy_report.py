@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .log_ticks import log_ticks
 from .measures import MONOLITHIC_RADAU, RunRow
 from .orders import (
     ASYMPTOTIC_LIMIT,
@@ -211,37 +212,67 @@ def accuracy_markdown(study: AccuracyStudy) -> str:
     )
 
 
+_DASHES = {"constant": ":", "linear": "-", "quadratic": "--"}
+_MARKERS = {"gauss_seidel": "o", "jacobi": "s"}
+
+
 def _style(study_rows: Sequence[RunRow]):
     solvers = list(dict.fromkeys(r.solver for r in study_rows if r.algorithm != "monolithic"))
     colours = {s: f"C{i % 10}" for i, s in enumerate(solvers)}
-    dashes = {"constant": ":", "linear": "-", "quadratic": "--"}
-    markers = {"gauss_seidel": "o", "jacobi": "s"}
-    return colours, dashes, markers
+    return colours, dict(_DASHES), dict(_MARKERS)
 
 
-def _legend(ax, colours, dashes, markers, work_precision: bool) -> None:
+def _drawn(rows: Sequence[RunRow]) -> dict[str, set[str]]:
+    """What the diagrams draw of ``rows``: solvers, extrapolations, algorithms, monolithic kinds."""
+    coupled = [r for r in rows if r.usable and r.algorithm != "monolithic"]
+    single = [r for r in rows if r.usable and r.algorithm == "monolithic"]
+    return {
+        "solver": {r.solver for r in coupled},
+        "extrapolation": {r.extrapolation for r in coupled},
+        "algorithm": {r.algorithm for r in coupled},
+        "monolithic": {"radau" if r.family == MONOLITHIC_RADAU else "solver" for r in single},
+    }
+
+
+def _legend(ax, colours, dashes, markers, work_precision: bool, rows: Sequence[RunRow]) -> None:
+    """The legend of what was run and drawn: no entry for a family the study did not run."""
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], color=c, lw=2, label=s) for s, c in colours.items()]
-    handles += [Line2D([], [], color="0.3", ls=d, label=e) for e, d in dashes.items()]
-    handles += [Line2D([], [], color="0.3", ls="", marker=m, label=a) for a, m in markers.items()]
+    drawn = _drawn(rows)
+    handles = [
+        Line2D([], [], color=c, lw=2, label=s) for s, c in colours.items() if s in drawn["solver"]
+    ]
+    handles += [
+        Line2D([], [], color="0.3", ls=d, label=e)
+        for e, d in dashes.items()
+        if e in drawn["extrapolation"]
+    ]
+    handles += [
+        Line2D([], [], color="0.3", ls="", marker=m, label=a)
+        for a, m in markers.items()
+        if a in drawn["algorithm"]
+    ]
     if work_precision:
-        handles += [
-            Line2D([], [], color="k", marker="D", ms=4, label="monolithic, Radau rtol"),
-            Line2D(
-                [],
-                [],
-                color="w",
-                ls="",
-                marker="*",
-                ms=11,
-                mec="k",
-                label="monolithic, unit solver",
-            ),
-            Line2D([], [], color="k", ls="-.", lw=1, label="monolithic reference"),
-        ]
-    else:
-        handles += [
+        if "radau" in drawn["monolithic"]:
+            handles.append(
+                Line2D([], [], color="k", marker="D", ms=4, label="monolithic, Radau rtol")
+            )
+        if "solver" in drawn["monolithic"]:
+            handles.append(
+                Line2D(
+                    [],
+                    [],
+                    color="w",
+                    ls="",
+                    marker="*",
+                    ms=11,
+                    mec="k",
+                    label="monolithic, unit solver",
+                )
+            )
+        handles.append(Line2D([], [], color="k", ls="-.", lw=1, label="monolithic reference"))
+    elif "solver" in drawn["monolithic"]:
+        handles.append(
             Line2D(
                 [],
                 [],
@@ -249,7 +280,7 @@ def _legend(ax, colours, dashes, markers, work_precision: bool) -> None:
                 ls=(0, (1, 3)),
                 label="solver's own error\n(monolithic, same solver)",
             )
-        ]
+        )
     ax.legend(
         handles=handles,
         loc="center left",
@@ -314,7 +345,7 @@ def _plot_families(ax, study: AccuracyStudy, x_of, y_of, work_precision: bool) -
                     xytext=(4, 4),
                 )
             labelled = True
-    _legend(ax, colours, dashes, markers, work_precision)
+    _legend(ax, colours, dashes, markers, work_precision, study.rows)
 
 
 def plot_work_precision(study: AccuracyStudy, path: Path) -> Path:
@@ -343,6 +374,7 @@ def plot_work_precision(study: AccuracyStudy, path: Path) -> Path:
         textcoords="offset points",
         xytext=(0, 4),
     )
+    log_ticks(ax)
     fig.savefig(path)
     return path
 
@@ -378,6 +410,7 @@ def plot_convergence(study: AccuracyStudy, path: Path) -> Path:
                 fontsize="small",
                 color="0.4",
             )
+    log_ticks(ax)
     fig.savefig(path)
     return path
 

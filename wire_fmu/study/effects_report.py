@@ -9,6 +9,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .log_ticks import log_ticks
 from .tables import write_tables
 
 if TYPE_CHECKING:
@@ -111,9 +112,16 @@ def plot_effects(study: EffectsStudy, path: Path) -> Path:
     left.barh(list(y), [100 * r.saved_share for r in rows], color="C0")
     left.set_xlabel("time saved (% of wall time per simulated second)")
     left.axvline(0.0, color="k", lw=0.8)
-    right.barh(list(y), [max(r.output_change, 1e-16) for r in rows], color="C3")
+    changed = [(i, r.output_change) for i, r in enumerate(rows) if r.output_change > 0.0]
+    right.barh([i for i, _ in changed], [c for _, c in changed], color="C3")
     right.set_xscale("log")
+    if not changed:
+        right.set_xlim(1e-16, 1.0)
     right.set_xlabel("change in key outputs (max |dy| / range)")
+    log_ticks(right, y=False, most=6)
+    for i, r in enumerate(rows):
+        if not r.output_change > 0.0:  # none at all: no bar on a log axis, say so
+            right.annotate("no change", (0.02, i), xycoords=("axes fraction", "data"), va="center")
     left.set_yticks(list(y), labels)
     left.invert_yaxis()
     for ax in (left, right):
