@@ -42,6 +42,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from wire_fmu.master.plot_units import DisplayUnit, display_unit
 from wire_fmu.master.plots import read_results
 
 from .axes import Axis
@@ -353,7 +354,16 @@ def _group_axis(axes: list[Axis], axis: Axis) -> Axis | None:
     return None
 
 
-def _draw_panel(ax, axes: list[Axis], axis: Axis, name: str, rows: list[dict]) -> None:
+def _draw_panel(
+    ax,
+    axes: list[Axis],
+    axis: Axis,
+    name: str,
+    rows: list[dict],
+    shown: tuple[DisplayUnit, DisplayUnit, DisplayUnit | None],
+) -> None:
+    """The figure ``name`` against ``axis`` (x and y in the units ``shown``; a group's too)."""
+    x_unit, y_unit, group_unit = shown
     group = _group_axis(axes, axis)
     connect = axis.is_grid and len(axes) <= (2 if group else 1)
     keys = sorted({r[group.target] for r in rows}, key=_order) if group else [None]
@@ -361,21 +371,51 @@ def _draw_panel(ax, axes: list[Axis], axis: Axis, name: str, rows: list[dict]) -
     for key in keys:
         chosen = [r for r in rows if group is None or r[group.target] == key]
         x = _positions(axis, [r[axis.target] for r in chosen], labels)
-        y = np.asarray([r[name] for r in chosen], dtype=float)
+        x = x if labels else x_unit.show(x)
+        y = y_unit.show(np.asarray([r[name] for r in chosen], dtype=float))
         order = np.argsort(x, kind="stable")
-        label = f"{group.target.rsplit('.', 1)[-1]} = {_short(key)}" if group else None
+        label = _group_label(group, key, group_unit) if group else None
         ax.plot(x[order], y[order], "o-" if connect else "o", ms=4, label=label)
     if labels:
-        ax.set_xticks(range(len(labels)), labels, rotation=30, fontsize="small")
+        ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right", fontsize="small")
     if axis.log_scale:
         ax.set_xscale("log")
-    ax.set_xlabel(axis.target)
+    ax.set_xlabel(_with_unit(_axis_name(axis.target), x_unit), fontsize="small")
     ax.grid(True, alpha=0.3)
     if group:
-        ax.legend(loc="best", fontsize="small")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
 
 
-def plot_summary(rows: list[dict[str, Any]], spec: SweepSpec, directory: Path) -> list[Path]:
+def _axis_name(target: str) -> str:
+    """An axis target as a short name: ``units.cylinder.parameters.x`` -> ``cylinder.x``."""
+    parts = target.split(".")
+    if parts[0] == "units" and len(parts) >= 4 and parts[2] == "parameters":
+        return ".".join([parts[1], *parts[3:]])
+    return target
+
+
+def _with_unit(text: str, shown: DisplayUnit) -> str:
+    return f"{text} ({shown.label})" if shown.label else text
+
+
+def _group_label(group: Axis, key: Any, shown: DisplayUnit | None) -> str:
+    name = group.target.rsplit(".", 1)[-1]
+    if shown is not None and shown.label and isinstance(key, int | float):
+        return f"{name} = {_short(shown.show(key))} {shown.label}"
+    return f"{name} = {_short(key)}"
+
+
+def _display(unit: str, values: list[Any]) -> DisplayUnit:
+    numbers = [abs(v) for v in values if isinstance(v, int | float) and not isinstance(v, bool)]
+    return display_unit(unit, max(numbers, default=float("nan")))
+
+
+def plot_summary(
+    rows: list[dict[str, Any]],
+    spec: SweepSpec,
+    directory: Path,
+    units: Mapping[str, str] | None = None,
+) -> list[Path]:
     """One PNG per key figure: the figure against each swept parameter.
 
     Only finished cases are drawn (the title says how many others there are);
@@ -391,6 +431,10 @@ def plot_summary(rows: list[dict[str, Any]], spec: SweepSpec, directory: Path) -
         The sweep.
     directory : Path
         Where the PNG files go (created).
+    units : mapping of str to str, optional
+        Unit of each axis target and figure column
+        (:func:`~wire_fmu.sweep.units.sweep_units`); values are shown in
+        engineering multiples of them (kN, MPa) and every axis names its unit.
 
     Returns
     -------
@@ -399,6 +443,8 @@ def plot_summary(rows: list[dict[str, Any]], spec: SweepSpec, directory: Path) -
     """
     from matplotlib.figure import Figure
 
+    units = units or {}
+
     directory.mkdir(parents=True, exist_ok=True)
     axes = [a for a in spec.axes if not a.is_grid or len(a.values) > 1] or list(spec.axes)
     written = []
@@ -406,15 +452,25 @@ def plot_summary(rows: list[dict[str, Any]], spec: SweepSpec, directory: Path) -
         done = [r for r in rows if r["status"] == "finished" and r[figure.name] is not None]
         width = min(len(axes), 3)
         height = -(-len(axes) // width)
-        fig = Figure(figsize=(4.5 * width, 3.6 * height), dpi=100, layout="constrained")
+        grouped = any(_group_axis(axes, a) for a in axes)  # legends beside the panels
+        panel_width = 6.2 if grouped else 4.5
+        fig = Figure(figsize=(panel_width * width, 3.6 * height), dpi=100, layout="constrained")
         others = len(rows) - len(done)
         note = f" ({others} of {len(rows)} cases not finished, not shown)" if others else ""
         fig.suptitle(f"{figure.name} = {figure.expression}{note}")
+        y_unit = _display(units.get(figure.column, ""), [r[figure.name] for r in done])
         for i, axis in enumerate(axes):
             ax = fig.add_subplot(height, width, i + 1)
-            ax.set_ylabel(figure.name)
+            ax.set_ylabel(_with_unit(figure.name, y_unit))
+            x_unit = _display(units.get(axis.target, ""), [r[axis.target] for r in done])
+            group = _group_axis(axes, axis)
+            group_unit = (
+                _display(units.get(group.target, ""), [r[group.target] for r in done])
+                if group
+                else None
+            )
             if done:
-                _draw_panel(ax, axes, axis, figure.name, done)
+                _draw_panel(ax, axes, axis, figure.name, done, (x_unit, y_unit, group_unit))
         path = directory / f"{figure.name}.png"
         fig.savefig(path)
         written.append(path)

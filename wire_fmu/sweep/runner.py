@@ -67,6 +67,7 @@ from .cases import Case, apply_case, check_targets, expand, with_figures_recorde
 from .cluster import _check_workers, _client, _run_on_dask
 from .results import DONE_STATUSES, CaseOutcome, ResultStore, plot_summary
 from .spec import SweepSpec, SweepSpecError, load_sweep_spec
+from .units import case_metadata, sweep_units
 from .worker import CaseTask, _describe, _execute_here
 
 __all__ = ["run_sweep", "SweepResult", "ProgressWriter", "scene_key"]
@@ -377,7 +378,11 @@ def run_sweep(
         finished = True
     finally:
         rows = store.consolidate()
-    drawn = plot_summary(rows, spec, store.plots_dir) if plots and finished else []
+    drawn = (
+        plot_summary(rows, spec, store.plots_dir, _units(spec, store, rows))
+        if plots and finished
+        else []
+    )
     result = SweepResult(
         store.directory,
         store.summary_path,
@@ -390,6 +395,14 @@ def run_sweep(
     )
     logger.info("sweep %r: %s in %.3g s", spec.name, result.counts, result.wall_time)
     return result
+
+
+def _units(spec: SweepSpec, store: ResultStore, rows: list[dict[str, Any]]) -> dict[str, str]:
+    """Units of the axes and figure columns, read from a finished case's metadata."""
+    finished = [store.case_dir(r["case_id"]) for r in rows if r.get("status") == "finished"]
+    return sweep_units(
+        [a.target for a in spec.axes], [f.column for f in spec.figures], case_metadata(finished)
+    )
 
 
 class _Sink:
