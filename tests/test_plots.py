@@ -228,3 +228,23 @@ def test_a_results_folder_is_plotted_again_from_its_own_files(tmp_path: Path):
     written = plot_results(tmp_path)
     assert [p.name for p in written] == ["fast_line_tension.png", "brake.png"]
     assert all(p.stat().st_size > 10_000 for p in written)
+
+
+@pytest.mark.parametrize(
+    ("given", "label"),
+    [
+        ("torque (N m)", "torque (kN·m)"),
+        ("torque (N.m)", "torque (kN·m)"),
+        ("speed (N m, motor shaft)", "speed, motor shaft (kN·m)"),
+        ("N.m", "motor drive torque (kN·m)"),
+        ("force (N)", "motor drive torque (kN·m)"),  # another unit's label names another panel
+        ("", "motor drive torque (kN·m)"),
+    ],
+)
+def test_the_scene_s_axis_label_keeps_its_quantity_and_gets_the_unit_shown(given, label):
+    t = np.linspace(0.0, 1.0, 11)
+    data = {"time": t, "full.motor.drive_torque": 2e3 * t}
+    context = PlotContext(units={"full.motor.drive_torque": "N.m"})
+    request = PlotRequest("Torque", ("full.motor.drive_torque",), given)
+    (ax,) = _drawn(plot_figure(request, data, context))
+    assert ax.get_ylabel() == label

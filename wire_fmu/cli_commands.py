@@ -247,8 +247,9 @@ def _report(outcome: Any) -> Path | None:
         return None
     try:
         return write_report(outcome.directory, plots=list(outcome.plots) or None)
-    except (WireFmuError, OSError, ValueError) as exc:
+    except Exception as exc:  # noqa: BLE001 - the run's results stand without their report
         logging.getLogger(__name__).warning("the report could not be written: %s", exc)
+        logging.getLogger(__name__).debug("report failure", exc_info=True)
         return None
 
 

@@ -384,14 +384,27 @@ def _ylabel(given: str, panel: _Panel, shown: DisplayUnit, context: PlotContext)
     """The axis label: the scene's quantity with the unit shown, else the column's name.
 
     The scene's label (``"tension (N)"``; of ``"a ; b"`` the first part) names
-    the panel whose unit it gives, or every panel if it gives none; a label
-    that is only a unit (``"rad/s"``) names nothing.
+    the panel whose unit it gives (``N m`` is ``N.m``; a note after a comma,
+    ``"speed (rad/s, motor shaft)"``, is kept), or every panel if it gives
+    none; a label that is only a unit (``"rad/s"``) names nothing.
     """
     quantity, said = _LABEL.fullmatch((given or "").split(";")[0]).groups()
-    units = (panel.unit, pretty_unit(panel.unit), shown.label)
-    if not quantity or quantity in units or (said is not None and said.strip() not in units):
+    units = {_same(u) for u in (panel.unit, pretty_unit(panel.unit), shown.label)}
+    head, _, note = (said or "").partition(",")
+    if not quantity or _same(quantity) in units or (said is not None and _same(head) not in units):
         quantity = _words(panel.columns[0])
+    elif note.strip():
+        quantity = f"{quantity}, {note.strip()}"
     return f"{quantity} ({shown.label})" if shown.label else quantity
+
+
+_SUPERSCRIPTS = str.maketrans({"²": "2", "³": "3", "⁴": "4", "⁻": "-", "¹": "1", "·": " "})
+
+
+def _same(unit: str) -> str:
+    """A unit made comparable however written: ``N m``, ``N.m``, ``N·m``; ``m^2``, ``m²``."""
+    text = unit.translate(_SUPERSCRIPTS).replace("^", "").replace(".", " ").replace("*", " ")
+    return " ".join(text.split())
 
 
 def _words(column: str) -> str:

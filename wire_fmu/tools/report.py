@@ -205,7 +205,10 @@ def _summary(meta: dict[str, Any], result: dict[str, Any]) -> str:
     rows = [
         ("status", result.get("status", "")),
         ("message", result.get("message") or "-"),
-        ("simulated", f"{_g(result.get('end_time'))} s of {_g(meta['run'].get('stop_time'))} s"),
+        (
+            "simulated",
+            f"{_g(result.get('end_time'))} s of {_g((meta.get('run') or {}).get('stop_time'))} s",
+        ),
         ("wall time", f"{_g(result.get('wall_time'))} s"),
         ("real-time factor", _g(rtf) if rtf is not None else "-"),
         ("steps", _steps(result)),
