@@ -1,0 +1,122 @@
+"""``check`` and ``run`` warn about every setting a scene's effects leave without influence."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from wire_fmu.cli import main
+from wire_fmu.master.run import load_scene_file, shipped_scenes
+from wire_fmu.unit_reference.scene_warnings import inactive_settings
+
+SCENE = """
+name = "warned"
+description = "A hoist whose settings its effects partly ignore."
+
+[run]
+stop_time = 0.05
+step = 0.01
+
+[units.winch]
+fmu = "Winch"
+effects = {winch_effects}
+
+[units.winch.parameters]
+rope_diameter = 0.0381
+brake_friction = 0.35
+
+[units.rope]
+fmu = "BlockTrain"
+effects = {rope_effects}
+
+[units.rope.parameters.reeving]
+rope = {{ axial_stiffness = 5.8e7, damping = 1.2e5, linear_mass = 6.2 }}
+[units.rope.parameters.reeving.bodies]
+block = {{ kind = "block", mass = 1.0e4, position = 10.0, port = "block_a" }}
+[units.rope.parameters.reeving.sheaves]
+crown = {{ centre = [0.0, 30.0, 0.0], radius = 0.5, inertia = 50.0, efficiency = 0.96 }}
+travel = {{ body = "block", centre = [1.0, 10.0, 0.0], radius = 0.5, efficiency = 0.96 }}
+[units.rope.parameters.reeving.anchors]
+dead = {{ point = [1.5, 0.0, 0.0] }}
+[[units.rope.parameters.reeving.path]]
+line_end = "line_a"
+point = [-0.5, 0.0, 0.0]
+[[units.rope.parameters.reeving.path]]
+sheave = "crown"
+wrap = "cw"
+[[units.rope.parameters.reeving.path]]
+sheave = "travel"
+wrap = "ccw"
+[[units.rope.parameters.reeving.path]]
+anchor = "dead"
+
+[[bonds]]
+name = "fast_line"
+ports = "winch.rope <-> rope.line_a"
+
+[[events]]
+time = 0.02
+label = "brake on"
+set = {{ "winch.brake.lever_force" = 500.0 }}
+"""
+
+
+def _scene(tmp_path: Path, winch: list[str], rope: list[str]) -> Path:
+    path = tmp_path / "warned.toml"
+    text = SCENE.format(winch_effects=repr(winch), rope_effects=repr(rope))
+    path.write_text(textwrap.dedent(text).replace("'", '"'), encoding="utf-8")
+    return path
+
+
+def _warnings(tmp_path: Path, winch: list[str], rope: list[str]) -> list[str]:
+    return inactive_settings(load_scene_file(_scene(tmp_path, winch, rope)))
+
+
+def test_every_ignored_setting_is_named_with_its_unit_and_the_effect_it_needs(tmp_path):
+    warnings = _warnings(tmp_path, ["drum_inertia"], [])
+
+    def about(unit: str, what: str) -> str:
+        (found,) = [w for w in warnings if w.startswith(f"unit {unit!r}: ") and what in w]
+        return found
+
+    assert "'rope_layers'" in about("winch", "parameter 'rope_diameter'")
+    assert "'band_brake'" in about("winch", "parameter 'brake_friction'")
+    lever = about("winch", "input 'brake.lever_force'")
+    assert "event 'brake on'" in lever and "'band_brake'" in lever
+    efficiency = about("rope", "'sheaves.<name>.efficiency' (crown, travel)")
+    assert "'bearing_friction' (which needs 'sheave_inertia')" in efficiency
+    assert "'rope_damping'" in about("rope", "'rope.damping'")
+    assert "'sheave_inertia'" in about("rope", "'sheaves.<name>.inertia' (crown)")
+    assert "'rope_slip'" in about("rope", "'rope.linear_mass'")
+    assert len(warnings) == 7
+
+
+def test_a_scene_whose_effects_use_what_it_sets_has_no_warning(tmp_path):
+    winch = ["drum_inertia", "band_brake", "rope_layers"]
+    rope = ["rope_damping", "sheave_inertia", "bearing_friction", "rope_slip"]
+    assert _warnings(tmp_path, winch, rope) == []
+
+
+def test_an_effect_that_silences_an_input_is_named(tmp_path):
+    scene = load_scene_file(_scene(tmp_path, ["drum_inertia", "band_brake"], []))
+    scene.events[0].values.clear()
+    from wire_fmu.master.scene.data import VarRef
+
+    scene.events[0].values[VarRef("winch", "drum.speed_command")] = 1.0
+    (warning,) = [w for w in inactive_settings(scene) if "speed_command" in w]
+    assert "acts only without effect 'drum_inertia'" in warning
+
+
+@pytest.mark.parametrize("name", sorted(shipped_scenes()))
+def test_no_shipped_scene_sets_what_its_effects_ignore(name):
+    assert inactive_settings(load_scene_file(shipped_scenes()[name])) == []
+
+
+def test_check_prints_the_warnings_and_succeeds(tmp_path, capsys):
+    assert main(["check", str(_scene(tmp_path, ["drum_inertia", "band_brake"], []))]) == 0
+    out = capsys.readouterr().out
+    assert "no problems" in out
+    warned = [ln for ln in out.splitlines() if ln.startswith("warning: ")]
+    assert len(warned) == 5 and any(".efficiency'" in ln for ln in warned)
