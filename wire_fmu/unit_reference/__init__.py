@@ -5,15 +5,6 @@ outputs, ports, effects, the fields of structured parameters);
 :mod:`.text` and :mod:`.markdown` write it for the terminal
 (``wire-fmu info UNIT``) and for ``docs/units.md``;
 :mod:`.scene_warnings` finds what a scene sets that its effects leave without
-influence (``wire-fmu check``).
+influence (``wire-fmu check``). Nothing is imported here, so that the command
+line, which registers :mod:`.command`, does not load the physics core to start.
 """
-
-from wire_fmu.unit_reference.catalogue import (
-    Entry,
-    UnitReference,
-    chosen_effects,
-    unit_names,
-    unit_reference,
-)
-
-__all__ = ["Entry", "UnitReference", "chosen_effects", "unit_names", "unit_reference"]
