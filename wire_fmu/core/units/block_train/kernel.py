@@ -43,6 +43,9 @@ index  name                contents
 17-24  friction links      see :mod:`.kernel_friction`
 25     ``jacobian``        the Jacobian's bordered band structure
                            (:func:`.kernel_jacobian.jacobian_structure`)
+26     ``flow_columns``    int, per span: the columns of ``flow`` that are not
+                           zero (at most one per span end), padded with -1
+27     ``flow_values``     per span: those entries of ``flow``
 =====  ==================  ==================================================
 
 ROS2 runs on that structure (:func:`linearise`, :func:`factor`, :func:`solve`): a
@@ -122,6 +125,8 @@ def kernel_data(model) -> tuple:
         model.kernel_geometry_step,
         *friction_data(model),
         model.kernel_jacobian_structure,
+        model.kernel_flow_columns,
+        model.kernel_flow_values,
     )
 
 
@@ -132,6 +137,28 @@ def _matvec(a: np.ndarray, v: np.ndarray) -> np.ndarray:
     for i in range(a.shape[0]):
         for j in range(a.shape[1]):
             out[i] += a[i, j] * v[j]
+    return out
+
+
+@jit
+def _flow_matvec(columns: np.ndarray, values: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``flow @ v`` over the non-zero entries of ``flow`` (the same sums as :func:`_matvec`)."""
+    out = np.zeros(columns.shape[0])
+    for i in range(columns.shape[0]):
+        for k in range(columns.shape[1]):
+            if columns[i, k] >= 0:
+                out[i] += values[i, k] * v[columns[i, k]]
+    return out
+
+
+@jit
+def _flow_vecmat(w: np.ndarray, columns: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """``w @ flow`` over the non-zero entries of ``flow`` (the same sums as :func:`_vecmat`)."""
+    out = np.zeros(size)
+    for i in range(columns.shape[0]):
+        for k in range(columns.shape[1]):
+            if columns[i, k] >= 0:
+                out[columns[i, k]] += w[i] * values[i, k]
     return out
 
 
@@ -164,10 +191,13 @@ def evaluate(t: float, x: np.ndarray, data):
         ``forces`` on the coordinates (N), span ``tension``, ``trial`` tension and
         ``elastic`` tension (N), ``stretch`` (m), ``line_force`` (N), ``body_force`` (N),
         floor ``depth`` (m) and ``trial_contact`` (N), ``span_energy`` (J), ``potential``
-        (J), ``loss`` (W), external ``power`` (W), and ``ok`` (False when a span has no
-        unstretched rope left, or a segment no tangent).
+        (J), ``loss`` (W), external ``power`` (W), ``ok`` (False when a span has no
+        unstretched rope left, or a segment no tangent), the span lengths' Jacobian
+        ``dL/dy`` (spans x bodies, 1), each span's share of ``loss`` (W) and its force
+        on the unstretched rope (N).
     """
-    sizes, rope, masses, len0, jac0, flow, blocks = data[:7]
+    sizes, rope, len0, jac0, blocks = data[0], data[1], data[3], data[4], data[6]
+    flow_columns, flow_values = data[26], data[27]
     offsets, taut, broken, contact, held = data[7:12]
     n, nb, nd = sizes[0], sizes[1], sizes[2]
     ea, damping = rope[0], rope[1]
@@ -196,8 +226,8 @@ def evaluate(t: float, x: np.ndarray, data):
     else:
         big_l, jac, ok = len0 + _matvec(jac0, y), jac0, True
     big_l_rate = _matvec(jac, ydot)
-    small_l = offsets + _matvec(flow, flow_q)
-    small_l_rate = _matvec(flow, flow_v)
+    small_l = offsets + _flow_matvec(flow_columns, flow_values, flow_q)
+    small_l_rate = _flow_matvec(flow_columns, flow_values, flow_v)
     tension = np.zeros(n_spans)
     trial = np.empty(n_spans)
     elastic = np.empty(n_spans)
@@ -232,7 +262,7 @@ def evaluate(t: float, x: np.ndarray, data):
             span_loss[i] = max(-strain_rate, 0.0)
             loss += span_loss[i]
     body_force = -_vecmat(tension, jac)
-    generalised = _vecmat(on_unstretched, flow)
+    generalised = _flow_vecmat(on_unstretched, flow_columns, flow_values, n + N_LINES)
     forces = generalised[:n].copy()
     potential = 0.0
     depth = np.zeros(nb)

@@ -197,6 +197,13 @@ class BlockTrainModel(
                 elif self.nodes[node].kind == "line_end":
                     flow[i, n + LINE_PORTS.index(self.nodes[node].name)] += sign
         self.flow_matrix = flow
+        width = max(1, max((np.count_nonzero(row) for row in flow), default=0))
+        self.kernel_flow_columns = np.full((len(self.spans), width), -1, dtype=np.int64)
+        self.kernel_flow_values = np.zeros((len(self.spans), width))
+        for i, row in enumerate(flow):
+            columns = np.flatnonzero(row)
+            self.kernel_flow_columns[i, : columns.size] = columns
+            self.kernel_flow_values[i, : columns.size] = row[columns]
         self._line_signs = [float(c) for c in self.line_sign]
         self.driver_ports = [b.port for b in self.drivers]
         self.block_weight = np.array(
