@@ -120,3 +120,11 @@ def test_check_prints_the_warnings_and_succeeds(tmp_path, capsys):
     assert "no problems" in out
     warned = [ln for ln in out.splitlines() if ln.startswith("warning: ")]
     assert len(warned) == 5 and any(".efficiency'" in ln for ln in warned)
+
+
+def test_run_prints_the_warnings_before_it_runs(tmp_path, capsys):
+    scene = _scene(tmp_path, ["drum_inertia", "band_brake"], [])
+    assert main(["run", str(scene), "-q", "-o", str(tmp_path / "out"), "--stop-time", "0.02"]) == 0
+    out = capsys.readouterr().out
+    warned = [ln for ln in out.splitlines() if ln.startswith("warning: ")]
+    assert len(warned) == 5 and out.index(warned[-1]) < out.index("scene 'warned'")
