@@ -128,3 +128,12 @@ def test_run_prints_the_warnings_before_it_runs(tmp_path, capsys):
     out = capsys.readouterr().out
     warned = [ln for ln in out.splitlines() if ln.startswith("warning: ")]
     assert len(warned) == 5 and out.index(warned[-1]) < out.index("scene 'warned'")
+
+
+def test_a_setting_equal_to_its_declared_default_asks_for_nothing_and_is_not_warned(tmp_path):
+    path = _scene(tmp_path, ["drum_inertia", "band_brake"], [])
+    text = path.read_text(encoding="utf-8").replace("damping = 1.2e5", "damping = 0.0")
+    path.write_text(text.replace("efficiency = 0.96", "efficiency = 1.0"), encoding="utf-8")
+    warnings = inactive_settings(load_scene_file(path))
+    assert not [w for w in warnings if "damping" in w or "efficiency" in w]
+    assert [w for w in warnings if "'sheaves.<name>.inertia' (crown)" in w]

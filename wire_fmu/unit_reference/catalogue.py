@@ -128,6 +128,8 @@ class Entry:
         A field that must be given.
     tunable : bool
         A parameter that may change during a run.
+    value : Any
+        The default itself (None when there is none).
     """
 
     name: str
@@ -141,6 +143,21 @@ class Entry:
     acts_without: tuple[str, ...] = ()
     required: bool = False
     tunable: bool = False
+    value: Any = None
+
+    def is_default(self, value: Any) -> bool:
+        """Whether ``value`` is the default (numbers compared as numbers).
+
+        Parameters
+        ----------
+        value : Any
+            A value a scene sets.
+        """
+        if self.value is None or isinstance(value, bool) != isinstance(self.value, bool):
+            return False
+        if isinstance(value, int | float) and isinstance(self.value, int | float):
+            return float(value) == float(self.value)
+        return value == self.value
 
     def acts(self, effects: Iterable[str]) -> bool:
         """Whether this has any influence with the effects chosen.
@@ -173,6 +190,7 @@ class Entry:
             var.acts_with,
             var.acts_without,
             tunable=var.variability.value == "tunable",
+            value=None if output else var.start,
         )
 
     @classmethod
@@ -195,6 +213,7 @@ class Entry:
             field.acts_with,
             field.acts_without,
             required=field.required,
+            value=None if field.required else field.default,
         )
 
 

@@ -3,7 +3,9 @@
 A scene may set a parameter, a key of a structured parameter (a sheave's
 ``efficiency`` in a reeving) or an input (by an event, a driver or a
 connection) that acts only with an effect the unit does not include: the
-value is then silently ignored. :func:`inactive_settings` finds each one from
+value is then silently ignored. A value equal to the declared default is not
+reported: the scene asks for nothing the unit does not do.
+:func:`inactive_settings` finds each one from
 the units' declarations (``acts_with``/``acts_without`` on
 :class:`~wire_fmu.core.framework.variables.Variable` and
 :class:`~wire_fmu.core.framework.data_fields.DataField`), naming the unit, the
@@ -50,7 +52,7 @@ def inactive_settings(scene: Scene) -> list[str]:
         effects = frozenset(spec.effects)
         for key, value in spec.parameters.items():
             entry = ref.entry(key)
-            if entry is not None and not entry.acts(effects):
+            if entry is not None and not entry.acts(effects) and not entry.is_default(value):
                 warnings.append(_warning(name, ref, effects, f"parameter {key!r}", entry))
             for field, places in _fields_set(ref.fields.get(key, ()), value):
                 if not field.acts(effects):
@@ -100,12 +102,17 @@ def _inputs_set(scene: Scene, unit: str, ref: UnitReference, effects: frozenset[
 
 
 def _fields_set(fields: Iterable[Entry], value: Any) -> Iterator[tuple[Entry, list[str]]]:
-    """Each declared field that ``value`` (a table, or its JSON text) sets, with where."""
+    """Each declared field that ``value`` (a table, or its JSON text) sets to other than its
+    default, with where."""
     data = _table(value)
     if data is None:
         return
     for field in fields:
-        places = list(_where(data, field.name.split("."), []))
+        places = [
+            where
+            for where, value in _where(data, field.name.split("."), [])
+            if not field.is_default(value)
+        ]
         if places:
             yield field, places
 
@@ -119,11 +126,11 @@ def _table(value: Any) -> Mapping | None:
     return value if isinstance(value, Mapping) else None
 
 
-def _where(data: Any, parts: list[str], at: list[str]) -> Iterator[str]:
-    """Where in ``data`` the dotted ``parts`` are set: the entries (``crown_0``) and nodes
-    (``path[3]``) standing for ``<name>`` and ``[i]``, empty for a fixed key."""
+def _where(data: Any, parts: list[str], at: list[str]) -> Iterator[tuple[str, Any]]:
+    """Where in ``data`` the dotted ``parts`` are set, and to what: the entries (``crown_0``)
+    and nodes (``path[3]``) standing for ``<name>`` and ``[i]``, empty for a fixed key."""
     if not parts:
-        yield "/".join(at)
+        yield "/".join(at), data
         return
     head, rest = parts[0], parts[1:]
     if not isinstance(data, Mapping):
