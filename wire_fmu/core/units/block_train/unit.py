@@ -42,6 +42,7 @@ from wire_fmu.core.framework.unit import (
     output,
     parameter,
 )
+from wire_fmu.core.units.block_train.interface import port_linearisations
 from wire_fmu.core.units.block_train.model import (
     BLOCK_TRAIN_EFFECTS,
     BlockTrainInputs,
@@ -97,6 +98,14 @@ def _variables():
             "Initial rope tension when not set by block equilibrium",
             min=0.0,
         ),
+        parameter(
+            "interface_model",
+            False,
+            "",
+            "Publish each port's effort linearised about the state at the end of every step "
+            "(stiffness, damping, effort_rate), for a flow-side unit to integrate against",
+            type=bool,
+        ),
     )
     inputs = []
     for line in LINE_PORTS:
@@ -123,6 +132,26 @@ def _variables():
         )
         for p in MOVER_PORTS
     ]
+    for p, effort in [*((p, "tension") for p in LINE_PORTS), *((p, "force") for p in MOVER_PORTS)]:
+        outputs += [
+            output(
+                f"{p}.stiffness",
+                "N/m",
+                f"-d {effort} / d position at {p} with the rope's state frozen "
+                "(with interface_model; else 0)",
+            ),
+            output(
+                f"{p}.damping",
+                "N s/m",
+                f"-d {effort} / d velocity at {p} (with interface_model; else 0)",
+            ),
+            output(
+                f"{p}.effort_rate",
+                "N/s",
+                f"d {effort} / d t with {p} held still: the other inputs' share "
+                "(with interface_model; else 0)",
+            ),
+        ]
     for p in BLOCK_PORTS:
         outputs += [
             output(f"{p}.position", "m", f"Position of block {p} along its direction"),
@@ -422,6 +451,11 @@ class BlockTrainUnit(Unit):
             stored - self.initial_energy + out["dissipated_energy"] - out["external_work"]
         )
         out["mode_changes"] = int(m.mode_changes)
+        if self.values["interface_model"]:
+            for name, lin in port_linearisations(m, self.time, m.state).items():
+                out[f"{name}.stiffness"] = lin.stiffness
+                out[f"{name}.damping"] = lin.damping
+                out[f"{name}.effort_rate"] = lin.effort_rate
         if not (math.isfinite(out["stored_energy"]) and math.isfinite(out["tension_max"])):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 

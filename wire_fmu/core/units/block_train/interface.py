@@ -1,0 +1,158 @@
+"""The block train's interface model: each port's effort linearised about the present state.
+
+A unit on the flow side of a bond (the cylinder whose rod carries the moving
+sheaves, the winch paying out the fast line) that integrates its step against the
+rope's *local model* of the effort, instead of a value held over the step, carries
+the stiff rope mode across the bond inside its own implicit solver (issue 17;
+reduced interface models after Peiret, Kovecses et al., 2019). The block train
+offers, per port, at the end of each step:
+
+``stiffness``
+    ``K = -d effort / d position`` (N/m): the rope's spring as the port sees it;
+``damping``
+    ``D = -d effort / d velocity`` (N s/m): its Kelvin-Voigt damper;
+``effort_rate``
+    ``R = d effort / d t`` (N/s) with the port itself held still: how the effort
+    moves with the other inputs (the heave at the rope's far end, a line paid out).
+
+so that ``effort(x, v, t) ~ effort_0 - K (x - x_0) - D (v - v_0) + R (t - t_0)``
+about the port's position ``x_0``, velocity ``v_0`` and the time ``t_0`` of the
+step's end. The derivatives are central differences of the model's own effort
+(:meth:`~wire_fmu.core.units.block_train.model.BlockTrainModel.summary`) with the
+internal state (blocks, sheaves) frozen: the instantaneous stiffness, which is what
+the coupling needs over one step.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+
+from wire_fmu.core.units.block_train.reeving import LINE_PORTS
+
+__all__ = ["PortLinearisation", "port_linearisations"]
+
+RELATIVE_STEP = 1e-6
+"""Differencing step of a position or velocity, relative to ``max(1, |value|)`` (m, m/s)."""
+TIME_STEP = 1e-6
+"""Differencing step of the time, s."""
+
+
+@dataclass(frozen=True)
+class PortLinearisation:
+    """One port's effort linearised about the present state.
+
+    Attributes
+    ----------
+    stiffness : float
+        ``-d effort / d position``, N/m.
+    damping : float
+        ``-d effort / d velocity``, N s/m.
+    effort_rate : float
+        ``d effort / d t`` with the port held still, N/s.
+    """
+
+    stiffness: float
+    damping: float
+    effort_rate: float
+
+
+@dataclass(frozen=True)
+class _Slot:
+    """Where a port sits in the held-input vector, and which output is its effort."""
+
+    position: int
+    rate: int
+    sign: float
+    tension: int | None = None  # span, for a line end
+    body: int | None = None  # body index, for a driven body
+
+
+def _slots(model) -> dict[str, _Slot]:
+    """The ports the reeving uses, by name, with their places in the held-input vector."""
+    n_lines = len(LINE_PORTS)
+    slots = {}
+    for k in (0, model.n_nodes - 1):
+        node = model.nodes[k]
+        if node.kind == "line_end":
+            i = LINE_PORTS.index(node.name)
+            span = 0 if k == 0 else len(model.spans) - 1
+            sign = model.line_sign[i]
+            slots[node.name] = _Slot(1 + i, 1 + n_lines + i, sign, tension=span)
+    nd, nb = len(model.drivers), len(model.blocks)
+    for j, body in enumerate(model.drivers):
+        first = 1 + 2 * n_lines
+        slots[body.port] = _Slot(first + j, first + nd + j, 1.0, body=nb + j)
+    return slots
+
+
+@contextmanager
+def _holding(model, vector: np.ndarray) -> Iterator[None]:
+    """Evaluate with the held-input vector ``vector`` inside the ``with`` block."""
+    t_held, inputs, kept = model._t_step, model.inputs, model.held_vector
+    summary = model._step_summary
+    model._hold(t_held, inputs, vector)
+    try:
+        yield
+    finally:
+        model._hold(t_held, inputs, kept)
+        model._step_summary = summary
+
+
+def _effort(model, slot: _Slot, t: float, x: np.ndarray, vector: np.ndarray) -> float:
+    """The port's effort at ``(t, x)`` with held inputs ``vector``: tension or force, N."""
+    with _holding(model, vector):
+        _, _, tension, body_force = model.summary(t, x.copy())
+    return float(tension[slot.tension] if slot.tension is not None else body_force[slot.body])
+
+
+def _linearise(model, slot: _Slot, t: float, x: np.ndarray) -> PortLinearisation:
+    held = model.held_vector
+    elapsed = t - model._t_step
+    rate = held[slot.rate]
+    # d/d position: the held position moves, so the position at t does too
+    step = RELATIVE_STEP * max(1.0, abs(held[slot.position] + rate * elapsed))
+    up, down = held.copy(), held.copy()
+    up[slot.position] += slot.sign * step
+    down[slot.position] -= slot.sign * step
+    d_position = (_effort(model, slot, t, x, up) - _effort(model, slot, t, x, down)) / (2 * step)
+    # d/d velocity at the same position at t: the held position makes up for the rate
+    step = RELATIVE_STEP * max(1.0, abs(rate))
+    up, down = held.copy(), held.copy()
+    up[slot.rate] += slot.sign * step
+    up[slot.position] -= slot.sign * step * elapsed
+    down[slot.rate] -= slot.sign * step
+    down[slot.position] += slot.sign * step * elapsed
+    d_velocity = (_effort(model, slot, t, x, up) - _effort(model, slot, t, x, down)) / (2 * step)
+    # d/d t with this port still where it is at t
+    still = held.copy()
+    still[slot.position] += rate * elapsed
+    still[slot.rate] = 0.0
+    later = _effort(model, slot, t + TIME_STEP, x, still)
+    earlier = _effort(model, slot, t - TIME_STEP, x, still)
+    return PortLinearisation(
+        stiffness=-d_position, damping=-d_velocity, effort_rate=(later - earlier) / (2 * TIME_STEP)
+    )
+
+
+def port_linearisations(model, t: float, x: np.ndarray) -> dict[str, PortLinearisation]:
+    """Every port's effort linearised at ``(t, x)`` (see the module docstring).
+
+    Parameters
+    ----------
+    model : BlockTrainModel
+        The block train, holding the inputs of its last step.
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State ``[q, v, dissipated, external work]``; left as it is.
+
+    Returns
+    -------
+    dict of str to PortLinearisation
+        By port name (``line_a``, ``mover_a``, ...), for the ports the reeving uses.
+    """
+    return {name: _linearise(model, slot, t, x) for name, slot in _slots(model).items()}
