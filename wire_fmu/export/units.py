@@ -82,6 +82,7 @@ UNITS: dict[str, UnitDefinition] = {
         _u("N", (DisplayUnit("kN", 1e-3),), kg=1, m=1, s=-2),
         _u("kN", factor=1e3, kg=1, m=1, s=-2),
         _u("N.s", kg=1, m=1, s=-1),
+        _u("N/s", (DisplayUnit("kN/s", 1e-3),), kg=1, m=1, s=-3),
         _u("N/m", kg=1, s=-2),
         _u("N.s/m", kg=1, s=-1),
         _u("N.s2/m2", kg=1, m=-1),  # quadratic damping (hydraulic cushion F = c v^2)

@@ -9,14 +9,16 @@ compiled kernel gives plain functions
 ``rhs(t, x, data) -> x'``, ``guards(t, x, data) -> g`` and ``project(x, data) -> x``
 
 over a tuple ``data`` of arrays (parameters, modes, held inputs), the linear
-algebra of ROS2 (the ``dense_*`` functions here, or a structured set of its own such as the block
-train's bordered band), and a cached entry point of its own that calls
-:func:`advance_to_event` with them. The linear algebra is four functions:
+algebra of ROS2 (the ``dense_*`` functions here, or a structured set of its own
+such as the block train's bordered band), and a cached entry point of its own
+that calls :func:`advance_to_event` (dense) or :func:`advance_structured` with
+them. The linear algebra is four functions:
 
 ``linearise(rhs, t, x, data) -> (J, evaluations)``, ``unlinearised(data) -> J``
 (an empty ``J`` of the same type), ``factor(J, g h, data) -> F`` (empty for a NaN
-``g h``) and ``solve(F, b, data) -> (I - g h J)^-1 b``. The
-compiled loop returns at the end of the step or at the first located event;
+``g h``) and ``solve(F, b, data) -> (I - g h J)^-1 b``.
+
+The compiled loop returns at the end of the step or at the first located event;
 :class:`CompiledFixedStep` then lets the Python model switch its mode (and say
 so in words) and calls the loop again. Nothing here allocates per step beyond
 numpy temporaries inside the compiled code.
@@ -51,6 +53,7 @@ __all__ = [
     "STATUS_EVENT",
     "STATUS_NONFINITE",
     "STATUS_PYTHON",
+    "advance_structured",
     "advance_to_event",
     "dense_factor",
     "dense_linearise",
@@ -173,7 +176,32 @@ def _stage_calls(method: int, x: np.ndarray) -> int:
 
 
 @jit_inline
-def advance_to_event(
+def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data):
+    """:func:`advance_structured` with the ``dense_*`` linear algebra (every state
+    differenced, ``I - g h J`` inverted): for the units of a few states."""
+    return advance_structured(
+        rhs,
+        guards,
+        project,
+        dense_linearise,
+        dense_unlinearised,
+        dense_factor,
+        dense_solve,
+        method,
+        t0,
+        t1,
+        n,
+        k,
+        t,
+        x,
+        directions,
+        tol,
+        data,
+    )
+
+
+@jit_inline
+def advance_structured(
     rhs,
     guards,
     project,

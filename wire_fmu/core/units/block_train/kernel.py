@@ -65,7 +65,7 @@ import numpy as np
 
 from wire_fmu.core.framework import bordered_band
 from wire_fmu.core.framework.compiled import jit, jit_inline
-from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_structured
 from wire_fmu.core.units.block_train.kernel_friction import (
     accelerations,
     capacities,
@@ -526,14 +526,14 @@ def solve(fac: tuple, b: np.ndarray, data) -> np.ndarray:
 
 @jit
 def advance(method, t0, t1, n, k, t, x, directions, tol, data):
-    """:func:`~wire_fmu.core.framework.compiled_step.advance_to_event` over this kernel.
+    """:func:`~wire_fmu.core.framework.compiled_step.advance_structured` over this kernel.
 
     Parameters
     ----------
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(
+    return advance_structured(
         rhs,
         guards,
         project,
@@ -604,24 +604,8 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     x = x.copy()
     x[2 * n_coords + 1] += after[9].sum() - before[9].sum()
     x = project(x, new)
-    status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs,
-        guards,
-        project,
-        linearise,
-        unlinearised,
-        factor,
-        solve,
-        method,
-        t0,
-        t1,
-        n,
-        0,
-        t0,
-        x,
-        directions,
-        tol,
-        new,
+    status, x, t, k, fired, steps, calls, h = advance(
+        method, t0, t1, n, 0, t0, x, directions, tol, new
     )
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(t1, x, new)

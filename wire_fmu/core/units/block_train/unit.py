@@ -142,7 +142,7 @@ def _variables():
             ),
             output(
                 f"{p}.damping",
-                "N s/m",
+                "N.s/m",
                 f"-d {effort} / d velocity at {p} (with interface_model; else 0)",
             ),
             output(

@@ -29,13 +29,7 @@ Python.
 from __future__ import annotations
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import (
-    advance_to_event,
-    dense_factor,
-    dense_linearise,
-    dense_solve,
-    dense_unlinearised,
-)
+from wire_fmu.core.framework.compiled_step import advance_to_event
 from wire_fmu.core.units.hydraulics.kernel_arrays import (
     REPORT,
     kernel_data,
@@ -77,22 +71,4 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(
-        rhs,
-        guards,
-        project,
-        dense_linearise,
-        dense_unlinearised,
-        dense_factor,
-        dense_solve,
-        method,
-        t0,
-        t1,
-        n,
-        k,
-        t,
-        x,
-        directions,
-        tol,
-        data,
-    )
+    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)

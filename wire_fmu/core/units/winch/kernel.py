@@ -26,15 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
-from wire_fmu.core.framework.compiled_step import (
-    STATUS_DONE,
-    STATUS_PYTHON,
-    advance_to_event,
-    dense_factor,
-    dense_linearise,
-    dense_solve,
-    dense_unlinearised,
-)
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
 
 __all__ = [
     "HELD",
@@ -258,25 +250,7 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(
-        rhs,
-        guards,
-        project,
-        dense_linearise,
-        dense_unlinearised,
-        dense_factor,
-        dense_solve,
-        method,
-        t0,
-        t1,
-        n,
-        k,
-        t,
-        x,
-        directions,
-        tol,
-        data,
-    )
+    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
 
 
 @jit
@@ -323,23 +297,7 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         data = (modes, inertia, stiffness, damping, held)
         x = project(x, data)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs,
-        guards,
-        project,
-        dense_linearise,
-        dense_unlinearised,
-        dense_factor,
-        dense_solve,
-        method,
-        t0,
-        t1,
-        n,
-        0,
-        t0,
-        x,
-        directions,
-        tol,
-        data,
+        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
     )
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(x, data)
