@@ -25,8 +25,6 @@ the coupling needs over one step.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,29 +87,16 @@ def _slots(model) -> dict[str, _Slot]:
     return slots
 
 
-@contextmanager
-def _holding(model, vector: np.ndarray) -> Iterator[None]:
-    """Evaluate with the held-input vector ``vector`` inside the ``with`` block."""
-    t_held, inputs, kept = model._t_step, model.inputs, model.held_vector
-    summary = model._step_summary
-    model._hold(t_held, inputs, vector)
-    try:
-        yield
-    finally:
-        model._hold(t_held, inputs, kept)
-        model._step_summary = summary
-
-
 def _effort(model, slot: _Slot, t: float, x: np.ndarray, vector: np.ndarray) -> float:
     """The port's effort at ``(t, x)`` with held inputs ``vector``: tension or force, N."""
-    with _holding(model, vector):
+    with model.holding(vector):
         _, _, tension, body_force = model.summary(t, x.copy())
     return float(tension[slot.tension] if slot.tension is not None else body_force[slot.body])
 
 
 def _linearise(model, slot: _Slot, t: float, x: np.ndarray) -> PortLinearisation:
     held = model.held_vector
-    elapsed = t - model._t_step
+    elapsed = t - model.held_vector[0]
     rate = held[slot.rate]
     # d/d position: the held position moves, so the position at t does too
     step = RELATIVE_STEP * max(1.0, abs(held[slot.position] + rate * elapsed))

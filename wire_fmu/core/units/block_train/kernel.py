@@ -322,7 +322,7 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
-    return _rhs_of(evaluate(t, x, data), x, data)
+    return _rhs_of(evaluate(t, x, data), x, data)[0]
 
 
 @jit
@@ -359,21 +359,21 @@ def rhs_parts(t: float, x: np.ndarray, data):
         for j in range(nd):
             p += tension[i] * jac[i, nb + j] * mover_v[j]
         span_power[i] = p
-    link_loss = np.zeros(data[17].shape[0])
-    if link_loss.size:
-        caps = capacities(tension, data)
-        link_force = accelerations(result[0], caps, data[2], data)[1]
-        link_losses(x, n, link_force, link_loss, data)
-    return _rhs_of(result, x, data), tension, result[15], span_power, jac, link_loss
+    out, link_force = _rhs_of(result, x, data)
+    link_loss = np.zeros(link_force.size)
+    link_losses(x, n, link_force, link_loss, data)
+    return out, tension, result[15], span_power, jac, link_loss
 
 
 @jit
-def _rhs_of(result, x: np.ndarray, data) -> np.ndarray:
-    """:func:`rhs` from :func:`evaluate`'s ``result`` at state ``x``."""
+def _rhs_of(result, x: np.ndarray, data):
+    """:func:`rhs` from :func:`evaluate`'s ``result`` at state ``x``, and the link forces
+    (N; none without friction links)."""
     n = data[0][0]
     masses = data[2]
     forces, loss, power = result[0], result[11], result[12]
     out = np.empty_like(x)
+    link_force = np.zeros(0)
     for i in range(n):
         out[i] = x[n + i]
     if data[17].shape[0] == 0:
@@ -391,7 +391,7 @@ def _rhs_of(result, x: np.ndarray, data) -> np.ndarray:
     out[2 * n + 1] = power
     if not result[13]:
         out[:] = math.nan
-    return out
+    return out, link_force
 
 
 @jit

@@ -35,6 +35,8 @@ The equations of motion are Lagrange's with the rope strain energy of
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -246,6 +248,19 @@ class BlockTrainModel(
         self._mover_y0 = vector[movers : movers + len(self.driver_ports)]
         self._mover_v = vector[movers + len(self.driver_ports) :]
 
+    @contextmanager
+    def holding(self, vector: np.ndarray) -> Iterator[None]:
+        """Evaluate with the held-input vector ``vector`` (layout of :meth:`_held`) inside
+        the ``with`` block; the inputs held before come back after it."""
+        t_held, inputs, kept = self._t_step, self.inputs, self.held_vector
+        summary = self._step_summary
+        self._hold(t_held, inputs, vector)
+        try:
+            yield
+        finally:
+            self._hold(t_held, inputs, kept)
+            self._step_summary = summary
+
     def span_lengths(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Geometric span lengths (m) and their Jacobian w.r.t. body motion.
 
@@ -395,7 +410,7 @@ class BlockTrainModel(
         """
         if self.compiled:
             return kernel.rhs(t, x, self.kernel_data())
-        return self._rhs_of(x, self.evaluate(t, x))
+        return self._rhs_of(x, self.evaluate(t, x))[0]
 
     def rhs_parts(self, t: float, x: np.ndarray) -> tuple:
         """:meth:`rhs` and the local pieces its coupled rows are sums of, from one
@@ -431,8 +446,7 @@ class BlockTrainModel(
             for j, velocity in enumerate(self._mover_v):
                 p += tension[i] * dl_dy[i, nb + j] * velocity
             span_power[i] = p
-        caps = self._capacities(tension)
-        _, link_force = self.friction.accelerations(ev["forces"], caps)
+        out, link_force = self._rhs_of(x, ev)
         v = x[n : 2 * n]
         link_loss = np.array(
             [
@@ -441,10 +455,11 @@ class BlockTrainModel(
             ]
         )
         span_loss = ev["rope"].loss_power * intact
-        return self._rhs_of(x, ev), tension, span_loss, span_power, dl_dy, link_loss
+        return out, tension, span_loss, span_power, dl_dy, link_loss
 
-    def _rhs_of(self, x: np.ndarray, ev: dict) -> np.ndarray:
-        """:meth:`rhs` from the Python kernel's evaluation ``ev`` at state ``x``."""
+    def _rhs_of(self, x: np.ndarray, ev: dict) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`rhs` from the Python kernel's evaluation ``ev`` at state ``x``, and the
+        friction links' forces (N)."""
         n = self.n_coords
         v = x[n : 2 * n]
         out = np.empty_like(x)
@@ -456,7 +471,7 @@ class BlockTrainModel(
             out[self.friction.stuck_to_ground()] = 0.0
         out[2 * n] = ev["loss"] + self.friction.loss_power(v, link_force)
         out[2 * n + 1] = self._external_power(ev)
-        return out
+        return out, link_force
 
     # -------------------------------------------------------------- stepping
     def advance(
