@@ -183,7 +183,8 @@ def vendor_annotations(ports: Iterable[Port]) -> ET.Element:
     xml.etree.ElementTree.Element
         ``<VendorAnnotations><Tool name="wire_fmu"><Ports><Port .../>...``, one ``Port``
         element per port with the attributes ``name``, ``kind``, ``side``, ``effort``,
-        ``flow``, ``description`` and (when the port has one) ``position``.
+        ``flow``, ``description``, (when the port has one) ``position`` and (when it
+        carries the interface model) ``interface="true"`` and its ``interface_switch``.
     """
     annotations = ET.Element("VendorAnnotations")
     tool = ET.SubElement(annotations, "Tool", name=PORTS_TOOL)
@@ -199,6 +200,10 @@ def vendor_annotations(ports: Iterable[Port]) -> ET.Element:
         if port.position:
             attrs["position"] = port.position
         attrs["description"] = port.description
+        if port.interface:
+            attrs["interface"] = "true"
+        if port.interface_switch:
+            attrs["interface_switch"] = port.interface_switch
         ET.SubElement(section, "Port", attrs)
     return annotations
 

@@ -61,6 +61,11 @@ class PortDeclaration:
         Name of its position variable, if it has one.
     description : str
         What the port is.
+    interface : bool
+        Whether the port carries the interface model
+        (:data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` as ``{port}.{quantity}``).
+    interface_switch : str or None
+        The effort side's Boolean parameter that turns the interface model on.
     """
 
     name: str
@@ -70,6 +75,8 @@ class PortDeclaration:
     flow: str
     position: str | None = None
     description: str = ""
+    interface: bool = False
+    interface_switch: str | None = None
 
 
 @dataclass(frozen=True)
@@ -151,6 +158,8 @@ def _declaration(attrs: dict[str, str]) -> PortDeclaration:
         attrs["flow"],
         attrs.get("position") or None,
         attrs.get("description", ""),
+        attrs.get("interface") == "true",
+        attrs.get("interface_switch") or None,
     )
 
 

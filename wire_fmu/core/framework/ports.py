@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
-__all__ = ["PORT_KINDS", "Port", "PortSide", "port"]
+__all__ = ["INTERFACE_QUANTITIES", "INTERFACE_UNITS", "PORT_KINDS", "Port", "PortSide", "port"]
 
 PORT_KINDS = {
     # kind: (effort unit, flow unit, position unit)
@@ -27,6 +27,27 @@ PORT_KINDS = {
     "rotational": ("N.m", "rad/s", "rad"),
 }
 """Kinds of power port and the SI units of their effort, flow and position."""
+
+INTERFACE_QUANTITIES = (
+    "stiffness",
+    "damping",
+    "effort_rate",
+    "reference_position",
+    "reference_velocity",
+)
+"""The interface model of a port's effort, as ``{port}.{quantity}`` variables.
+
+``effort(x, v, t) ~ effort - stiffness (x - reference_position)
+- damping (v - reference_velocity) + effort_rate (t - t0)`` about the communication
+point ``t0``: outputs of the effort side, inputs of a flow side that integrates its
+step against this local model instead of a held effort.
+"""
+INTERFACE_UNITS = {
+    "translational": ("N/m", "N.s/m", "N/s", "m", "m/s"),
+    "rope": ("N/m", "N.s/m", "N/s", "m", "m/s"),
+    "rotational": ("N.m/rad", "N.m.s/rad", "N.m/s", "rad", "rad/s"),
+}
+"""SI units of the :data:`INTERFACE_QUANTITIES` by port kind."""
 
 
 class PortSide(StrEnum):
@@ -56,6 +77,12 @@ class Port:
         Name of the position variable the flow integrates to, if any.
     description : str
         What the port is, for listings.
+    interface : bool
+        Whether the port carries the interface model (:data:`INTERFACE_QUANTITIES`):
+        outputs on the effort side, inputs on the flow side.
+    interface_switch : str or None
+        On the effort side, the Boolean parameter that turns the interface model's
+        computation on (the master sets it when it wires the model).
     """
 
     name: str
@@ -65,11 +92,20 @@ class Port:
     flow: str
     position: str | None = None
     description: str = ""
+    interface: bool = False
+    interface_switch: str | None = None
 
     @property
     def variables(self) -> tuple[str, ...]:
         """The port's variable names: effort, flow and (if any) position."""
         return (self.effort, self.flow) + ((self.position,) if self.position else ())
+
+    @property
+    def interface_variables(self) -> dict[str, str]:
+        """Variable name of each interface quantity by quantity (empty without a model)."""
+        if not self.interface:
+            return {}
+        return {q: f"{self.name}.{q}" for q in INTERFACE_QUANTITIES}
 
     def problems(self, causality: dict[str, str], units: dict[str, str]) -> list[str]:
         """What is wrong with the port against its unit's variables (empty when sound).
@@ -88,12 +124,27 @@ class Port:
         wanted = {self.effort: gives, self.flow: takes}
         if self.position:
             wanted[self.position] = takes
+        expected = list(zip(wanted.items(), PORT_KINDS[self.kind], strict=False))
+        if self.interface:
+            units_wanted = INTERFACE_UNITS[self.kind]
+            names = self.interface_variables.values()
+            expected += [((n, gives), u) for n, u in zip(names, units_wanted, strict=True)]
         problems = []
-        for (name, want), unit in zip(wanted.items(), PORT_KINDS[self.kind], strict=False):
+        for (name, want), unit in expected:
             if causality.get(name) != want:
                 problems.append(f"port {self.name!r}: {name!r} must be an {want} of the unit")
             elif units.get(name) != unit:
                 problems.append(f"port {self.name!r}: {name!r} must be in {unit}")
+        if self.interface_switch and (not self.interface or self.side is not PortSide.effort):
+            problems.append(
+                f"port {self.name!r}: an interface switch belongs to an effort-side port "
+                "with an interface model"
+            )
+        elif self.interface_switch and causality.get(self.interface_switch) != "parameter":
+            problems.append(
+                f"port {self.name!r}: interface switch {self.interface_switch!r} must be a "
+                "parameter of the unit"
+            )
         return problems
 
 
@@ -105,6 +156,8 @@ def port(
     flow: str,
     position: str | None = None,
     description: str = "",
+    interface: bool = False,
+    interface_switch: str | None = None,
 ) -> Port:
     """A :class:`Port` whose variable names without a dot are taken under the port's name.
 
@@ -114,7 +167,7 @@ def port(
 
     Parameters
     ----------
-    name, kind, side, effort, flow, position, description
+    name, kind, side, effort, flow, position, description, interface, interface_switch
         As for :class:`Port`; ``effort``, ``flow`` and ``position`` may be short names.
     """
 
@@ -128,4 +181,14 @@ def port(
         """
         return variable if variable is None or "." in variable else f"{name}.{variable}"
 
-    return Port(name, kind, side, full(effort), full(flow), full(position), description)
+    return Port(
+        name,
+        kind,
+        side,
+        full(effort),
+        full(flow),
+        full(position),
+        description,
+        interface,
+        interface_switch,
+    )
