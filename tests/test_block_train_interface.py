@@ -10,12 +10,23 @@ tensioner's rod carries 4 parts (``J = 4``): the figure its scene states,
 
 from __future__ import annotations
 
+from xml.etree import ElementTree as ET
+
 import numpy as np
 import pytest
 
-from wire_fmu.core.units.block_train.reevings import drilling_block_train, riser_tensioner
+from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS
+from wire_fmu.core.units.block_train.interface import port_linearisations
+from wire_fmu.core.units.block_train.reevings import (
+    drilling_block_train,
+    riser_tensioner,
+    single_fall,
+)
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
+from wire_fmu.export.model_description import patch_model_description
 
 from .block_train_helpers import make_unit
+from .facade_checks import load_facade_class
 
 RING_SPEED = 0.5  # m/s, the riser's ring moving along its direction (down)
 
@@ -88,3 +99,102 @@ def test_linearisation_leaves_the_step_untouched():
         assert unit.advance(1e-4, 1e-3).success
     assert with_model.values["mover_a.force"] == without.values["mover_a.force"]
     np.testing.assert_array_equal(with_model.model.state, without.model.state)
+
+
+# -- the reference point ------------------------------------------------------------
+STEP = 1e-3  # s
+
+
+def reversed_fall():
+    """One vertical rope from a hanging block up to ``line_b``, the path's last node: a line
+    end whose payout runs against the path (held with the sign -1)."""
+    reeving = single_fall()
+    top = {"line_end": "line_b", "point": [0.0, 10.0, 0.0]}
+    reeving["path"] = [{"anchor": "hook"}, top]
+    return reeving
+
+
+def stepped(unit, inputs: dict[str, float]):
+    """``unit`` with ``inputs`` set, after one step of :data:`STEP` from 0."""
+    unit.values.update(inputs)
+    result = unit.advance(0.0, STEP)
+    assert result.success, result.message
+    return unit
+
+
+@pytest.mark.parametrize(
+    ("reeving", "port", "position", "velocity"),
+    [
+        (riser_tensioner, "mover_a", "position", "velocity"),
+        (riser_tensioner, "mover_b", "position", "velocity"),
+        (reversed_fall, "line_b", "payout", "payout_rate"),
+        (lambda: drilling_block_train(4), "line_a", "payout", "payout_rate"),
+    ],
+)
+def test_the_reference_is_the_port_motion_held_to_the_step_end(reeving, port, position, velocity):
+    """``reference_position`` is the port's own position input moved on by its rate over the
+    step (what the flow side will connect), ``reference_velocity`` its rate; and at that point
+    the effort is the one published, with the published stiffness about it."""
+    unit = make_unit(reeving(), "rope_damping", interface_model=True)
+    held = {f"{port}.{position}": 1e-3, f"{port}.{velocity}": -0.03}
+    stepped(unit, held)
+    values = dict(unit.values)
+    reference = held[f"{port}.{position}"] + held[f"{port}.{velocity}"] * STEP
+    assert values[f"{port}.reference_position"] == pytest.approx(reference, rel=1e-12)
+    assert values[f"{port}.reference_velocity"] == held[f"{port}.{velocity}"]
+    effort = "tension" if port.startswith("line") else "force"
+    e0, stiffness = values[f"{port}.{effort}"], values[f"{port}.stiffness"]
+    assert stiffness > 0.0
+
+    def effort_at(moved: float) -> float:
+        """The effort with the port's inputs at the reference, moved by ``moved`` (m)."""
+        unit.values[f"{port}.{position}"] = values[f"{port}.reference_position"] + moved
+        unit.values[f"{port}.{velocity}"] = values[f"{port}.reference_velocity"]
+        unit.evaluate_outputs()
+        return unit.values[f"{port}.{effort}"]
+
+    assert effort_at(0.0) == pytest.approx(e0, rel=1e-9)
+    moved = 1e-5  # m
+    assert effort_at(moved) - e0 == pytest.approx(-stiffness * moved, rel=1e-4)
+
+
+def test_without_the_interface_model_the_reference_is_not_published():
+    """Off: the reference outputs stay 0 whatever the port's motion."""
+    unit = make_unit(riser_tensioner(), "rope_damping", interface_model=False)
+    stepped(unit, {"mover_a.position": 0.01, "mover_a.velocity": 0.2})
+    assert unit.values["mover_a.reference_position"] == 0.0
+    assert unit.values["mover_a.reference_velocity"] == 0.0
+
+
+def test_the_linearisation_carries_its_reference_point():
+    """``port_linearisations`` gives the reference with the derivatives, port by port."""
+    unit = make_unit(riser_tensioner(), "rope_damping", interface_model=True)
+    stepped(unit, {"mover_b.position": -0.02, "mover_b.velocity": RING_SPEED})
+    model = unit.model
+    lins = port_linearisations(model, unit.time, model.state)
+    assert set(lins) == {"mover_a", "mover_b"}
+    ring = lins["mover_b"]
+    assert ring.reference_position == pytest.approx(-0.02 + RING_SPEED * STEP, rel=1e-12)
+    assert ring.reference_velocity == RING_SPEED
+    assert (lins["mover_a"].reference_position, lins["mover_a"].reference_velocity) == (0.0, 0.0)
+
+
+def test_every_port_declares_its_interface_model_and_its_switch():
+    """The framework's check passes; the built model description marks each port as carrying
+    the interface model switched by ``interface_model``, its outputs declared in their units."""
+    assert BlockTrainUnit.check_declarations() == []
+    facade = load_facade_class("block_train", "BlockTrain")(instance_name="xml", resources=None)
+    raw = ET.tostring(facade.to_xml(), encoding="UTF-8")
+    root = ET.fromstring(patch_model_description(raw, BlockTrainUnit, "test"))
+    ports = root.findall("VendorAnnotations/Tool/Ports/Port")
+    assert {p.get("name") for p in ports} == {"line_a", "line_b", "mover_a", "mover_b"}
+    variables = {v.get("name"): v for v in root.find("ModelVariables")}
+    for element in ports:
+        assert element.get("interface") == "true"
+        assert element.get("interface_switch") == "interface_model"
+        kind = element.get("kind")
+        for quantity, unit in zip(INTERFACE_QUANTITIES, INTERFACE_UNITS[kind], strict=True):
+            variable = variables[f"{element.get('name')}.{quantity}"]
+            assert variable.get("causality") == "output"
+            assert variable.find("Real").get("unit") == unit
+    assert variables["interface_model"].get("causality") == "parameter"

@@ -13,11 +13,17 @@ offers, per port, at the end of each step:
     ``D = -d effort / d velocity`` (N s/m): its Kelvin-Voigt damper;
 ``effort_rate``
     ``R = d effort / d t`` (N/s) with the port itself held still: how the effort
-    moves with the other inputs (the heave at the rope's far end, a line paid out).
+    moves with the other inputs (the heave at the rope's far end, a line paid out);
+``reference_position``, ``reference_velocity``
+    ``x_0`` (m) and ``v_0`` (m/s): the port's position and velocity the effort and
+    its derivatives were taken at, in the port's own variables (``payout`` and
+    ``payout_rate`` of a line end, ``position`` and ``velocity`` of a driven body):
+    the held input extrapolated to the step's end, which is where the flow side's
+    own position is only to the extent that the extrapolation was right,
 
 so that ``effort(x, v, t) ~ effort_0 - K (x - x_0) - D (v - v_0) + R (t - t_0)``
-about the port's position ``x_0``, velocity ``v_0`` and the time ``t_0`` of the
-step's end. The derivatives are central differences of the model's own effort
+about the time ``t_0`` of the step's end. The derivatives are central differences of
+the model's own effort
 (:meth:`~wire_fmu.core.units.block_train.model.BlockTrainModel.summary`) with the
 internal state (blocks, sheaves) frozen: the instantaneous stiffness, which is what
 the coupling needs over one step.
@@ -51,11 +57,18 @@ class PortLinearisation:
         ``-d effort / d velocity``, N s/m.
     effort_rate : float
         ``d effort / d t`` with the port held still, N/s.
+    reference_position : float
+        The port's position the effort was linearised at, in its own variable
+        (``payout`` or ``position``), m.
+    reference_velocity : float
+        The port's velocity there (``payout_rate`` or ``velocity``), m/s.
     """
 
     stiffness: float
     damping: float
     effort_rate: float
+    reference_position: float
+    reference_velocity: float
 
 
 @dataclass(frozen=True)
@@ -64,7 +77,7 @@ class _Slot:
 
     position: int
     rate: int
-    sign: float
+    sign: float  # held value = sign * the port's own variable (a line's payout)
     tension: int | None = None  # span, for a line end
     body: int | None = None  # body index, for a driven body
 
@@ -94,12 +107,20 @@ def _effort(model, slot: _Slot, t: float, x: np.ndarray, vector: np.ndarray) -> 
     return float(tension[slot.tension] if slot.tension is not None else body_force[slot.body])
 
 
+def _reference(held: np.ndarray, slot: _Slot, elapsed: float) -> tuple[float, float]:
+    """The port's position (m) and velocity (m/s) at ``elapsed`` (s) into the held step,
+    in the port's own variables (a held line payout is signed, see :class:`_Slot`)."""
+    rate = held[slot.rate]
+    return slot.sign * (held[slot.position] + rate * elapsed), slot.sign * rate
+
+
 def _linearise(model, slot: _Slot, t: float, x: np.ndarray) -> PortLinearisation:
     held = model.held_vector
     elapsed = t - model.held_vector[0]
     rate = held[slot.rate]
+    position, velocity = _reference(held, slot, elapsed)
     # d/d position: the held position moves, so the position at t does too
-    step = RELATIVE_STEP * max(1.0, abs(held[slot.position] + rate * elapsed))
+    step = RELATIVE_STEP * max(1.0, abs(position))
     up, down = held.copy(), held.copy()
     up[slot.position] += slot.sign * step
     down[slot.position] -= slot.sign * step
@@ -119,7 +140,11 @@ def _linearise(model, slot: _Slot, t: float, x: np.ndarray) -> PortLinearisation
     later = _effort(model, slot, t + TIME_STEP, x, still)
     earlier = _effort(model, slot, t - TIME_STEP, x, still)
     return PortLinearisation(
-        stiffness=-d_position, damping=-d_velocity, effort_rate=(later - earlier) / (2 * TIME_STEP)
+        stiffness=-d_position,
+        damping=-d_velocity,
+        effort_rate=(later - earlier) / (2 * TIME_STEP),
+        reference_position=position,
+        reference_velocity=velocity,
     )
 
 

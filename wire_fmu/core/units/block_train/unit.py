@@ -103,7 +103,9 @@ def _variables():
             False,
             "",
             "Publish each port's effort linearised about the state at the end of every step "
-            "(stiffness, damping, effort_rate), for a flow-side unit to integrate against",
+            "(stiffness, damping, effort_rate) and the port motion it was taken at "
+            "(reference_position, reference_velocity), for a flow-side unit to integrate "
+            "against",
             type=bool,
         ),
     )
@@ -132,7 +134,11 @@ def _variables():
         )
         for p in MOVER_PORTS
     ]
-    for p, effort in [*((p, "tension") for p in LINE_PORTS), *((p, "force") for p in MOVER_PORTS)]:
+    interface_ports = [
+        *((p, "tension", "payout", "payout_rate") for p in LINE_PORTS),
+        *((p, "force", "position", "velocity") for p in MOVER_PORTS),
+    ]
+    for p, effort, position, velocity in interface_ports:
         outputs += [
             output(
                 f"{p}.stiffness",
@@ -150,6 +156,17 @@ def _variables():
                 "N/s",
                 f"d {effort} / d t with {p} held still: the other inputs' share "
                 "(with interface_model; else 0)",
+            ),
+            output(
+                f"{p}.reference_position",
+                "m",
+                f"{position} at {p} the {effort} was linearised at: the held input at the "
+                "step's end (with interface_model; else 0)",
+            ),
+            output(
+                f"{p}.reference_velocity",
+                "m/s",
+                f"{velocity} at {p} the {effort} was linearised at (with interface_model; else 0)",
             ),
         ]
     for p in BLOCK_PORTS:
@@ -189,6 +206,10 @@ def _variables():
     return params + tuple(inputs) + tuple(outputs)
 
 
+_INTERFACE = {"interface": True, "interface_switch": "interface_model"}
+"""Every port publishes its interface model when the parameter ``interface_model`` is set."""
+
+
 class BlockTrainUnit(Unit):
     """Rope reeved over sheaves on fixed and moving blocks (SPEC sections 2-6)."""
 
@@ -197,9 +218,12 @@ class BlockTrainUnit(Unit):
     VARIABLES = _variables()
     DATA_FIELDS = MappingProxyType({"reeving": REEVING_FIELDS})
     PORTS = (
-        *(port(n, "rope", PortSide.effort, "tension", "payout_rate", "payout") for n in LINE_PORTS),
         *(
-            port(n, "translational", PortSide.effort, "force", "velocity", "position")
+            port(n, "rope", PortSide.effort, "tension", "payout_rate", "payout", **_INTERFACE)
+            for n in LINE_PORTS
+        ),
+        *(
+            port(n, "translational", PortSide.effort, "force", "velocity", "position", **_INTERFACE)
             for n in MOVER_PORTS
         ),
     )
@@ -456,6 +480,8 @@ class BlockTrainUnit(Unit):
                 out[f"{name}.stiffness"] = lin.stiffness
                 out[f"{name}.damping"] = lin.damping
                 out[f"{name}.effort_rate"] = lin.effort_rate
+                out[f"{name}.reference_position"] = lin.reference_position
+                out[f"{name}.reference_velocity"] = lin.reference_velocity
         if not (math.isfinite(out["stored_energy"]) and math.isfinite(out["tension_max"])):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
