@@ -116,6 +116,7 @@ class Slave(NamedValues):
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
         self._c_arrays: dict[tuple[str, tuple[int, ...]], tuple[Any, Any, int]] = {}
+        self._natives: dict[str, Any] = {}
         self._fatal = False
         self._unzipdir: str | None = None
 
@@ -176,6 +177,7 @@ class Slave(NamedValues):
             unzipdir = self._unzipdir
         cwd = os.getcwd()
         try:
+            self._natives.clear()
             self._fmu = FMU2Slave(
                 guid=md.guid,
                 unzipDirectory=unzipdir,
@@ -231,6 +233,7 @@ class Slave(NamedValues):
         if self._fatal:  # FMI 2.0: after fmi2Fatal no further call is allowed
             _KEEP_ALIVE.append(fmu)
             self._fmu = None
+            self._natives.clear()
             self._remove_unzipdir()
             return
         for name, call in (
@@ -243,6 +246,7 @@ class Slave(NamedValues):
                 logger.debug("%s: %s failed during cleanup: %s", self.name, name, exc)
         _KEEP_ALIVE.append(fmu)  # keep the library (and its handle) alive
         self._fmu = None
+        self._natives.clear()
         self._remove_unzipdir()  # the loaded library stays mapped; its files can go
 
     # -- values ------------------------------------------------------------------
@@ -273,7 +277,7 @@ class Slave(NamedValues):
             n = len(refs)
             arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), (ctype * n)(), n)
         vrs, values, n = arrays
-        self._invoke(_GETTERS[kind], getattr(fmu, f"fmi2Get{kind}"), fmu.component, vrs, n, values)
+        self._invoke(_GETTERS[kind], self._native(f"fmi2Get{kind}"), fmu.component, vrs, n, values)
         return list(values)
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
@@ -297,7 +301,9 @@ class Slave(NamedValues):
             n = len(refs)
             arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), None, n)
         vrs, _, n = arrays
-        self._invoke("setReal", fmu.fmi2SetReal, fmu.component, vrs, n, (fmi2Real * n)(*values))
+        self._invoke(
+            "setReal", self._native("fmi2SetReal"), fmu.component, vrs, n, (fmi2Real * n)(*values)
+        )
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:
         """Fast path: get Reals by value reference.
@@ -333,8 +339,11 @@ class Slave(NamedValues):
             On fmi2Error or fmi2Fatal.
         """
         self.messages.kept.clear()
-        try:
-            self._call("doStep", t, h)  # currentCommunicationPoint, communicationStepSize
+        fmu = self._fmu
+        if fmu is None:
+            raise UnitFailedError(f"unit {self.name!r} is not instantiated", self.name)
+        try:  # currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint
+            self._invoke("doStep", self._native("fmi2DoStep"), fmu.component, t, h, 1)
         except FMICallException as exc:
             self._fatal = self._fatal or exc.status == 4
             said = "; ".join(self.messages.kept[-3:]) or "no message"
@@ -372,6 +381,37 @@ class Slave(NamedValues):
             A state from :meth:`get_state`; not used again.
         """
         self._call("freeFMUstate", state)
+
+    def _native(self, function: str) -> Any:
+        """The FMU's C function ``function``, called without fmpy's wrapper (status checked).
+
+        fmpy's wrapper around each call (a method, its ``_call`` and the optional call
+        logger, which the master does not use) costs about as much as the call
+        itself for the three calls every macro step makes per unit: ``fmi2DoStep``,
+        ``fmi2SetReal`` and ``fmi2Get{Real,Integer}``. The C function with fmpy's
+        argument and result types, and a check that raises
+        :class:`~fmpy.fmi1.FMICallException` as fmpy's wrapper does, is kept here.
+
+        Parameters
+        ----------
+        function : str
+            An FMI 2.0 function name the FMU exports (``"fmi2DoStep"``).
+        """
+        checked = self._natives.get(function)
+        if checked is None:
+            c_functions = getattr(self._fmu, "_functions", None)  # typed by fmpy at load
+            if not isinstance(c_functions, dict) or function not in c_functions:
+                return getattr(self._fmu, function)  # an fmpy without them: its wrapper
+            c_function = c_functions[function]
+
+            def checked(*args, _f=c_function, _name=function):
+                status = _f(*args)
+                if status > 1:  # worse than fmi2Warning
+                    raise FMICallException(function=_name, status=status)
+                return status
+
+            self._natives[function] = checked
+        return checked
 
     def _call(self, fn: str, *args, **kwargs):
         fmu = self._fmu
