@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from wire_fmu.core.framework.step_limits import (
     MAX_EVENTS_PER_STEP,
@@ -52,6 +51,8 @@ class ScipySolver:
         t1 : float
             End time, s.
         """
+        from scipy.integrate import solve_ivp  # here: most runs never need it (0.1 s to import)
+
         internal_steps(t0, t1, self.settings.max_step)
         tol = self.settings.event_time_tolerance
         t, x = t0, np.array(x0, dtype=float)
