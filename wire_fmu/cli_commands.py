@@ -134,7 +134,8 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a scene and initialise its units as a run would; exit 1 listing every problem.
 
-    Settings the scene's effects leave without influence are warnings (exit 0).
+    Settings the scene's effects leave without influence, and bonds that cannot give the
+    interface model ``run.interface_models`` asks for, are warnings (exit 0).
 
     Parameters
     ----------
@@ -147,14 +148,17 @@ def cmd_check(args: argparse.Namespace) -> int:
         Exit status: 0 on success.
     """
     from wire_fmu.master.run import check_scene
+    from wire_fmu.master.scene import interface_warnings
     from wire_fmu.unit_reference.scene_warnings import inactive_settings
 
     scene = check_scene(args.scene, args.fmu_dir)
+    wired = len(scene.interface_bonds)
+    bonds = plural(len(scene.bonds), "bond") + (f" ({wired} with interface model)" if wired else "")
     _print(
         f"scene {scene.name!r}: no problems ({plural(len(scene.units), 'unit')}, "
-        f"{plural(len(scene.bonds), 'bond')}, {plural(len(scene.connections), 'connection')})"
+        f"{bonds}, {plural(len(scene.connections), 'connection')})"
     )
-    for warning in inactive_settings(scene):
+    for warning in inactive_settings(scene) + interface_warnings(scene):
         _print(f"warning: {warning}")
     return 0
 

@@ -33,6 +33,11 @@ Mapping
   ``AngularDisplacement`` or ``Volume`` groups. libcosim pairs the nested
   groups by position and connects each pair output to input, so effort
   goes one way and flow the other, as in the scene.
+* A bond whose interface model is wired adds the model's five links
+  (stiffness, damping, effort rate, reference position and velocity, effort
+  side to flow side) as ``VariableConnection`` elements after its groups:
+  OSP-IS has no variable group for them. The effort unit's switch parameter
+  is an ``InitialValue`` like any other.
 * Plain connections (and the generated signals unit's) are
   ``VariableConnection`` elements.
 * ``UnitDefinitions`` of each model description give every unit its SI
@@ -51,7 +56,7 @@ from pathlib import Path
 from lxml import etree
 
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
-from wire_fmu.master.scene import Bond, Scene, VarRef
+from wire_fmu.master.scene import INTERFACE_ROLE, Bond, Scene, VarRef
 
 from .plan import ExportPlan, archive_names, plan_export
 
@@ -248,6 +253,21 @@ def _connections(root: etree._Element, plan: ExportPlan) -> None:
                 element = _el(connections, OSP_NS, "VariableGroupConnection")
                 for unit in (a, b):
                     _endpoint(element, "VariableGroup", VarRef(unit, by_end[(unit, key)].name))
+        _interface_connections(connections, bond)
+
+
+def _interface_connections(connections: etree._Element, bond: Bond) -> None:
+    """The bond's wired interface model: one ``VariableConnection`` per link, after a note."""
+    links = [c for c in bond.connections if c.role == INTERFACE_ROLE]
+    if not links:
+        return
+    connections.append(
+        etree.Comment(f" interface model of bond {bond.name!r}: held over each step ")
+    )
+    for c in links:
+        element = _el(connections, OSP_NS, "VariableConnection")
+        _endpoint(element, "Variable", c.source)
+        _endpoint(element, "Variable", c.target)
 
 
 def system_structure_tree(

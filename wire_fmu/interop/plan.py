@@ -11,7 +11,10 @@ OSP know no time signals. The SSP and OSP writers only serialise an
 What another tool cannot be told (and is therefore logged as a warning):
 the coupling algorithm (libcosim's fixed-step algorithm is Jacobi with
 inputs held constant, see ``docs/interop.md``), extrapolation, iteration,
-adaptive steps, and event times off the fixed step grid.
+adaptive steps, and event times off the fixed step grid. A bond's wired
+interface model needs no warning: its links are ordinary connections
+(:attr:`ExportPlan.all_connections`), held over the step as another tool
+holds every input, and the effort unit's switch is among its start values.
 """
 
 from __future__ import annotations

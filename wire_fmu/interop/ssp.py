@@ -21,7 +21,11 @@ Mapping
   ``ssd:Connection`` elements (any tool can run them), each marked with an
   annotation of type ``org.wire-fmu.bond`` naming the bond, its kind
   (``translational``, ``rotational``, ``rope``, ``hydraulic``) and the
-  connection's role (``effort``, ``flow``, ``position``).
+  connection's role (``effort``, ``flow``, ``position``). A bond whose
+  interface model is wired adds the model's five links (stiffness, damping,
+  effort rate, reference position and velocity, effort side to flow side),
+  ordinary connections too, with the role ``interface``; the effort unit's
+  switch parameter is in its parameter set like any other.
 * Drivers and scheduled events become the generated signals component
   (:mod:`wire_fmu.interop.signals`) and plain connections from it.
 * ``ssd:DefaultExperiment`` gives the start and stop time; an annotation of

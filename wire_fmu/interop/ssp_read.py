@@ -14,8 +14,12 @@ builds the same plain data a scene file holds, then parses it with
   ``String``; String parameters like a JSON reeving pass through unchanged).
 * Each ``ssd:Connection`` is oriented output to input by the FMUs' own
   causalities. Connections carrying our ``org.wire-fmu.bond`` annotation are
-  regrouped into power bonds (name, kind, effort/flow/position); all others
-  are plain connections.
+  regrouped into power bonds (name, kind, effort/flow/position, and the
+  ``interface`` links of a wired interface model: such a bond comes back
+  asking for its model, ``interface_model = true``, unless the restored run
+  settings say ``interface_models = true``); all others are plain
+  connections. The effort unit's interface switch comes back as the
+  parameter it was exported as.
 * Our ``org.wire-fmu.scene`` annotation, when present, restores the run
   settings, drivers, events, outputs, plots and effects exactly, and the
   generated signals component is dropped (its drivers are ours again).
@@ -56,7 +60,7 @@ from wire_fmu.master.scene import Scene, SceneError, parse_scene
 
 from .ssp import SSD_NAME
 from .ssp_read_annotation import _restore, _scene_metadata
-from .ssp_read_elements import _components, _connections, _run_settings
+from .ssp_read_elements import _components, _connections, _run_settings, _wire_interface_models
 from .ssp_read_files import _q, _read_xml
 
 __all__ = ["read_ssp", "extract_ssp", "ssp_scene_data"]
@@ -147,6 +151,7 @@ def ssp_scene_data(folder: Path) -> tuple[dict[str, Any], list[str]]:
     if meta is not None:
         data["name"] = meta.get("name", data["name"])
         _restore(data, meta, folder, problems)
+    _wire_interface_models(data["bonds"], data["run"])
     return data, problems
 
 

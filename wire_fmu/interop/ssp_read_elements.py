@@ -1,5 +1,6 @@
 """SSD elements as scene data: components and their parameter bindings, connections
-(regrouped into bonds where our annotation marks them) and run settings."""
+(regrouped into bonds where our annotation marks them, an interface model's links
+among them) and run settings."""
 
 from __future__ import annotations
 
@@ -18,7 +19,9 @@ from .ssp_read_files import _annotation, _inside, _q, _read_xml, _shown
 
 _FMU_TYPE = "application/x-fmu-sharedlibrary"
 _VALUE_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
-_ROLES = ("effort", "flow", "position")
+_ROLES = ("effort", "flow", "position", "interface")
+_MANY = "interface"
+"""The role a bond has several connections of (its interface model's links)."""
 _INT32 = (-(2**31), 2**31 - 1)  # an FMI 2.0 Integer
 _MAX_MODEL_DESCRIPTION = 256 << 20  # modelDescription.xml of a component FMU, bytes
 
@@ -220,11 +223,31 @@ def _connections(
             )
             continue
         bond = bonds.setdefault(name, {"name": name, "kind": kind})
+        if role == _MANY:
+            bond.setdefault(role, []).append(f"{link[0]} -> {link[1]}")
+            continue
         if role in bond:
             problems.append(f"{where}: bond {name!r} has a second {role} connection")
             continue
         bond[role] = f"{link[0]} -> {link[1]}"
     return plain, list(bonds.values())
+
+
+def _wire_interface_models(bonds: list[dict], run: dict[str, Any]) -> None:
+    """Bonds that came with interface links ask for their model, unless the run already does.
+
+    Parameters
+    ----------
+    bonds : list of dict
+        The bonds as scene data (long form).
+    run : dict
+        The run settings as scene data.
+    """
+    if run.get("interface_models") is True:
+        return
+    for bond in bonds:
+        if bond.get(_MANY):
+            bond["interface_model"] = True
 
 
 def _number(

@@ -19,6 +19,13 @@ second order (SPEC section 15).
 
 With fewer past values than a scheme needs (at the start, after a reset)
 the order drops accordingly.
+
+An interface model's links (a port's stiffness, damping, effort rate and
+reference motion) and the effort of their bond are never extrapolated: the
+scene holds them ``constant`` whatever the run's scheme
+(:data:`~wire_fmu.master.scene.data.HELD`), since they are the coefficients
+of a model the flow side integrates its step against, taken about one
+instant; a trend extrapolated on top would count the model's own rate twice.
 """
 
 from __future__ import annotations

@@ -9,6 +9,16 @@ position variables. A scene bond written as two ports is turned here into
 the three links of the long form: the effort from the effort side to the
 flow side, the flow and (when both ports have one) the position back.
 
+Interface models: when both ports declare one (``interface="true"``), the
+bond also offers five links ``effort_unit.{port}.{quantity} ->
+flow_unit.{port}.{quantity}``, one per
+:data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` (stiffness,
+damping, effort rate, reference position and velocity), and names the
+effort side's ``interface_switch`` parameter that turns their computation
+on. Whether the scene wires them is its choice (``run.interface_models``,
+or the bond's ``interface_model``; see :mod:`wire_fmu.master.scene.bonds`);
+when a side declares no model, :attr:`PortLinks.lacking` says which.
+
 The declarations are read from the FMU file itself, so any FMU that carries
 them can be bonded by port; for others the long form is the way.
 """
@@ -21,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES
 from wire_fmu.export.model_description import PORTS_TOOL
 from wire_fmu.master.archive import check_member_size
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR, resolve_fmu
@@ -30,6 +41,7 @@ __all__ = [
     "PORT_BOND_PATTERN",
     "PortDeclaration",
     "PortLinks",
+    "interface_links",
     "parse_port_pair",
     "port_links",
     "read_ports",
@@ -92,12 +104,24 @@ class PortLinks:
         (back).
     position : tuple of str or None
         Source and target of the position link, when both ports have a position.
+    interface : tuple of (str, str)
+        The interface model's links, effort side to flow side, one per
+        :data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` in that order; empty
+        unless both ports declare the model.
+    switch : str or None
+        The effort side's ``"unit.parameter"`` that turns its interface model on (None
+        without interface links, or when the effort side names none).
+    lacking : tuple of str
+        The ports that declare no interface model, as ``"unit.port (side side)"``.
     """
 
     kind: str
     effort: tuple[str, str]
     flow: tuple[str, str]
     position: tuple[str, str] | None
+    interface: tuple[tuple[str, str], ...] = ()
+    switch: str | None = None
+    lacking: tuple[str, ...] = ()
 
 
 def parse_port_pair(text: object) -> tuple[tuple[str, str], tuple[str, str]] | None:
@@ -227,9 +251,49 @@ def port_links(
     position = None
     if e_port.position:
         position = (f"{f_unit}.{f_port.position}", f"{e_unit}.{e_port.position}")
+    interface, switch, lacking = interface_links((e_unit, e_port), (f_unit, f_port))
     return PortLinks(
         a_port.kind,
         (f"{e_unit}.{e_port.effort}", f"{f_unit}.{f_port.effort}"),
         (f"{f_unit}.{f_port.flow}", f"{e_unit}.{e_port.flow}"),
         position,
+        interface,
+        switch,
+        lacking,
     ), []
+
+
+def interface_links(
+    effort: tuple[str, PortDeclaration], flow: tuple[str, PortDeclaration]
+) -> tuple[tuple[tuple[str, str], ...], str | None, tuple[str, ...]]:
+    """The interface model's links across a bond, its switch, and the ports that lack one.
+
+    Parameters
+    ----------
+    effort, flow : tuple of (str, PortDeclaration)
+        The effort side's and the flow side's unit name and port declaration.
+
+    Returns
+    -------
+    links : tuple of (str, str)
+        ``("effort_unit.{port}.{quantity}", "flow_unit.{port}.{quantity}")`` for each of
+        :data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES`, in that order; empty
+        unless both ports declare the model.
+    switch : str or None
+        ``"effort_unit.parameter"``: the effort side's interface switch, with the links.
+    lacking : tuple of str
+        Each port without the model, ``"unit.port (effort side)"`` or ``"(flow side)"``.
+    """
+    lacking = tuple(
+        f"{unit}.{port.name} ({port.side} side)"
+        for unit, port in (effort, flow)
+        if not port.interface
+    )
+    if lacking:
+        return (), None, lacking
+    (e_unit, e_port), (f_unit, f_port) = effort, flow
+    links = tuple(
+        (f"{e_unit}.{e_port.name}.{q}", f"{f_unit}.{f_port.name}.{q}") for q in INTERFACE_QUANTITIES
+    )
+    switch = f"{e_unit}.{e_port.interface_switch}" if e_port.interface_switch else None
+    return links, switch, ()

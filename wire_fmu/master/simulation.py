@@ -21,6 +21,12 @@ observers (which read: recorder, progress, energy monitor). One macro step:
    passes a share of what the bond carried: with any settings, a macro step
    too large for the dynamics across a bond is never a silent blow-up.
 
+A bond whose interface model is wired (:mod:`~wire_fmu.master.scene.data`)
+hands its flow side the effort side's stiffness, damping, effort rate and
+reference motion with the effort, all held over the step at their values at
+its start; those links count as the effort's in the step order, so the flow
+side still steps first and takes the model about the step's start.
+
 Across the FMI boundary each unit gets, per macro step, one batched set of
 its Real inputs (connected, driven, set by events) and, after its step, one
 batched read per FMI type of what the master needs: the outputs that feed
@@ -51,7 +57,7 @@ from .interrupts import InterruptRequestedError, Interrupts
 from .macro_step import MODE_CHANGE_TIME, MacroStep
 from .manipulators import DriverSet, ScheduledEvents
 from .run_result import RunResult, SimulationStoppedError
-from .scene import Scene
+from .scene import INTERFACE_ROLE, Scene, interface_warnings
 from .slave import Slave, StepRefusedError, UnitFailedError
 from .step_size import _ns
 from .unit_io import EndValues, InputPlan, ReadPlan, Watch
@@ -116,7 +122,7 @@ class Simulation(UnitExchange, MacroStep):
         flows_to, feeds = defaultdict(set), defaultdict(set)
         for c in self.scene.all_connections:
             feeds[c.source.unit].add(c.target.unit)
-            if c.role != "effort":
+            if c.role not in ("effort", INTERFACE_ROLE):  # these go with the effort
                 flows_to[c.source.unit].add(c.target.unit)
         return step_order(list(self.scene.units), flows_to, feeds, self.run_settings.order)
 
@@ -173,6 +179,8 @@ class Simulation(UnitExchange, MacroStep):
         with Interrupts() as interrupts:
             self._interrupts = interrupts
             try:
+                for warning in interface_warnings(self.scene):
+                    logger.warning("%s", warning)
                 self.initialize()
                 self._fire_events(self.time)
                 for obs in self.observers:

@@ -4,6 +4,8 @@ Every problem is collected, each naming the unit and variable, in the manner
 of libcosim's ``system_structure`` and Drake's ``DiagramBuilder``: unknown
 units, variables and effects; inputs fed twice; outputs fed into outputs;
 unit and type mismatches; a bond whose effort and flow do not make a power;
+a wired interface model whose quantities are not in their units, or whose
+effort unit's switch parameter is off (its links would carry zeros);
 algebraic loops through direct feedthrough; drivers, events, recorded and
 plotted variables that do not exist. :func:`check_through_fmi` then
 instantiates each unit with its parameters and enters initialisation mode,
@@ -21,8 +23,20 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
+from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS
+
 from .catalog import DEFAULT_FMU_DIR, is_ours, resolve_fmu
-from .scene import BOND_KINDS, Scene, SceneError, VarRef, unknown_unit_problems
+from .ports import read_ports
+from .run_record import declared_start
+from .scene import (
+    BOND_KINDS,
+    INTERFACE_ROLE,
+    Bond,
+    Scene,
+    SceneError,
+    VarRef,
+    unknown_unit_problems,
+)
 from .slave import value_problem
 
 __all__ = [
@@ -131,8 +145,10 @@ def _variable_problem(structure: Structure, ref: VarRef, causality: str, what: s
             f"{causality}s: {', '.join(names)}"
         )
     if var.causality != causality:
-        hint = " (an output cannot feed an output)" if causality == "input" else ""
-        return f"{what} {ref}: is an {var.causality}, expected an {causality}{hint}"
+        output_fed = causality == "input" and var.causality == "output"
+        hint = " (an output cannot feed an output)" if output_fed else ""
+        article = "an" if var.causality[:1] in ("a", "e", "i", "o", "u") else "a"
+        return f"{what} {ref}: is {article} {var.causality}, expected an {causality}{hint}"
     return None
 
 
@@ -177,12 +193,84 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
     return problems
 
 
+def _interface_unit(kind: str, variable: str) -> str | None:
+    """The unit an interface model's quantity ``{port}.{quantity}`` has in a ``kind`` bond."""
+    quantity = variable.rpartition(".")[2]
+    if kind not in INTERFACE_UNITS or quantity not in INTERFACE_QUANTITIES:
+        return None
+    return INTERFACE_UNITS[kind][INTERFACE_QUANTITIES.index(quantity)]
+
+
+def _interface_unit_problems(bond: Bond, structure: Structure) -> list[str]:
+    """An interface link whose source is not in its quantity's unit for the bond's kind."""
+    problems = []
+    for c in bond.connections:
+        var = structure.variable(c.source) if c.role == INTERFACE_ROLE else None
+        expected = var is not None and _interface_unit(bond.kind, c.source.variable)
+        if expected and var.type == "Real" and (var.unit or "") != expected:
+            problems.append(
+                f"bond {bond.name!r} ({bond.kind}): interface link {c.source} -> {c.target}: "
+                f"{c.source} has unit {var.unit or 'none'}, expected {expected} (the "
+                f"interface model of a {bond.kind} bond)"
+            )
+    return problems
+
+
+def _declared_switch(bond: Bond, structure: Structure) -> str | None:
+    """The effort unit's declared switch of the port whose interface outputs the bond links."""
+    unit = bond.effort.source.unit
+    try:
+        ports = read_ports(structure.paths[unit]) if unit in structure.paths else {}
+    except ValueError:
+        return None  # said where the scene's ports are read, if the scene bonds by port
+    sources = {c.source.variable for c in bond.interface}
+    for port in ports.values():
+        offered = {f"{port.name}.{q}" for q in INTERFACE_QUANTITIES}
+        if port.interface and port.interface_switch and sources & offered:
+            return port.interface_switch
+    return None
+
+
+def _switch_problem(scene: Scene, bond: Bond, structure: Structure) -> str | None:
+    """Why a wired interface model's links would carry zeros: its switch is off."""
+    unit = bond.effort.source.unit
+    spec = scene.units.get(unit)
+    if spec is None or unit not in structure.descriptions:
+        return None
+    switch = bond.interface_switch.variable if bond.interface_switch else None
+    switch = switch or _declared_switch(bond, structure)
+    var = structure.variable(VarRef(unit, switch)) if switch else None
+    if var is None or switch in spec.switched_on:
+        return None
+    given = switch in spec.parameters
+    value = spec.parameters[switch] if given else declared_start(var)
+    if value is True:
+        return None
+    asked = "run.interface_models" if bond.interface_model is None else "its interface_model = true"
+    shown = str(value).lower() if isinstance(value, bool) else repr(value)
+    said = f"sets {switch} = {shown}" if given else f"leaves {switch} at {shown}"
+    fix = (
+        f"leave {switch} out (the master sets it) or set interface_model = false on the bond"
+        if given
+        else f"set {switch} = true on unit {unit!r} or interface_model = false on the bond"
+    )
+    return (
+        f"bond {bond.name!r}: its interface model is wired ({asked}), but unit {unit!r} "
+        f"{said}, so {bond.interface[0].source} and the model's other outputs would carry "
+        f"zeros; expected {switch} = true: {fix}"
+    )
+
+
 def _bond_problems(scene: Scene, structure: Structure) -> list[str]:
     problems = []
     for bond in scene.bonds:
         units = dict(
             zip(("effort", "flow", "position"), BOND_KINDS.get(bond.kind, ()), strict=False)
         )
+        if bond.wired:
+            problems += _interface_unit_problems(bond, structure)
+            switch = _switch_problem(scene, bond, structure)
+            problems += [switch] if switch else []
         for c in bond.connections:
             var = structure.variable(c.source)
             if var is None or var.type != "Real":

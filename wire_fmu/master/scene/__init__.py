@@ -20,6 +20,8 @@ Format::
     iteration_tolerance = 1e-6
     adaptive = false          # macro step from the bonds' energy residual
     synchronise_events = false  # a mode change inside a step: every unit steps to it
+    interface_models = false  # true: bonds whose two ports declare an interface model
+                              # carry it (see wire_fmu.master.scene.bonds)
     energy_tolerance = 10.0   # J per step, with adaptive; the energy guard's floor
     energy_guard = 0.1        # stop once a bond's coupling created this share of
                               # the energy it carried (inf: off); see energy_guard.py
@@ -40,10 +42,13 @@ Format::
     effort = "rope.mover_a.force -> cylinder.rod.force"
     flow = "cylinder.rod.velocity -> rope.mover_a.velocity"
     position = "cylinder.rod.position -> rope.mover_a.position"
+    interface = []            # optional: an interface model's links, effort side to flow side
 
     [[bonds]]                 # the same, as the two ports it joins (links and kind from the
     name = "rod"              # ports the FMUs declare; see wire_fmu.master.scene.bonds)
     ports = "cylinder.rod <-> rope.mover_a"
+    interface_model = true    # optional: this bond's coupling whatever run.interface_models
+                              # says (true: its interface model's links too; false: none)
 
     [[connections]]           # plain signals
     from = "a.x"
@@ -82,11 +87,19 @@ file) and :mod:`.checks` (values, names, unit references, run settings).
 
 from __future__ import annotations
 
-from .checks import is_plain_name, is_scalar, unknown_unit_problems, valid_time
+from .checks import (
+    interface_warnings,
+    is_plain_name,
+    is_scalar,
+    unknown_unit_problems,
+    valid_time,
+)
 from .data import (
     ALGORITHMS,
     BOND_KINDS,
     EXTRAPOLATIONS,
+    HELD,
+    INTERFACE_ROLE,
     Bond,
     Connection,
     DriverSpec,
@@ -117,10 +130,13 @@ __all__ = [
     "read_scene_data",
     "is_plain_name",
     "unknown_unit_problems",
+    "interface_warnings",
     "valid_time",
     "is_scalar",
     "MAX_SCENE_BYTES",
     "ALGORITHMS",
     "EXTRAPOLATIONS",
     "BOND_KINDS",
+    "HELD",
+    "INTERFACE_ROLE",
 ]

@@ -7,6 +7,19 @@ ports the two units' FMUs declare (:mod:`wire_fmu.master.ports`), so the
 short form is the one place where reading a scene opens its units' FMUs
 (ours are built if needed). A short-form bond is named after its first port
 unless ``name`` says otherwise.
+
+Interface models: when both ports of a short-form bond declare one, the bond
+also offers the model's five links (``effort_unit.{port}.{quantity} ->
+flow_unit.{port}.{quantity}``: stiffness, damping, effort rate, reference
+position and velocity) and the effort side's switch parameter. The scene
+wires them with ``interface_models = true`` in ``[run]``, or per bond with
+``interface_model = true`` (``false`` keeps the bond's three links whatever
+the run says); see :mod:`.data` for what wiring does. A bond that is asked
+for the model by its own key and whose ports cannot give it is a problem; asked
+by the run setting, it keeps its three links and ``wire-fmu check`` warns
+(:func:`.checks.interface_warnings`). A long-form bond lists the model's links
+itself, ``interface = ["rope.mover_a.stiffness -> cylinder.rod.stiffness",
+...]``, effort side to flow side, and its scene sets the effort unit's switch.
 """
 
 from __future__ import annotations
@@ -14,16 +27,25 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from ..ports import PortDeclaration, parse_port_pair, port_links
-from .data import BOND_KINDS, EXTRAPOLATIONS, Bond, Connection, VarRef
+from ..ports import PortDeclaration, PortLinks, parse_port_pair, port_links
+from .data import BOND_KINDS, EXTRAPOLATIONS, HELD, INTERFACE_ROLE, Bond, Connection, VarRef
 from .sections import _as_list, _parse_link, _text, _unknown_keys
 
 __all__ = ["PortsOf", "parse_bonds"]
 
 PortsOf = Callable[[str], tuple[dict[str, PortDeclaration] | None, str | None]]
 """A unit's name -> ``(its ports, None)`` or ``(None, why they cannot be read)``."""
-_LONG_KEYS = {"name", "kind", "effort", "flow", "position", "extrapolation"}
-_SHORT_KEYS = {"name", "kind", "ports", "extrapolation"}
+_LONG_KEYS = {
+    "name",
+    "kind",
+    "effort",
+    "flow",
+    "position",
+    "extrapolation",
+    "interface",
+    "interface_model",
+}
+_SHORT_KEYS = {"name", "kind", "ports", "extrapolation", "interface_model"}
 
 
 def parse_bonds(
@@ -75,6 +97,46 @@ def _extrapolation(spec: Mapping, where: str, problems: list[str]) -> str | None
     return extrapolation
 
 
+def _interface_model(spec: Mapping, where: str, problems: list[str]) -> bool | None:
+    """The bond's ``interface_model`` (None when it leaves the choice to the run)."""
+    choice = spec.get("interface_model")
+    if choice is not None and not isinstance(choice, bool):
+        problems.append(f"{where}: 'interface_model' must be true or false, got {choice!r}")
+        return None
+    return choice
+
+
+def _interface_links(
+    spec: Mapping, name: str, where: str, problems: list[str]
+) -> tuple[Connection, ...]:
+    """A long-form bond's ``interface`` links (role ``interface``, held over the step)."""
+    texts = spec.get("interface", [])
+    if not isinstance(texts, list):
+        problems.append(
+            f"{where}: 'interface' must be a list of 'unit.output -> unit.input' links, "
+            f"got {texts!r}"
+        )
+        return ()
+    links = []
+    for k, text in enumerate(texts):
+        link = _parse_link(text, f"{where} interface link {k}", problems)
+        if link:
+            links.append(Connection(*link, role=INTERFACE_ROLE, bond=name, extrapolation=HELD))
+    return tuple(links)
+
+
+def _crossed_interface(
+    effort: Connection, interface: tuple[Connection, ...], where: str, problems: list[str]
+) -> None:
+    """A problem for each interface link that does not go the effort's way."""
+    for c in interface:
+        if (c.source.unit, c.target.unit) != (effort.source.unit, effort.target.unit):
+            problems.append(
+                f"{where}: interface link {c.source} -> {c.target} must go the effort's way, "
+                f"from unit {effort.source.unit!r} to unit {effort.target.unit!r}"
+            )
+
+
 def _long_bond(
     spec: Mapping, i: int, names: set[str], units: set[str], problems: list[str]
 ) -> Bond | None:
@@ -84,6 +146,13 @@ def _long_bond(
     if kind not in BOND_KINDS:
         problems.append(f"{where}: 'kind' must be one of {sorted(BOND_KINDS)}, got {kind!r}")
     extrapolation = _extrapolation(spec, where, problems)
+    choice = _interface_model(spec, where, problems)
+    interface = _interface_links(spec, name, where, problems)
+    if choice is True and not interface and "interface" not in spec:
+        problems.append(
+            f"{where}: 'interface_model' = true needs the bond's 'interface' links (or write "
+            "the bond as 'ports' whose FMUs declare the model)"
+        )
     links = {}
     for role in ("effort", "flow", "position"):
         if role not in spec:
@@ -105,7 +174,17 @@ def _long_bond(
             f"(effort {e.source.unit} -> {e.target.unit}, flow "
             f"{f.source.unit} -> {f.target.unit})"
         )
-    return Bond(name, str(kind), e, f, links.get("position"))
+    _crossed_interface(e, interface, where, problems)
+    return Bond(
+        name,
+        str(kind),
+        e,
+        f,
+        links.get("position"),
+        interface=interface,
+        interface_model=choice,
+        extrapolation=extrapolation,
+    )
 
 
 def _short_bond(
@@ -121,6 +200,7 @@ def _short_bond(
     name = _name(spec, i, default, names, problems)
     where = f"bond {name!r}"
     extrapolation = _extrapolation(spec, where, problems)
+    choice = _interface_model(spec, where, problems)
     _unknown_keys(spec, _SHORT_KEYS, where, problems)
     if pair is None:
         problems.append(
@@ -138,8 +218,21 @@ def _short_bond(
     if kind != links.kind:
         problems.append(f"{where}: 'kind' {kind!r} differs from the ports' kind {links.kind!r}")
         return None
+    if choice is True and links.lacking:
+        problems.append(
+            f"{where}: 'interface_model' = true, but {' and '.join(links.lacking)} declares "
+            "no interface model; leave the key out or set it false to keep the bond's effort, "
+            "flow and position links"
+        )
+    return _bond_of_links(name, links, extrapolation, choice)
 
-    def connection(pair: tuple[str, str], role: str) -> Connection:
+
+def _bond_of_links(
+    name: str, links: PortLinks, extrapolation: str | None, choice: bool | None
+) -> Bond:
+    """The bond of a port pair's links (see :func:`~wire_fmu.master.ports.port_links`)."""
+
+    def connection(pair: tuple[str, str], role: str, scheme: str | None) -> Connection:
         """The bond's link of ``role``.
 
         Parameters
@@ -147,18 +240,25 @@ def _short_bond(
         pair : (str, str)
             Source and target, ``"unit.variable"`` each.
         role : str
-            ``"effort"``, ``"flow"`` or ``"position"``.
+            ``"effort"``, ``"flow"``, ``"position"`` or ``"interface"``.
+        scheme : str or None
+            Its extrapolation (None: the run's).
         """
         source, target = (VarRef.parse(side) for side in pair)
-        return Connection(source, target, role=role, bond=name, extrapolation=extrapolation)
+        return Connection(source, target, role=role, bond=name, extrapolation=scheme)
 
-    position = connection(links.position, "position") if links.position else None
+    position = links.position and connection(links.position, "position", extrapolation)
     return Bond(
         name,
         links.kind,
-        connection(links.effort, "effort"),
-        connection(links.flow, "flow"),
-        position,
+        connection(links.effort, "effort", extrapolation),
+        connection(links.flow, "flow", extrapolation),
+        position or None,
+        interface=tuple(connection(p, INTERFACE_ROLE, HELD) for p in links.interface),
+        interface_switch=VarRef.parse(links.switch) if links.switch else None,
+        interface_model=choice,
+        interface_lacking=links.lacking,
+        extrapolation=extrapolation,
     )
 
 

@@ -1,4 +1,5 @@
-"""Checks of scene values: names, unit references, times, scalars and run settings."""
+"""Checks of scene values: names, unit references, times, scalars and run settings, and
+the warnings about bonds that cannot give the interface model the scene asks for."""
 
 from __future__ import annotations
 
@@ -8,7 +9,13 @@ from typing import Any
 
 from .data import ALGORITHMS, EXTRAPOLATIONS, RunSettings, Scene, VarRef
 
-__all__ = ["is_plain_name", "unknown_unit_problems", "valid_time", "is_scalar"]
+__all__ = [
+    "is_plain_name",
+    "unknown_unit_problems",
+    "valid_time",
+    "is_scalar",
+    "interface_warnings",
+]
 
 MIN_TIME, MAX_TIME = 1e-9, 1e12
 """Shortest step and latest time a run can count (whole nanoseconds in 64 bits), s."""
@@ -63,6 +70,39 @@ def unknown_unit_problems(scene: Scene) -> list[str]:
         for where, ref in refs
         if ref.unit not in units
     ]
+
+
+def interface_warnings(scene: Scene) -> list[str]:
+    """Each bond asked for its interface model by ``run.interface_models`` that has none.
+
+    Such a bond keeps its effort, flow and position links (a bond that asks by its own
+    ``interface_model = true`` and cannot have it is a problem instead, found where the
+    scene is read).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+
+    Returns
+    -------
+    list of str
+        One warning per such bond, naming it and the port (and side) without the model,
+        or saying that it is written link by link without interface links.
+    """
+    warnings = []
+    for bond in scene.bonds:
+        if bond.wired or bond.interface_model is not None or not scene.run.interface_models:
+            continue
+        if bond.interface_lacking:
+            why = f"{' and '.join(bond.interface_lacking)} declares no interface model"
+        else:
+            why = "it is written link by link without 'interface' links"
+        warnings.append(
+            f"bond {bond.name!r}: run.interface_models asks for interface models, but {why}; "
+            "the bond keeps its effort, flow and position links"
+        )
+    return warnings
 
 
 def valid_time(value: Any) -> bool:
@@ -127,7 +167,7 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
             f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
             "one step (a coupling that needs more does not converge)"
         )
-    for key in ("adaptive", "synchronise_events"):
+    for key in ("adaptive", "synchronise_events", "interface_models"):
         if not isinstance(getattr(s, key), bool):
             problems.append(f"run.{key} must be true or false, got {getattr(s, key)!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):

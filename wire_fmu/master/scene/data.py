@@ -1,11 +1,22 @@
 """What a parsed scene holds: variable references, units, connections, bonds, drivers,
-events, plots and run settings (see :mod:`wire_fmu.master.scene` for the file format)."""
+events, plots and run settings (see :mod:`wire_fmu.master.scene` for the file format).
+
+A bond's interface model is wired by the :class:`Scene` itself, from the run's
+``interface_models`` and the bond's own ``interface_model``: a bond whose ports
+offer the model then carries its five links among its connections
+(:attr:`Bond.connections`, role ``"interface"``), its effort and those links are
+held at the effort side's values at the step's start (``constant``), and the
+effort unit's switch parameter is set true in its parameters (recorded in
+:attr:`UnitSpec.switched_on`). Since a :class:`Scene` is wired whenever it is made,
+a copy with other run settings (``dataclasses.replace``, a sweep, a command-line
+override) is wired by its own settings.
+"""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -27,10 +38,17 @@ __all__ = [
     "ALGORITHMS",
     "EXTRAPOLATIONS",
     "BOND_KINDS",
+    "HELD",
+    "INTERFACE_ROLE",
 ]
 
 ALGORITHMS = ("jacobi", "gauss_seidel")
 EXTRAPOLATIONS = ("constant", "linear", "quadratic")
+INTERFACE_ROLE = "interface"
+"""The role of an interface model's links (effort side to flow side) in a bond."""
+HELD = "constant"
+"""The extrapolation of a wired interface model's links and of its bond's effort: the
+effort side's values at the step's start, about which the model is taken."""
 BOND_KINDS = {
     # kind: (effort unit, flow unit, position unit)
     "translational": ("N", "m/s", "m"),
@@ -85,12 +103,41 @@ class UnitSpec:
         Effects to include (ours only); everything else is the simplest model.
     parameters : dict
         Parameter values; tables become JSON text for String parameters.
+    switched_on : tuple of str
+        Boolean parameters among ``parameters`` that the scene did not write and that are
+        true because a bond wires this unit's interface model (its ``interface_switch``).
     """
 
     name: str
     fmu: str
     effects: tuple[str, ...] = ()
     parameters: dict[str, Any] = field(default_factory=dict)
+    switched_on: tuple[str, ...] = ()
+
+    def own_parameters(self) -> dict[str, Any]:
+        """The parameters the scene wrote (without those an interface model switched on)."""
+        return {
+            k: v for k, v in self.parameters.items() if not (k in self.switched_on and v is True)
+        }
+
+    def switched(self, switches: tuple[str, ...]) -> UnitSpec:
+        """The unit with ``switches`` true where the scene does not set them itself.
+
+        Parameters
+        ----------
+        switches : tuple of str
+            Boolean parameters that wired interface models need on.
+
+        Returns
+        -------
+        UnitSpec
+            ``self`` when nothing changes, else a copy with the switches set.
+        """
+        own = self.own_parameters()
+        added = tuple(sorted(name for name in set(switches) if name not in own))
+        if added == self.switched_on and len(own) + len(added) == len(self.parameters):
+            return self
+        return replace(self, parameters={**own, **dict.fromkeys(added, True)}, switched_on=added)
 
     def parameter_values(self) -> dict[str, Any]:
         """Parameters as FMI values (tables and lists serialised to JSON)."""
@@ -104,8 +151,8 @@ class UnitSpec:
 class Connection:
     """An output feeding an input.
 
-    ``role`` is ``"effort"``, ``"flow"`` or ``"position"`` inside a bond,
-    ``"signal"`` otherwise.
+    ``role`` is ``"effort"``, ``"flow"``, ``"position"`` or ``"interface"`` (one of an
+    interface model's links) inside a bond, ``"signal"`` otherwise.
     """
 
     source: VarRef
@@ -117,18 +164,77 @@ class Connection:
 
 @dataclass(frozen=True)
 class Bond:
-    """A power bond between two units (effort one way, flow back)."""
+    """A power bond between two units (effort one way, flow back).
+
+    Attributes
+    ----------
+    name, kind : str
+        The bond's name and kind (one of :data:`BOND_KINDS`).
+    effort, flow : Connection
+        The effort link (effort side to flow side) and the flow link (back).
+    position : Connection or None
+        The position link (back), if any.
+    interface : tuple of Connection
+        The interface model's links the bond offers (role ``"interface"``, effort side
+        to flow side, held over the step); empty when either port lacks the model.
+    interface_switch : VarRef or None
+        The effort unit's Boolean parameter that turns its interface model on.
+    interface_model : bool or None
+        The bond's own choice of coupling (its ``interface_model`` key); None follows
+        ``run.interface_models``.
+    interface_lacking : tuple of str
+        The ports that declare no interface model (``"unit.port (flow side)"``).
+    extrapolation : str or None
+        The bond's own extrapolation (its ``extrapolation`` key).
+    wired : bool
+        Whether the interface links are among the connections (set by the :class:`Scene`).
+    """
 
     name: str
     kind: str
     effort: Connection
     flow: Connection
     position: Connection | None = None
+    interface: tuple[Connection, ...] = ()
+    interface_switch: VarRef | None = None
+    interface_model: bool | None = None
+    interface_lacking: tuple[str, ...] = ()
+    extrapolation: str | None = None
+    wired: bool = False
 
     @property
     def connections(self) -> tuple[Connection, ...]:
-        """The bond's connections."""
-        return tuple(c for c in (self.effort, self.flow, self.position) if c is not None)
+        """The bond's connections: effort, flow, position, and the interface links if wired."""
+        links = tuple(c for c in (self.effort, self.flow, self.position) if c is not None)
+        return links + (self.interface if self.wired else ())
+
+    def asks_interface(self, run: RunSettings) -> bool:
+        """Whether the scene asks this bond for its interface model.
+
+        Parameters
+        ----------
+        run : RunSettings
+            The scene's run settings (``interface_models``).
+        """
+        choice = run.interface_models if self.interface_model is None else self.interface_model
+        return choice is True
+
+    def wire(self, on: bool) -> Bond:
+        """The bond with its interface links wired (``on``, when it has them) or not.
+
+        Wired, the effort is held like the links (:data:`HELD`): the flow side takes
+        the effort and its model about the same instant.
+
+        Parameters
+        ----------
+        on : bool
+            Whether the scene asks for the interface model.
+        """
+        wired = bool(on and self.interface)
+        scheme = HELD if wired else self.extrapolation
+        if wired == self.wired and self.effort.extrapolation == scheme:
+            return self
+        return replace(self, effort=replace(self.effort, extrapolation=scheme), wired=wired)
 
 
 @dataclass(frozen=True)
@@ -172,6 +278,7 @@ class RunSettings:
     iteration_tolerance: float = 1e-6
     adaptive: bool = False
     synchronise_events: bool = False
+    interface_models: bool = False
     energy_tolerance: float = 10.0
     energy_guard: float = DEFAULT_SHARE
     min_step: float = 1e-5
@@ -197,6 +304,26 @@ class Scene:
     base_dir: Path
     source: Path | None = None
     study: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        """Wire each bond's interface model as the run and the bond ask (module docstring)."""
+        bonds = tuple(b.wire(b.asks_interface(self.run)) for b in self.bonds)
+        switches: dict[str, list[str]] = {}
+        for bond in bonds:
+            if bond.wired and bond.interface_switch is not None:
+                switch = bond.interface_switch
+                switches.setdefault(switch.unit, []).append(switch.variable)
+        units = {
+            name: spec.switched(tuple(switches.get(name, ()))) for name, spec in self.units.items()
+        }
+        if any(units[n] is not s for n, s in self.units.items()):
+            object.__setattr__(self, "units", units)
+        object.__setattr__(self, "bonds", bonds)
+
+    @property
+    def interface_bonds(self) -> tuple[Bond, ...]:
+        """The bonds whose interface model is wired."""
+        return tuple(b for b in self.bonds if b.wired)
 
     @property
     def all_connections(self) -> tuple[Connection, ...]:
