@@ -262,7 +262,11 @@ def test_a_long_form_bond_lists_its_links_and_its_scene_sets_the_switch(declared
     structure.paths["rope"] = Path("no such file.fmu")  # its declarations cannot be read
     assert validate._bond_problems(scene, structure) == []
     assert validate._bond_problems(scene, _structure("true")) == []
-    data["bonds"][0]["interface"] = ["cylinder.rod.velocity -> rope.mover_a.stiffness", 3]
+    data["bonds"][0]["interface"] = [
+        "cylinder.rod.velocity -> rope.mover_a.stiffness",
+        3,
+        "rope.mover_a.damping -> cylnder.rod.damping",
+    ]
     data["bonds"][0]["interface_model"] = "on"
     _, problems = _read(data)
     assert problems == [
@@ -270,6 +274,10 @@ def test_a_long_form_bond_lists_its_links_and_its_scene_sets_the_switch(declared
         "bond 'rod' interface link 1: must read 'unit.output -> unit.input', got 3",
         "bond 'rod': interface link cylinder.rod.velocity -> rope.mover_a.stiffness must go "
         "the effort's way, from unit 'rope' to unit 'cylinder'",
+        "bond 'rod': interface link rope.mover_a.damping -> cylnder.rod.damping must go the "
+        "effort's way, from unit 'rope' to unit 'cylinder'",
+        "bond 'rod' interface: cylnder.rod.damping names no unit 'cylnder'; the scene's "
+        "units: cylinder, rope",
     ]
 
 

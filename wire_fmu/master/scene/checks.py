@@ -52,11 +52,8 @@ def unknown_unit_problems(scene: Scene) -> list[str]:
     known = ", ".join(sorted(units)) or "none"
     refs: list[tuple[str, VarRef]] = []
     for bond in scene.bonds:
-        refs += [
-            (f"bond {bond.name!r} {c.role}", r)
-            for c in bond.connections
-            for r in (c.source, c.target)
-        ]
+        links = bond.connections + (() if bond.wired else bond.interface)  # wired or not
+        refs += [(f"bond {bond.name!r} {c.role}", r) for c in links for r in (c.source, c.target)]
     for i, c in enumerate(scene.connections):
         refs += [(f"connection {i}", c.source), (f"connection {i}", c.target)]
     for i, d in enumerate(scene.drivers):

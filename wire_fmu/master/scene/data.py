@@ -48,7 +48,10 @@ INTERFACE_ROLE = "interface"
 """The role of an interface model's links (effort side to flow side) in a bond."""
 HELD = "constant"
 """The extrapolation of a wired interface model's links and of its bond's effort: the
-effort side's values at the step's start, about which the model is taken."""
+effort side's values at the step's start, about which the model is taken (the flow side
+steps first, so it has no newer ones; in an iterated step, or with ``run.order`` putting
+the effort side first, a constant hold takes the newest values: the model about the
+step's end)."""
 BOND_KINDS = {
     # kind: (effort unit, flow unit, position unit)
     "translational": ("N", "m/s", "m"),
