@@ -675,6 +675,26 @@ def test_osp_carries_the_links_as_variable_connections_and_the_switch(fmus, tmp_
     assert values[("b", "interface_model")] == "true"
 
 
+@pytest.mark.integration
+@pytest.mark.parametrize("kind", ["ssp", "osp"])
+def test_libcosim_runs_the_exported_links_as_our_master_does(fmus, tmp_path, kind):
+    import numpy as np
+
+    from wire_fmu.interop.osp import export_osp
+    from wire_fmu.interop.ssp import export_ssp
+
+    from .interop_helpers import run_libcosim, run_ours
+
+    data = _pair_data(fmus, algorithm="jacobi", extrapolation="constant")
+    scene = parse_scene(data, base_dir=tmp_path)
+    path = (export_ssp if kind == "ssp" else export_osp)(scene, tmp_path / kind)
+    names, ours = run_ours(scene)
+    theirs = run_libcosim(path, names, step=0.01, stop=0.1, kind=kind)
+    seen = names.index(("a", "seen_stiffness")) + 1
+    assert (theirs[:, seen] == 60.0).all()
+    assert np.abs(theirs - ours).max() <= 1e-12 * max(1.0, np.abs(ours).max())
+
+
 # -- the riser tensioner -----------------------------------------------------------------------
 @pytest.mark.integration
 def test_the_riser_cylinder_receives_the_ropes_stiffness_through_the_rod_bond(tmp_path):
