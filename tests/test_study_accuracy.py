@@ -22,7 +22,15 @@ from wire_fmu.study.accuracy import reference_run, run_accuracy_study
 from wire_fmu.study.accuracy_report import accuracy_markdown
 from wire_fmu.study.measures import RunRow, output_error
 from wire_fmu.study.orders import equal_error, observed_orders, theoretical_order
-from wire_fmu.study.plan import StudyError, study_scene, study_settings, with_stop_time
+from wire_fmu.study.plan import (
+    StudyError,
+    build_grid,
+    configured_scene,
+    coupling_choices,
+    study_scene,
+    study_settings,
+    with_stop_time,
+)
 from wire_fmu.study.solvers import SolverChoice, scene_solver
 
 from .block_train_helpers import (
@@ -254,6 +262,7 @@ def test_observed_orders_match_theory_across_a_power_bond(tmp_path):
         steps=(0.04, 0.02, 0.01, 0.005),
         stop_time=1.2,
         solvers=(),
+        couplings=(),
         monolithic_rtols=(),
     )
     study = run_accuracy_study(scene, tmp_path, settings=settings, progress=False)
@@ -275,6 +284,41 @@ def test_observed_orders_match_theory_across_a_power_bond(tmp_path):
         assert (tmp_path / name).stat().st_size > 0
     assert "Observed convergence orders" in (tmp_path / "accuracy.md").read_text()
     assert study.comparison and study.comparison[0].cheapest
+
+
+def test_the_grid_adds_couplings_a_scene_can_use():
+    """Event synchronisation for any scene; interface models only across a bond that offers
+    them (a bond written out long-hand offers none)."""
+    bonded = parse_scene(
+        {
+            "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
+            "bonds": [
+                {
+                    "name": "rope",
+                    "kind": "rope",
+                    "effort": "r.line_a.tension -> w.rope.tension",
+                    "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
+                    "position": "w.rope.payout -> r.line_a.payout",
+                }
+            ],
+            "study": {"key_outputs": ["r.line_a.tension"]},
+        },
+        base_dir=Path("."),
+    )
+    settings = replace(
+        study_settings(bonded), steps=(0.02, 0.01), solvers=(), extrapolations=("linear",)
+    )
+    assert coupling_choices(bonded, settings) == ["held", "synchronised"]
+    grid = build_grid(bonded, settings)
+    assert {c.family for c in grid} == {
+        f"{a} / linear / {scene_solver(bonded).label}{tail}"
+        for a in ("jacobi", "gauss_seidel")
+        for tail in ("", " / synchronised")
+    }
+    synchronised = next(c for c in grid if c.coupling == "synchronised")
+    configured = configured_scene(bonded, synchronised)
+    assert configured.run.synchronise_events and not configured.run.interface_models
+    assert coupling_choices(bonded, replace(settings, couplings=())) == ["held"]
 
 
 @pytest.mark.integration
@@ -304,6 +348,7 @@ def test_refused_and_blown_up_configurations_are_recorded(tmp_path):
         algorithms=("jacobi",),
         extrapolations=("quadratic",),
         solvers=(bogus, RK4),
+        couplings=(),
         monolithic_rtols=(),
     )
     study = run_accuracy_study(scene, tmp_path, settings=settings, progress=False)

@@ -216,9 +216,14 @@ _DASHES = {"constant": ":", "linear": "-", "quadratic": "--"}
 _MARKERS = {"gauss_seidel": "o", "jacobi": "s"}
 
 
+def _colour_key(row: RunRow) -> str:
+    """What a curve's colour tells: the units' solver and, unless held, the coupling."""
+    return row.solver if row.coupling == "held" else f"{row.solver} / {row.coupling}"
+
+
 def _style(study_rows: Sequence[RunRow]):
-    solvers = list(dict.fromkeys(r.solver for r in study_rows if r.algorithm != "monolithic"))
-    colours = {s: f"C{i % 10}" for i, s in enumerate(solvers)}
+    keys = list(dict.fromkeys(_colour_key(r) for r in study_rows if r.algorithm != "monolithic"))
+    colours = {s: f"C{i % 10}" for i, s in enumerate(keys)}
     return colours, dict(_DASHES), dict(_MARKERS)
 
 
@@ -227,7 +232,7 @@ def _drawn(rows: Sequence[RunRow]) -> dict[str, set[str]]:
     coupled = [r for r in rows if r.usable and r.algorithm != "monolithic"]
     single = [r for r in rows if r.usable and r.algorithm == "monolithic"]
     return {
-        "solver": {r.solver for r in coupled},
+        "solver": {_colour_key(r) for r in coupled},
         "extrapolation": {r.extrapolation for r in coupled},
         "algorithm": {r.algorithm for r in coupled},
         "monolithic": {"radau" if r.family == MONOLITHIC_RADAU else "solver" for r in single},
@@ -329,7 +334,7 @@ def _plot_families(ax, study: AccuracyStudy, x_of, y_of, work_precision: bool) -
         ax.plot(
             [x_of(r) for r in ok],
             [y_of(r) for r in ok],
-            color=colours[first.solver],
+            color=colours[_colour_key(first)],
             ls=dashes[first.extrapolation],
             marker=markers[first.algorithm],
             ms=4,

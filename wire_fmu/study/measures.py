@@ -135,6 +135,7 @@ class RunRow:
     fmi_overhead_share: float
     master_share: float
     message: str = ""
+    coupling: str = "held"
 
     @property
     def usable(self) -> bool:
@@ -168,6 +169,7 @@ def _row(config: Configuration, run: TimedRun, error: float, worst: str) -> RunR
         overhead,
         master,
         one_line(run.message),
+        config.coupling,
     )
 
 
@@ -206,6 +208,7 @@ def _skipped(config: Configuration, reason: str) -> RunRow:
         math.nan,
         math.nan,
         reason,
+        config.coupling,
     )
 
 

@@ -31,6 +31,7 @@ from wire_fmu.core.framework.unit import Causality, OdeView, Unit
 from wire_fmu.master.algorithms import step_order
 from wire_fmu.master.manipulators import DriverSet, ScheduledEvents
 from wire_fmu.master.scene import Scene, SceneError, VarRef
+from wire_fmu.master.scene.data import INTERFACE_ROLE
 from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 __all__ = [
@@ -105,12 +106,15 @@ class MonolithicModel:
         for name, spec in scene.units.items():
             unit = _core_class(spec.fmu)(name)
             values = spec.parameter_values()
+            for switch in spec.switched_on:  # one ODE needs no unit's interface model
+                values[switch] = False
             if "effects" in unit.values:
                 values["effects"] = ",".join(spec.effects)
             unit.values.update(values)
             unit.configure()
             self.units[name] = unit
-        self.connections = scene.all_connections
+        # an interface model's links stand in for the exact coupling the one ODE solves
+        self.connections = tuple(c for c in scene.all_connections if c.role != INTERFACE_ROLE)
         self.into: dict[str, list] = defaultdict(list)
         for c in self.connections:
             self.into[c.target.unit].append(c)

@@ -37,8 +37,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from wire_fmu.master.scene import Scene
+from wire_fmu.master.scene.data import INTERFACE_ROLE
 
 from .measures import RunRow
+from .plan import coupled_scene
 
 __all__ = [
     "THEORY",
@@ -89,9 +91,12 @@ def theoretical_order(scene: Scene, extrapolation: str) -> int | None:
 
     Position links of a bond are exact at every step start; the flow of such
     a bond is integrated into that position, so its hold costs one order
-    less than an effort's: second order even held constant. Every other
-    held input (efforts, plain signals) has :data:`THEORY`'s order. None
-    when nothing is held (no connections).
+    less than an effort's: second order even held constant. The effort of a
+    bond whose interface model is wired, and the model's links, are second
+    order too: the flow side integrates against the effort's first-order
+    expansion in position, velocity and time about the step's start. Every
+    other held input (efforts, plain signals) has :data:`THEORY`'s order.
+    None when nothing is held (no connections).
 
     Parameters
     ----------
@@ -101,6 +106,7 @@ def theoretical_order(scene: Scene, extrapolation: str) -> int | None:
         The scheme of the connections that do not set their own.
     """
     with_position = {b.name for b in scene.bonds if b.position is not None}
+    modelled = {b.name for b in scene.interface_bonds}
     orders = []
     for c in scene.all_connections:
         if c.role == "position":
@@ -108,6 +114,8 @@ def theoretical_order(scene: Scene, extrapolation: str) -> int | None:
         scheme = c.extrapolation or extrapolation
         if c.role == "flow" and c.bond in with_position:
             orders.append(2)
+        elif c.bond in modelled and c.role in ("effort", INTERFACE_ROLE):
+            orders.append(2)  # the effort's first-order model in x, v and t over the step
         else:
             orders.append(THEORY[scheme])
     return min(orders) if orders else None
@@ -186,7 +194,7 @@ def observed_orders(rows: Sequence[RunRow], scene: Scene, min_error: float = 0.0
             first.algorithm,
             first.extrapolation,
             first.solver,
-            theoretical_order(scene, first.extrapolation),
+            theoretical_order(coupled_scene(scene, first.coupling), first.extrapolation),
             math.nan,
             len(kept),
             tuple(r.step for r in kept),

@@ -46,6 +46,7 @@ __all__ = [
     "DEFAULT_STOP_TIME",
     "QUICK_STOP_TIME",
     "GRIDS",
+    "COUPLINGS",
     "StudySettings",
     "study_settings",
     "with_stop_time",
@@ -71,6 +72,25 @@ class StudyError(WireFmuError):
     """A study cannot be made (no reference, no key outputs, ...)."""
 
 
+COUPLINGS = {
+    "held": {"interface_models": False, "synchronise_events": False},
+    "interface": {"interface_models": True, "synchronise_events": False},
+    "synchronised": {"interface_models": False, "synchronise_events": True},
+    "interface+synchronised": {"interface_models": True, "synchronise_events": True},
+}
+"""How the units meet at a bond, by name, as the run settings that make it:
+
+``held``
+    every input held (or extrapolated) over the macro step, today's coupling;
+``interface``
+    the flow side of a bond that offers an interface model integrates its step against
+    the effort's local model (``[run] interface_models``);
+``synchronised``
+    a mode change inside a step rolls every unit back to it (``[run] synchronise_events``);
+``interface+synchronised``
+    both.
+"""
+
 GRIDS = ("slices", "product")
 """``slices``: every coupling with the scene's own solvers, and every solver with the
 scene's own coupling; ``product``: every coupling with every solver."""
@@ -92,6 +112,9 @@ class StudySettings:
         Spacing of the comparison grid, s (a multiple of every step).
     algorithms, extrapolations : tuple of str
         Coupling schemes of the grid.
+    couplings : tuple of str
+        Keys of :data:`COUPLINGS` besides the scene's own; ``interface`` ones only where a
+        bond offers an interface model.
     solvers : tuple of SolverChoice
         Internal solvers of the grid, besides the scene's own.
     grid : str
@@ -124,6 +147,7 @@ class StudySettings:
     output_interval: float
     algorithms: tuple[str, ...] = ALGORITHMS
     extrapolations: tuple[str, ...] = EXTRAPOLATIONS
+    couplings: tuple[str, ...] = tuple(COUPLINGS)
     solvers: tuple[SolverChoice, ...] = DEFAULT_SOLVERS
     grid: str = "slices"
     reference_rtol: float = 1e-10
@@ -230,15 +254,16 @@ class Configuration:
     extrapolation: str
     step: float
     solver: SolverChoice
+    coupling: str = "held"
 
     @property
     def family(self) -> str:
         """The family label: everything but the macro step."""
-        return family_label(self.algorithm, self.extrapolation, self.solver.label)
+        return family_label(self.algorithm, self.extrapolation, self.solver.label, self.coupling)
 
 
-def family_label(algorithm: str, extrapolation: str, solver: str) -> str:
-    """``"gauss_seidel / linear / ros2 h=1e-3"``.
+def family_label(algorithm: str, extrapolation: str, solver: str, coupling: str = "held") -> str:
+    """``"gauss_seidel / linear / ros2 h=1e-3"``, with `` / interface`` (etc.) appended.
 
     Parameters
     ----------
@@ -246,8 +271,47 @@ def family_label(algorithm: str, extrapolation: str, solver: str) -> str:
         The coupling scheme.
     solver : str
         The solver choice's label.
+    coupling : str
+        A key of :data:`COUPLINGS`; ``held`` is not written.
     """
-    return f"{algorithm} / {extrapolation} / {solver}"
+    label = f"{algorithm} / {extrapolation} / {solver}"
+    return label if coupling == "held" else f"{label} / {coupling}"
+
+
+def scene_coupling(scene: Scene) -> str:
+    """The key of :data:`COUPLINGS` the scene's own run settings make.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    """
+    own = {
+        "interface_models": scene.run.interface_models,
+        "synchronise_events": scene.run.synchronise_events,
+    }
+    return next(k for k, settings in COUPLINGS.items() if settings == own)
+
+
+def coupling_choices(scene: Scene, settings: StudySettings) -> list[str]:
+    """The scene's own coupling, then every other of the plan that would change a run.
+
+    ``interface`` couplings need a bond whose two ports offer an interface model.
+
+    Parameters
+    ----------
+    scene : Scene
+        The study scene.
+    settings : StudySettings
+        The plan, with its couplings.
+    """
+    own = scene_coupling(scene)
+    offered = any(b.interface for b in scene.bonds)
+    out = [own]
+    for name in settings.couplings:
+        if name not in out and (offered or not COUPLINGS[name]["interface_models"]):
+            out.append(name)
+    return out
 
 
 def solver_choices(scene: Scene, settings: StudySettings) -> list[SolverChoice]:
@@ -274,29 +338,45 @@ def build_grid(scene: Scene, settings: StudySettings) -> list[Configuration]:
     """Every configuration, family by family, each from its largest step down.
 
     ``slices`` (the default): every algorithm and extrapolation with the
-    scene's own solvers, then every other solver with the scene's own
-    algorithm and extrapolation; ``product``: every combination.
+    scene's own solvers and coupling (:data:`COUPLINGS`), then every other
+    coupling with every algorithm and the scene's own extrapolation and solvers,
+    then every other solver with the scene's own algorithm, extrapolation and
+    coupling; ``product``: every combination.
 
     Parameters
     ----------
     scene : Scene
         The study scene (its own coupling and solvers).
     settings : StudySettings
-        The plan: algorithms, extrapolations, macro steps, solvers, grid.
+        The plan: algorithms, extrapolations, couplings, macro steps, solvers, grid.
     """
     solvers = solver_choices(scene, settings)
     couplings = [(a, e) for a in settings.algorithms for e in settings.extrapolations]
     if settings.grid == "product":
         return [
-            Configuration(a, e, h, s) for s in solvers for a, e in couplings for h in settings.steps
+            Configuration(a, e, h, s, c)
+            for c in coupling_choices(scene, settings)
+            for s in solvers
+            for a, e in couplings
+            for h in settings.steps
         ]
-    own = [Configuration(a, e, h, solvers[0]) for a, e in couplings for h in settings.steps]
+    mine, *others = coupling_choices(scene, settings)
+    own = [Configuration(a, e, h, solvers[0], mine) for a, e in couplings for h in settings.steps]
     run = scene.run
-    return own + [
-        Configuration(run.algorithm, run.extrapolation, h, s)
-        for s in solvers[1:]
-        for h in settings.steps
-    ]
+    return (
+        own
+        + [
+            Configuration(a, run.extrapolation, h, solvers[0], c)
+            for c in others
+            for a in settings.algorithms
+            for h in settings.steps
+        ]
+        + [
+            Configuration(run.algorithm, run.extrapolation, h, s, mine)
+            for s in solvers[1:]
+            for h in settings.steps
+        ]
+    )
 
 
 def _solver_parameters(
@@ -331,6 +411,19 @@ def study_scene(scene: Scene, settings: StudySettings) -> Scene:
     return replace(scene, outputs=settings.key_outputs)
 
 
+def coupled_scene(scene: Scene, coupling: str) -> Scene:
+    """A copy of ``scene`` with the run settings of ``coupling`` (its bonds wired by them).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    coupling : str
+        A key of :data:`COUPLINGS`.
+    """
+    return with_run_settings(scene, **COUPLINGS[coupling])
+
+
 def configured_scene(
     scene: Scene, config: Configuration, structure: Structure | None = None
 ) -> Scene:
@@ -347,7 +440,11 @@ def configured_scene(
         have a ``solver`` variable (without it, to every unit).
     """
     scene = with_run_settings(
-        scene, step=config.step, algorithm=config.algorithm, extrapolation=config.extrapolation
+        scene,
+        step=config.step,
+        algorithm=config.algorithm,
+        extrapolation=config.extrapolation,
+        **COUPLINGS[config.coupling],
     )
     return replace(scene, units=_solver_parameters(scene, structure, config.solver))
 
