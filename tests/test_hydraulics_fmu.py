@@ -9,6 +9,7 @@ import math
 import pytest
 
 from wire_fmu.core.framework.unit import Causality
+from wire_fmu.core.units.hydraulics.interface import INTERFACE_INPUTS
 from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 from wire_fmu.core.units.hydraulics.unit import HydraulicsUnit
 from wire_fmu.export.model_description import check_units
@@ -32,7 +33,7 @@ def test_declarations_are_sound():
         if var.type is float:
             assert var.unit
     inputs = [v.name for v in HydraulicsUnit.VARIABLES if v.causality is Causality.input]
-    assert inputs == ["rod.force"]
+    assert inputs == ["rod.force", *INTERFACE_INPUTS]
     effects_doc = HydraulicsUnit.variable("effects").description
     assert all(name in effects_doc for name in HYDRAULICS_EFFECTS.names)
 
@@ -53,7 +54,7 @@ def test_rod_motion_is_a_state_with_no_direct_feedthrough():
     ):
         assert HydraulicsUnit.variable(name).depends_on == ()
     for name in ("rod.acceleration", "chamber.pressure", "seal.friction_force"):
-        assert HydraulicsUnit.variable(name).depends_on == ("rod.force",)
+        assert HydraulicsUnit.variable(name).depends_on == ("rod.force", *INTERFACE_INPUTS)
 
 
 def perturbed(unit: HydraulicsUnit, delta: float) -> tuple[dict, dict]:

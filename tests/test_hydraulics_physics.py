@@ -43,7 +43,7 @@ class TestGasSpring:
         at the equilibrium it oscillates about."""
         unit = gas_spring(effects)
         k = n * P_EQ * AREA**2 / V_EQ
-        assert unit.values["rod.stiffness"] == pytest.approx(k, rel=1e-12)
+        assert unit.values["hydraulic_stiffness"] == pytest.approx(k, rel=1e-12)
         push = -500.0
         out = run(unit, 2.5, 0.005, force=lambda t: F_EQ + push)
         p1 = P_EQ - push / AREA
@@ -262,7 +262,7 @@ class TestOilColumn:
         v_gas = 0.002 * 8.0e6 / P_EQ
         compliance = v_gas / P_EQ + oil / bulk
         k = AREA**2 / compliance
-        assert unit.values["rod.stiffness"] == pytest.approx(k, rel=1e-12)
+        assert unit.values["hydraulic_stiffness"] == pytest.approx(k, rel=1e-12)
         out = run(unit, 0.4, 0.002, force=lambda t: F_EQ - 500.0)
         assert period(out["time"], out["rod.position"]) == pytest.approx(
             2 * math.pi * math.sqrt(MASS / k), rel=2e-3

@@ -124,5 +124,9 @@ Stored: rod kinetic ``m_eff v^2/2``, line kinetic ``L q^2/2``, gas ``E(V_g)``
 ambient pressure ``s p_amb A x`` and of gravity ``-m g_rod x``. Dissipated:
 line ``R(q) q``, seal friction (sliding and viscous), cushions, stop dampers
 and relaxing pads. External work: ``force * (x1 - x0)`` per step, exact for
-the held input.
+the held input; with the effort side's interface model (the rod force
+``F = E0 - K (x - x_ref) - D (v - v_ref) + R (t - t0)`` over the step,
+:mod:`.interface`) ``E0 (x1 - x0)`` and the spring's
+``-K [(x1 - x_ref)^2 - (x0 - x_ref)^2] / 2`` exactly and the damper's and the
+rate's work as a state integrated with the step (present only in such steps).
 """

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.components.gas import PolytropicGas, isothermal_charge_volume
+from wire_fmu.core.units.hydraulics.interface import NO_INTERFACE, RodInterface
 from wire_fmu.core.units.hydraulics.limits import check_start
 
 __all__ = ["InitialState"]
@@ -20,7 +21,8 @@ class InitialState:
     """Initialisation of a cylinder model (a mixin).
 
     The model provides ``cyl``, ``sa``, ``spec``, ``line``, ``exponent``, ``layout``,
-    ``r_l``, ``r_t``, ``stops``, ``seal``, ``_settle_friction`` and ``check_limits``.
+    ``r_l``, ``r_t``, ``stops``, ``seal``, ``rod_force``, ``_settle_friction`` and
+    ``check_limits``.
     """
 
     def equilibrium_pressure(self, force: float) -> float:
@@ -35,23 +37,35 @@ class InitialState:
         return self.cyl.ambient_pressure - (force + weight) / self.sa
 
     def initialize(
-        self, force: float, *, position: float, velocity: float, gas_pressure: float | None
+        self,
+        force: float,
+        *,
+        position: float,
+        velocity: float,
+        gas_pressure: float | None,
+        interface: RodInterface = NO_INTERFACE,
     ) -> None:
-        """Set the state; ``gas_pressure`` None means static equilibrium with ``force``.
+        """Set the state; ``gas_pressure`` None means static equilibrium with the rod force.
 
         The gas was charged slowly (isothermally) from the pre-charge to the
-        initial pressure; from there on it follows ``p V^n = p0 V0^n``.
+        initial pressure; from there on it follows ``p V^n = p0 V0^n``. The rod force
+        is that of the interface model (if any) at the start: ``F(x0, v0, t0)``, with
+        ``t0`` the interface's ``start``.
 
         Parameters
         ----------
         force : float
-            External force on the rod along extension (positive pushes it out), N.
+            External force on the rod along extension (positive pushes it out) at the
+            start, ``E0``, N.
         position : float
             Rod extension, m.
         velocity : float
             Rod velocity along extension, m/s.
         gas_pressure : float or None
-            Initial absolute gas pressure, Pa; None for static equilibrium with ``force``.
+            Initial absolute gas pressure, Pa; None for static equilibrium with the rod
+            force.
+        interface : RodInterface
+            The effort side's interface model of the rod force, if any.
 
         Raises
         ------
@@ -60,7 +74,12 @@ class InitialState:
             position), listing every problem.
         """
         self.force = float(force)
-        p0 = self.equilibrium_pressure(force) if gas_pressure is None else float(gas_pressure)
+        self.interface = interface
+        self.time = interface.start
+        self.initial_position = float(position)
+        start_force = self.rod_force(self.time, float(position), float(velocity))
+        p0 = self.equilibrium_pressure(start_force) if gas_pressure is None else gas_pressure
+        p0 = float(p0)
         check_start(self, p0, position, velocity)
         acc = self.spec.accumulator
         v0 = min(
@@ -75,12 +94,11 @@ class InitialState:
             self.stops.start(position)
         if self.seal is not None:
             self.seal.start(velocity)  # a moving seal slides
-        self.initial_position = float(position)
         self.external_work = 0.0
         self.mode_changes = 0
         self.last_events = []
-        self.state = self._settle_friction(self.state, [])
-        self.check_limits(0.0, self.state)
+        self.state = self._settle_friction(self.state, [], self.time)
+        self.check_limits(self.time, self.state)
 
     def _initial_state(self, position: float, velocity: float, p0: float, v0: float) -> np.ndarray:
         lay = self.layout

@@ -11,11 +11,14 @@ array           type   contents
                        cavitation pressure, stroke, seal and stop parameters
 ``layout``      int    fixed when the model is built (``L_*`` indices): where the
                        optional states are (-1 when absent), the oil side's form and
-                       which parts (seal, stops, cushions, oil column) there are
+                       which parts (seal, stops, cushions, oil column) there are; a
+                       step with the rod's interface model takes a second layout,
+                       with the interface's work as one more state
 ``held``        float  what changes between calls (``H_*`` indices): the rod force
-                       held over the step, the seal's mode and held position, the
-                       stops' contact and cushion modes, the gas reference state,
-                       the oil compliance and the oil constant
+                       over the step (held, or the interface model's), the seal's
+                       mode and held position, the stops' contact and cushion modes,
+                       the gas reference state, the oil compliance, the oil constant
+                       and the time of the state the report and the limits are for
 ==============  =====  ===============================================================
 """
 
@@ -28,7 +31,7 @@ import numpy as np
 from wire_fmu.core.components.end_stops import EXTENDED, RETRACTED
 
 if TYPE_CHECKING:
-    from wire_fmu.core.units.hydraulics.model import HydraulicsModel
+    from wire_fmu.core.units.hydraulics.model import HydraulicsModel, Layout
 
 __all__ = ["REPORT", "kernel_data", "kernel_layout", "kernel_parameters"]
 
@@ -66,10 +69,11 @@ L_SEAL = 5  # 1 with seal friction
 L_STOPS = 6  # 1 with end stops
 L_CUSHIONS = 7  # 1 with cushion zones (end stops with cushion_length > 0)
 L_COLUMN = 8  # 1 when the line's oil column moves with the rod (inertance, rigid oil)
-N_LAYOUT = 9
+L_INTERFACE_WORK = 9  # index of the interface model's work state, or -1
+N_LAYOUT = 10
 
 # ------------------------------------------------------------ held (per call)
-H_FORCE = 0  # external rod force held over the step, N
+H_FORCE = 0  # external rod force at the step's start E0 (held without interface model), N
 H_SEAL_MODE = 1  # 0 stuck, +1/-1 sliding direction
 H_HELD_POSITION = 2  # where a stuck rod is held, m
 H_CONTACT = 3  # on the retracted stop, on the extended stop (2 entries)
@@ -78,7 +82,14 @@ H_GAS_PRESSURE = 7  # gas reference pressure p0, Pa
 H_GAS_VOLUME = 8  # gas reference volume V0, m^3
 H_COMPLIANCE = 9  # oil compliance C, m^3/Pa
 H_OIL_CONSTANT = 10  # gas volume minus s A x (rigid oil), m^3
-N_HELD = 11
+H_STIFFNESS = 11  # interface model: K = -dF/dx, N/m
+H_DAMPING = 12  # interface model: D = -dF/dv, N s/m
+H_EFFORT_RATE = 13  # interface model: R = dF/dt, N/s
+H_REFERENCE_EXTENSION = 14  # interface model: rod extension x_ref it is taken at, m
+H_REFERENCE_VELOCITY = 15  # interface model: rod velocity v_ref it is taken at, m/s
+H_STEP_START = 16  # interface model: the communication point t0 it is about, s
+H_TIME = 17  # time of the state the report and the limits are evaluated for, s
+N_HELD = 18
 
 REPORT = (
     "position",
@@ -132,20 +143,21 @@ def kernel_parameters(model: HydraulicsModel) -> np.ndarray:
     return out
 
 
-def kernel_layout(model: HydraulicsModel) -> np.ndarray:
-    """The fixed layout (``L_*``) of ``model``, built once.
+def kernel_layout(model: HydraulicsModel, lay: Layout) -> np.ndarray:
+    """The fixed layout (``L_*``) of ``model`` with the state layout ``lay``, built once.
 
     Parameters
     ----------
     model : HydraulicsModel
         The cylinder, with its seal and stops built.
+    lay : Layout
+        Where the model's states are: its own, or with the interface's work.
 
     Returns
     -------
     numpy.ndarray
         ``N_LAYOUT`` integers (see the ``L_*`` indices).
     """
-    lay = model.layout
     out = np.zeros(N_LAYOUT, dtype=np.int64)
     out[L_GAS_VOLUME], out[L_CHAMBER_PRESSURE] = lay.gas_volume, lay.chamber_pressure
     out[L_FLOW], out[L_DISSIPATED] = lay.flow, lay.dissipated
@@ -154,24 +166,27 @@ def kernel_layout(model: HydraulicsModel) -> np.ndarray:
     out[L_STOPS] = model.stops is not None
     out[L_CUSHIONS] = model.stops is not None and model.stops.spec.cushion_length > 0.0
     out[L_COLUMN] = model.has_inertance and not model.compressible
+    out[L_INTERFACE_WORK] = lay.interface_work
     return out
 
 
-def kernel_data(model: HydraulicsModel) -> tuple:
+def kernel_data(model: HydraulicsModel, time: float | None = None) -> tuple:
     """The tuple of arrays the kernel functions take, from ``model``'s present values.
 
     Parameters
     ----------
     model : HydraulicsModel
         The cylinder (see the module docstring).
+    time : float or None
+        Time the report and the limits are evaluated at, s; None: the model's ``time``.
 
     Returns
     -------
     tuple
         ``(parameters, layout, held)``; ``held`` is made afresh from the present modes,
-        rod force (N) and gas and oil references.
+        rod force (N) and its interface model, and gas and oil references.
     """
-    seal, stops, gas = model.seal, model.stops, model.gas
+    seal, stops, gas, interface = model.seal, model.stops, model.gas, model.interface
     seal_mode, held_position = (0, 0.0) if seal is None else (seal.mode, seal.held_position)
     contact, cushion = _NO_STOPS if stops is None else (stops.contact, stops.in_cushion)
     held = (
@@ -186,6 +201,13 @@ def kernel_data(model: HydraulicsModel) -> tuple:
         gas.reference_volume,
         model.compliance,
         model.oil_constant,
+        interface.stiffness,
+        interface.damping,
+        interface.effort_rate,
+        interface.reference_extension(model.initial_position),
+        interface.reference_velocity,
+        interface.start,
+        model.time if time is None else time,
     )
     return model.kernel_parameters, model.kernel_layout, np.array(held, dtype=np.float64)
 

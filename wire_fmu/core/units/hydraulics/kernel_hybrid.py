@@ -84,6 +84,8 @@ def derivative_into(out: np.ndarray, point: Point, acc: float, friction_loss: fl
         pressure = point.gas_pressure - point.chamber_pressure - drop
         out[c.flow_index] = pressure / c.inertance
     out[c.dissipated_index] = point.loss + friction_loss
+    if c.interface_index >= 0:
+        out[c.interface_index] = 0.0 if stuck else point.interface_power
 
 
 @jit
@@ -100,7 +102,7 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
         ``(parameters, layout, held)`` (see :mod:`.kernel_arrays`).
     """
     c = cylinder(data)
-    point = evaluate(x, c)
+    point = evaluate(t, x, c)
     acc, _, friction_loss = accelerate(point, c)
     out = np.empty_like(x)
     derivative_into(out, point, acc, friction_loss, c)
@@ -196,7 +198,7 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
         One value per guard, in the order of the module docstring.
     """
     c = cylinder(data)
-    point = evaluate(x, c)
+    point = evaluate(t, x, c)
     acc, link, _ = accelerate(point, c)
     out = np.empty(guard_count(data[1]))
     guards_into(out, point, acc, link, c)
@@ -228,7 +230,8 @@ def first_limit(values: np.ndarray, c: Cylinder) -> int:
 def limits_and_force(x: np.ndarray, data) -> tuple[int, float]:
     """The first limit guard already below zero at ``x`` (-1: none) and the force on the rod.
 
-    The force is every force on the rod but seal friction and the column's inertia, N.
+    The force is every force on the rod but seal friction and the column's inertia, N, at
+    the time ``data`` holds (``H_TIME``: the step's start, or an event's time).
 
     Parameters
     ----------
@@ -238,7 +241,7 @@ def limits_and_force(x: np.ndarray, data) -> tuple[int, float]:
         ``(parameters, layout, held)`` (see :mod:`.kernel_arrays`).
     """
     c = cylinder(data)
-    point = evaluate(x, c)
+    point = evaluate(c.time, x, c)
     acc, link, _ = accelerate(point, c)
     values = np.empty(guard_count(data[1]))
     guards_into(values, point, acc, link, c)
@@ -330,6 +333,9 @@ def report_into(out: np.ndarray, point: Point, acc: float, link: float, c: Cylin
 def report(x: np.ndarray, data) -> np.ndarray:
     """The quantities of ``REPORT`` at ``x``, in one array (one crossing back to Python).
 
+    Evaluated at the time ``data`` holds (``H_TIME``), which the interface model's rod
+    force depends on.
+
     Parameters
     ----------
     x : numpy.ndarray
@@ -343,7 +349,7 @@ def report(x: np.ndarray, data) -> np.ndarray:
         See :func:`report_into`.
     """
     c = cylinder(data)
-    point = evaluate(x, c)
+    point = evaluate(c.time, x, c)
     acc, link, _ = accelerate(point, c)
     out = np.empty(len(REPORT))
     report_into(out, point, acc, link, c)

@@ -23,18 +23,26 @@ from wire_fmu.core.units.hydraulics.kernel_arrays import (
     H_COMPLIANCE,
     H_CONTACT,
     H_CUSHION,
+    H_DAMPING,
+    H_EFFORT_RATE,
     H_FORCE,
     H_GAS_PRESSURE,
     H_GAS_VOLUME,
     H_HELD_POSITION,
     H_OIL_CONSTANT,
+    H_REFERENCE_EXTENSION,
+    H_REFERENCE_VELOCITY,
     H_SEAL_MODE,
+    H_STEP_START,
+    H_STIFFNESS,
+    H_TIME,
     L_CHAMBER_PRESSURE,
     L_COLUMN,
     L_CUSHIONS,
     L_DISSIPATED,
     L_FLOW,
     L_GAS_VOLUME,
+    L_INTERFACE_WORK,
     L_OIL_FORM,
     L_SEAL,
     L_STOPS,
@@ -74,7 +82,9 @@ __all__ = [
     "cylinder",
     "evaluate",
     "gas_pressure",
+    "interface_power",
     "line_drop",
+    "rod_force",
     "seal_stuck",
     "stored_energy",
 ]
@@ -114,6 +124,7 @@ Cylinder = namedtuple(
         "stops",
         "cushions",
         "column",
+        "interface_index",
         # per call, from ``held`` (see the H_* indices)
         "force",
         "seal_mode",
@@ -126,6 +137,13 @@ Cylinder = namedtuple(
         "reference_volume",
         "compliance",
         "oil_constant",
+        "stiffness",
+        "damping",
+        "effort_rate",
+        "reference_extension",
+        "reference_velocity",
+        "step_start",
+        "time",
     ),
 )
 """Everything the equations need, as named scalars (:func:`cylinder`)."""
@@ -172,6 +190,7 @@ def cylinder(data) -> Cylinder:
         lay[L_STOPS],
         lay[L_CUSHIONS],
         lay[L_COLUMN],
+        lay[L_INTERFACE_WORK],
         held[H_FORCE],
         held[H_SEAL_MODE],
         held[H_HELD_POSITION],
@@ -183,6 +202,13 @@ def cylinder(data) -> Cylinder:
         held[H_GAS_VOLUME],
         held[H_COMPLIANCE],
         held[H_OIL_CONSTANT],
+        held[H_STIFFNESS],
+        held[H_DAMPING],
+        held[H_EFFORT_RATE],
+        held[H_REFERENCE_EXTENSION],
+        held[H_REFERENCE_VELOCITY],
+        held[H_STEP_START],
+        held[H_TIME],
     )
 
 
@@ -203,6 +229,7 @@ Point = namedtuple(
         "trial_extended",
         "loss",
         "stored",
+        "interface_power",
     ),
 )
 """The model at one state (see ``hydraulics.reference_physics._Point``; ``stored`` without
@@ -318,13 +345,59 @@ def _stop_forces(pos: float, vel: float, c: Cylinder):
 
 
 @jit
-def evaluate(x: np.ndarray, c: Cylinder) -> Point:
+def rod_force(t: float, pos: float, vel: float, c: Cylinder) -> float:
+    """The external rod force ``F(x, v, t)`` over the step, N (``RodInterface.force``).
+
+    ``E0 - K (x - x_ref) - D (v - v_ref) + R (t - t0)``, each term added only when its
+    coefficient is nonzero: without the interface model the held force, bit for bit.
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    pos, vel : float
+        Rod extension (m) and velocity (m/s).
+    c : Cylinder
+        The cylinder (:func:`cylinder`).
+    """
+    force = c.force
+    if c.stiffness != 0.0:
+        force = force - c.stiffness * (pos - c.reference_extension)
+    if c.damping != 0.0:
+        force = force - c.damping * (vel - c.reference_velocity)
+    if c.effort_rate != 0.0:
+        force = force + c.effort_rate * (t - c.step_start)
+    return force
+
+
+@jit
+def interface_power(t: float, vel: float, c: Cylinder) -> float:
+    """Power of the interface model's damper and rate terms into the rod, W
+    (``RodInterface.power``).
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    vel : float
+        Rod velocity, m/s.
+    c : Cylinder
+        The cylinder (:func:`cylinder`).
+    """
+    return (c.effort_rate * (t - c.step_start) - c.damping * (vel - c.reference_velocity)) * vel
+
+
+@jit
+def evaluate(t: float, x: np.ndarray, c: Cylinder) -> Point:
     """Pressures, flow, forces and losses at state ``x`` (``HydraulicsModel.evaluate``).
 
     Parameters
     ----------
+    t : float
+        Time, s (the rod force of the interface model varies with it).
     x : numpy.ndarray
-        State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+        State ``[x, v, (V_g, p_c, q), dissipated, (interface work)]`` (m, m/s, m^3, Pa,
+        m^3/s, J, J).
     c : Cylinder
         The cylinder (:func:`cylinder`).
 
@@ -346,8 +419,9 @@ def evaluate(x: np.ndarray, c: Cylinder) -> Point:
     if c.stops:
         stop_force, depth_r, depth_e, trial_r, trial_e, stop_loss, _ = _stop_forces(pos, vel, c)
     viscous = c.viscous
-    force = c.force + hydraulic + c.weight + stop_force - viscous * vel
+    force = rod_force(t, pos, vel, c) + hydraulic + c.weight + stop_force - viscous * vel
     loss += stop_loss + viscous * vel * vel
+    power = interface_power(t, vel, c) if c.interface_index >= 0 else 0.0
     return Point(
         pos,
         vel,
@@ -363,6 +437,7 @@ def evaluate(x: np.ndarray, c: Cylinder) -> Point:
         trial_e,
         loss,
         stored,
+        power,
     )
 
 

@@ -17,9 +17,12 @@ with the same stage arithmetic element for element, but
   bits) each get their ``(I - g h J)^-1`` once, kept while the call lasts, instead of
   once every time the length changes: the same matrices, made fewer times;
 * every state is evaluated once: the guards at the end of a step, the first stage of the
-  next (the right-hand side does not depend on time) and the report at the end of the
-  communication step come from one evaluation, as do the limits, the Jacobian's base
-  point, the first guards and the first stage at the start;
+  next and the report at the end of the communication step come from one evaluation, as
+  do the limits, the Jacobian's base point, the first guards and the first stage at the
+  start (the shared loop evaluates the guards at ``t + h`` and the next step's first
+  stage at the grid's ``t_next``: with the interface model's rate the right-hand side
+  depends on time, and where the two differ in their last bit the first stage is
+  evaluated again at ``t_next``);
 * the products with ``(I - g h J)^-1`` go into those arrays (the same BLAS ``gemv``).
 
 The results are those of the shared loop to the last bit: the same numbers in the same
@@ -68,20 +71,20 @@ communication step usually has two or three)."""
 
 
 @jit
-def _slope_into(x: np.ndarray, out: np.ndarray, c: Cylinder) -> None:
-    """The state derivative at ``x`` into ``out`` (what ``kernel_hybrid.rhs`` returns)."""
-    point = evaluate(x, c)
+def _slope_into(t: float, x: np.ndarray, out: np.ndarray, c: Cylinder) -> None:
+    """The state derivative at ``(t, x)`` into ``out`` (what ``kernel_hybrid.rhs`` returns)."""
+    point = evaluate(t, x, c)
     acc, _, friction_loss = accelerate(point, c)
     derivative_into(out, point, acc, friction_loss, c)
 
 
 @jit
-def _evaluate_into(x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cylinder):
-    """Evaluate at ``x`` once: its derivative into ``slope``, its guards into ``values``.
+def _evaluate_into(t: float, x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cylinder):
+    """Evaluate at ``(t, x)`` once: its derivative into ``slope``, its guards into ``values``.
 
     Returns the point, the acceleration (m/s^2) and the seal force (N), for the report.
     """
-    point = evaluate(x, c)
+    point = evaluate(t, x, c)
     acc, link, friction_loss = accelerate(point, c)
     derivative_into(slope, point, acc, friction_loss, c)
     guards_into(values, point, acc, link, c)
@@ -89,14 +92,14 @@ def _evaluate_into(x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cyli
 
 
 @jit
-def _jacobian_into(jac, x, f0, probe, slope, c: Cylinder) -> None:
-    """Forward-difference Jacobian at ``x`` with ``f0`` the slope there (``_jacobian``)."""
+def _jacobian_into(jac, t, x, f0, probe, slope, c: Cylinder) -> None:
+    """Forward-difference Jacobian at ``(t, x)`` with ``f0`` the slope there (``_jacobian``)."""
     n = x.size
     for j in range(n):
         dx = 1e-7 * max(1.0, abs(x[j]))
         probe[:] = x
         probe[j] += dx
-        _slope_into(probe, slope, c)
+        _slope_into(t, probe, slope, c)
         for i in range(n):
             jac[i, j] = (slope[i] - f0[i]) / dx
 
@@ -126,13 +129,13 @@ def _kept(lengths: np.ndarray, h: float) -> int:
 
 
 @jit
-def _ros2_step(out, state, slope, h, w_inv, stage, k1, rest, k2, c: Cylinder) -> None:
-    """One ROS2 step of length ``h`` from ``state`` (slope there: ``slope``) into ``out``."""
+def _ros2_step(out, t, state, slope, h, w_inv, stage, k1, rest, k2, c: Cylinder) -> None:
+    """One ROS2 step of length ``h`` from ``(t, state)`` (slope there: ``slope``) into ``out``."""
     n = state.size
     np.dot(w_inv, slope, k1)
     for i in range(n):
         stage[i] = state[i] + h * k1[i]
-    _slope_into(stage, rest, c)
+    _slope_into(t + h, stage, rest, c)
     for i in range(n):
         rest[i] = rest[i] - 2.0 * k1[i]
     np.dot(w_inv, rest, k2)
@@ -141,19 +144,19 @@ def _ros2_step(out, state, slope, h, w_inv, stage, k1, rest, k2, c: Cylinder) ->
 
 
 @jit
-def _rk4_step(out, state, slope, h, stage, k2, k3, k4, c: Cylinder) -> None:
-    """One RK4 step of length ``h`` from ``state`` (slope there: ``slope``) into ``out``."""
+def _rk4_step(out, t, state, slope, h, stage, k2, k3, k4, c: Cylinder) -> None:
+    """One RK4 step of length ``h`` from ``(t, state)`` (slope there: ``slope``) into ``out``."""
     n = state.size
     half = 0.5 * h
     for i in range(n):
         stage[i] = state[i] + half * slope[i]
-    _slope_into(stage, k2, c)
+    _slope_into(t + 0.5 * h, stage, k2, c)
     for i in range(n):
         stage[i] = state[i] + half * k2[i]
-    _slope_into(stage, k3, c)
+    _slope_into(t + 0.5 * h, stage, k3, c)
     for i in range(n):
         stage[i] = state[i] + h * k3[i]
-    _slope_into(stage, k4, c)
+    _slope_into(t + h, stage, k4, c)
     sixth = h / 6.0
     for i in range(n):
         out[i] = state[i] + sixth * (slope[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -219,15 +222,15 @@ def quiet_step(method, t0, t1, n, x, directions, data):
     made = 0
     values = np.empty((2, guard_count(data[1])))
     g0, g1 = values[0], values[1]
-    point, acc, link = _evaluate_into(x, slope, g0, c)
+    point, acc, link = _evaluate_into(t0, x, slope, g0, c)
     if first_limit(g0, c) >= 0 or breaks_away(point.force, c):
         return False, x, nothing
     state[:] = x
     if seal_stuck(c):  # the rod is held where it stuck, at rest: evaluate it there
         hold(state, c)
-        point, acc, link = _evaluate_into(state, slope, g0, c)
+        point, acc, link = _evaluate_into(t0, state, slope, g0, c)
     if method == _ROS2:
-        _jacobian_into(jac, state, slope, stage, first, c)
+        _jacobian_into(jac, t0, state, slope, stage, first, c)
     t = t0
     for k in range(n):
         t_next = t0 + (t1 - t0) * (k + 1) / n
@@ -240,15 +243,17 @@ def quiet_step(method, t0, t1, n, x, directions, data):
                 lengths[kept] = h
                 made += 1
             w_inv = matrices[2 + kept]
-            _ros2_step(following, state, slope, h, w_inv, stage, first, second, third, c)
+            _ros2_step(following, t, state, slope, h, w_inv, stage, first, second, third, c)
         else:
-            _rk4_step(following, state, slope, h, stage, first, second, third, c)
+            _rk4_step(following, t, state, slope, h, stage, first, second, third, c)
         hold(following, c)
         if not _finite(following):
             return False, x, nothing
-        point, acc, link = _evaluate_into(following, slope, g1, c)
+        point, acc, link = _evaluate_into(t + h, following, slope, g1, c)
         if _fired(g0, g1, directions):
             return False, x, nothing
+        if t + h != t_next:  # the shared loop's next first stage is at the grid's time
+            _slope_into(t_next, following, slope, c)
         state, following = following, state
         g0, g1 = g1, g0
         t = t_next

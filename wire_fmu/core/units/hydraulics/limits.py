@@ -48,7 +48,7 @@ def limit_message(model: HydraulicsModel, kind: str, end: int, x: np.ndarray, t:
             f"{acc.full_volume:.6g} m3 at t = {t:.9g} s: no oil left to feed the cylinder"
         )
     if kind == "cavitation":
-        point = model.evaluate(x)
+        point = model.evaluate(t, x)
         p_c = model.chamber_pressure(point, model._accelerate(point)[0])
         return (
             f"chamber pressure {p_c:.6g} Pa fell to the cavitation pressure "

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.units.hydraulics import kernel
 from wire_fmu.core.units.hydraulics.initial_state import InitialState
+from wire_fmu.core.units.hydraulics.interface import NO_INTERFACE, RodInterface
 from wire_fmu.core.units.hydraulics.limits import limit_message
 from wire_fmu.core.units.hydraulics.oil_side import OilSide
 from wire_fmu.core.units.hydraulics.reference_physics import ReferencePhysics
@@ -56,6 +57,8 @@ __all__ = [
     "HydraulicsSpec",
     "HydraulicsModel",
     "HydraulicLimitError",
+    "Layout",
+    "RodInterface",
     "restitution_of_damping_ratio",
     "damping_ratio_for_restitution",
 ]
@@ -95,14 +98,19 @@ class HydraulicLimitError(ModelError):
 
 # ------------------------------------------------------------------ the model
 @dataclass(frozen=True)
-class _Layout:
-    """Indices of the optional states (-1 when absent)."""
+class Layout:
+    """Indices of the optional states (-1 when absent) and the number of states.
+
+    ``interface_work`` is the work of the interface model's damper and rate terms, a
+    state only while a step with the model is taken (it starts at 0 J each step).
+    """
 
     gas_volume: int
     chamber_pressure: int
     flow: int
     dissipated: int
     size: int
+    interface_work: int = -1
 
 
 class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, RefinedStepping):
@@ -138,7 +146,13 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         column = self.has_inertance and not self.compressible  # moves with the rod
         self.mass = self.cyl.moving_mass + (self.inertance * self.area**2 if column else 0.0)
         self.exponent = spec.accumulator.polytropic_exponent if self.polytropic else ISOTHERMAL
-        self.layout = self._build_layout()
+        self.own_layout = self._build_layout()
+        """Where the states are between steps (and in steps with the force held)."""
+        self.interface_layout = replace(
+            self.own_layout, interface_work=self.own_layout.size, size=self.own_layout.size + 1
+        )
+        """Where the states are in a step with the interface model: one more, its work."""
+        self.layout = self.own_layout
         self._oil_side = self._choose_oil_side()
         self.seal = RodSeal(spec.seal, self.mass) if "seal_friction" in effects else None
         self._viscous = self.seal.viscous if self.seal is not None else 0.0
@@ -150,9 +164,12 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         )
         self.compiled = use_compiled("hydraulic cylinder")  # the kernel covers every effect set
         self.kernel_parameters = kernel.kernel_parameters(self)
-        self.kernel_layout = kernel.kernel_layout(self)
+        self._kernel_layouts = {
+            lay: kernel.kernel_layout(self, lay) for lay in (self.own_layout, self.interface_layout)
+        }
+        self.kernel_layout = self._kernel_layouts[self.layout]
         self.step_report: tuple | None = None
-        """``(state, force, report values)`` of the state a quiet step ended in, or None."""
+        """``(state, load, report values)`` of the state a quiet step ended in, or None."""
         self.solver = self.kernel_solver(solver)
         self.contact_solver = self._make_contact_solver(solver)
         self._current_resolution = "coarse"
@@ -164,6 +181,11 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         self.oil_constant = 0.0
         self.state = np.zeros(self.layout.size)
         self.force = 0.0
+        """``E0``: the rod force at the step's start, held over it without interface model, N."""
+        self.interface: RodInterface = NO_INTERFACE
+        """The effort side's interface model of the rod force over the step."""
+        self.time = 0.0
+        """Time of :attr:`state`, s (the report and the limits are evaluated there)."""
         self.mode_changes = 0
         self.external_work = 0.0
         self.initial_position = 0.0
@@ -177,7 +199,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         self.has_inertance = "line_inertance" in effects
         self.compressible = "oil_compressibility" in effects
 
-    def _build_layout(self) -> _Layout:
+    def _build_layout(self) -> Layout:
         index = 2
         gas = p_c = flow = -1
         if self.compressible:
@@ -186,7 +208,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
                 p_c, index = index, index + 1
             if self.has_inertance:
                 flow, index = index, index + 1
-        return _Layout(gas, p_c, flow, index, index + 1)
+        return Layout(gas, p_c, flow, index, index + 1)
 
     def _build_guards(self) -> list[tuple[str, int]]:
         kinds = [("seal", 0)] if self.seal is not None else []
@@ -201,6 +223,18 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
     def n_states(self) -> int:
         """Number of continuous states, dissipated energy included."""
         return self.layout.size
+
+    def use_layout(self, lay: Layout) -> None:
+        """Take the states as ``lay`` places them (:attr:`own_layout` or
+        :attr:`interface_layout`); the state's length is the caller's.
+
+        Parameters
+        ----------
+        lay : Layout
+            One of the model's two layouts.
+        """
+        self.layout = lay
+        self.kernel_layout = self._kernel_layouts[lay]
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -264,6 +298,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
             If a limit guard fired.
         """
         self.first_event_time = min(self.first_event_time, t)
+        self.time = t
         x = np.array(x, dtype=float)
         seal_fired = []
         kinks_only = True
@@ -278,7 +313,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
                 self.last_events.append(self.stops.switch(kind, end, t))
             else:
                 raise HydraulicLimitError(limit_message(self, kind, end, x, t))
-        x = self._settle_friction(x, seal_fired)
+        x = self._settle_friction(x, seal_fired, t)
         if not kinks_only:
             logger.debug("t = %.9g s: events so far this step: %s", t, "; ".join(self.last_events))
         self.mode_changes += 0 if kinks_only else 1
@@ -308,14 +343,14 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
 
     # ------------------------------------------------------------ modes
     def _settle_friction(
-        self, x: np.ndarray, fired: list[int], force: float | None = None
+        self, x: np.ndarray, fired: list[int], t: float, force: float | None = None
     ) -> np.ndarray:
-        """Make the seal's mode consistent with the forces at ``x`` (``force``: on the rod, N,
-        if already known)."""
+        """Make the seal's mode consistent with the forces at ``(t, x)`` (``force``: on the
+        rod, N, if already known)."""
         if self.seal is None:
             return x
         if force is None:
-            force = self._limits_and_force(x)[1]
+            force = self._limits_and_force(x, t)[1]
         x[1], event = self.seal.settle(float(x[0]), float(x[1]), force, fired)
         if event:
             self.last_events.append(event)
@@ -331,7 +366,7 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         x : numpy.ndarray
             State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
         """
-        self._refuse_at_limit(self._limits_and_force(x)[0], t, x)
+        self._refuse_at_limit(self._limits_and_force(x, t)[0], t, x)
 
     def _refuse_at_limit(self, violated: int, t: float, x: np.ndarray) -> None:
         """Raise :class:`HydraulicLimitError` for guard ``violated`` (nothing for -1)."""
@@ -339,21 +374,27 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
             kind, end = self._guard_kinds[violated]
             raise HydraulicLimitError(limit_message(self, kind, end, x, t))
 
-    def _limits_and_force(self, x: np.ndarray) -> tuple[int, float]:
-        """The first limit guard already violated at ``x`` (-1: none) and the force on the rod.
+    def _limits_and_force(self, x: np.ndarray, t: float) -> tuple[int, float]:
+        """The first limit guard already violated at ``(t, x)`` (-1: none) and the force on
+        the rod.
 
         The force is every force but seal friction and the column's inertia, N (what the
-        seal must hold).
+        seal must hold), with the rod force of the interface model at ``t``.
         """
         if self.compiled:
-            return kernel.limits_and_force(x, self.kernel_data())
-        return self._reference_limits_and_force(x)
+            return kernel.limits_and_force(x, kernel.kernel_data(self, t))
+        return self._reference_limits_and_force(x, t)
+
+    @property
+    def load(self) -> tuple[float, RodInterface, float]:
+        """What the report depends on besides the state: rod force, interface model, time."""
+        return self.force, self.interface, self.time
 
     def _report_values(self) -> list[float]:
         """The compiled kernel's report of the present state (that of the last quiet step if
-        the state and force are still those it ended with)."""
+        the state and load are still those it ended with)."""
         kept = self.step_report
-        if kept is not None and kept[0] is self.state and kept[1] == self.force:
+        if kept is not None and kept[0] is self.state and kept[1] == self.load:
             return kept[2]
         return kernel.report(self.state, self.kernel_data()).tolist()
 

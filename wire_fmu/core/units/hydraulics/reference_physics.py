@@ -42,15 +42,17 @@ class _Point:
     trial: tuple[float, float]
     loss: float
     stored: float
+    interface_power: float  # of the interface model's damper and rate terms, W
 
 
 class ReferencePhysics:
     """The equations of a cylinder model in Python (a mixin).
 
     The model provides ``layout``, ``oil_constant``, ``sa``, ``spec``, ``cyl``, ``gas``,
-    ``force``, ``stops``, ``seal``, ``mass``, ``_viscous``, ``_oil_side``,
-    ``has_inertance``, ``compressible``, ``inertance``, ``r_l``, ``r_t``, ``compliance``,
-    ``area``, ``state`` and ``_guard_kinds``.
+    ``force``, ``interface``, ``initial_position``, ``time``, ``stops``, ``seal``,
+    ``mass``, ``_viscous``, ``_oil_side``, ``has_inertance``, ``compressible``,
+    ``inertance``, ``r_l``, ``r_t``, ``compliance``, ``area``, ``state`` and
+    ``_guard_kinds``.
     """
 
     def gas_volume(self, x: np.ndarray) -> float:
@@ -65,13 +67,31 @@ class ReferencePhysics:
             return float(x[self.layout.gas_volume])
         return self.oil_constant + self.sa * float(x[0])
 
-    def evaluate(self, x: np.ndarray, energy: bool = False) -> _Point:
-        """Pressures, flow, forces, losses (and stored energy if ``energy``) at state ``x``.
+    def rod_force(self, t: float, pos: float, vel: float) -> float:
+        """The external rod force ``F(x, v, t)`` over the step: held or the interface
+        model's (:meth:`RodInterface.force <.interface.RodInterface.force>`), N.
 
         Parameters
         ----------
+        t : float
+            Time, s.
+        pos, vel : float
+            Rod extension (m) and velocity (m/s).
+        """
+        interface = self.interface
+        x_ref = interface.reference_extension(self.initial_position)
+        return interface.force(self.force, t, pos, vel, x_ref)
+
+    def evaluate(self, t: float, x: np.ndarray, energy: bool = False) -> _Point:
+        """Pressures, flow, forces, losses (and stored energy if ``energy``) at ``(t, x)``.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the interface model's rod force varies with it).
         x : numpy.ndarray
-            State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
+            State ``[x, v, (V_g, p_c, q), dissipated, (interface work)]`` (m, m/s, m^3,
+            Pa, m^3/s, J, J).
         energy : bool
             Also compute the stored energy (J).
 
@@ -80,7 +100,8 @@ class ReferencePhysics:
         _Point
             Rod position (m) and velocity (m/s), gas volume (m^3) and pressure (Pa),
             chamber pressure (Pa), line flow (m^3/s), forces on the rod (N), stop
-            depths (m), loss power (W) and stored energy (J, 0 without ``energy``).
+            depths (m), loss power (W), stored energy (J, 0 without ``energy``) and the
+            interface model's power (W, 0 without its work state).
         """
         pos, vel = float(x[0]), float(x[1])
         v_gas = self.gas_volume(x)
@@ -92,8 +113,10 @@ class ReferencePhysics:
             _NO_STOP if self.stops is None else self.stops.forces(pos, vel)
         )
         weight = self.cyl.moving_mass * self.cyl.gravity_along_rod
-        force = self.force + hydraulic + weight + stop_force - self._viscous * vel
+        force = self.rod_force(t, pos, vel) + hydraulic + weight + stop_force
+        force = force - self._viscous * vel
         loss += stop_loss + self._viscous * vel * vel
+        power = self.interface.power(t, vel) if self.layout.interface_work >= 0 else 0.0
         if energy:
             stored += (
                 0.5 * self.mass * vel * vel
@@ -116,6 +139,7 @@ class ReferencePhysics:
             trial,
             loss,
             stored,
+            power,
         )
 
     def _accelerate(self, point: _Point) -> tuple[float, float, float]:
@@ -148,7 +172,7 @@ class ReferencePhysics:
         x : numpy.ndarray
             State ``[x, v, (V_g, p_c, q), dissipated]`` (m, m/s, m^3, Pa, m^3/s, J).
         """
-        point = self.evaluate(x)
+        point = self.evaluate(t, x)
         acc, _, friction_loss = self._accelerate(point)
         lay = self.layout
         out = np.empty_like(x)
@@ -163,6 +187,8 @@ class ReferencePhysics:
             drop = (self.r_l + self.r_t * abs(point.flow)) * point.flow
             out[lay.flow] = (point.gas_pressure - point.chamber_pressure - drop) / self.inertance
         out[lay.dissipated] = point.loss + friction_loss
+        if lay.interface_work >= 0:
+            out[lay.interface_work] = 0.0 if stuck else point.interface_power
         return out
 
     def _reference_guards(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -181,7 +207,7 @@ class ReferencePhysics:
             One value per guard (seal, gas, cavitation, stroke or stops); see
             ``guard_directions``.
         """
-        point = self.evaluate(x)
+        point = self.evaluate(t, x)
         acc, link, _ = self._accelerate(point)
         return np.array(
             [self._guard(kind, end, point, acc, link) for kind, end in self._guard_kinds]
@@ -201,13 +227,14 @@ class ReferencePhysics:
             return point.x if end == RETRACTED else self.cyl.stroke - point.x
         return self.stops.guard(kind, end, point.x, point.depth, point.trial)
 
-    def _reference_limits_and_force(self, x: np.ndarray) -> tuple[int, float]:
-        """The first limit guard already violated at ``x`` (-1: none) and the force on the rod.
+    def _reference_limits_and_force(self, x: np.ndarray, t: float) -> tuple[int, float]:
+        """The first limit guard already violated at ``(t, x)`` (-1: none) and the force on
+        the rod.
 
         The force is every force but seal friction and the column's inertia, N (what the
         seal must hold).
         """
-        point = self.evaluate(x)
+        point = self.evaluate(t, x)
         acc, link, _ = self._accelerate(point)
         for i, (kind, end) in enumerate(self._guard_kinds):
             if kind in _LIMITS and self._guard(kind, end, point, acc, link) < 0.0:
@@ -216,7 +243,7 @@ class ReferencePhysics:
 
     def _reference_report(self) -> dict[str, float]:
         """Physical quantities at the current state, for outputs (keys: ``kernel.REPORT``)."""
-        point = self.evaluate(self.state, energy=True)
+        point = self.evaluate(self.time, self.state, energy=True)
         acc, link, _ = self._accelerate(point)
         if self.seal is not None and self.seal.stuck:
             acc = 0.0

@@ -9,6 +9,12 @@ on the state and the step (bit-reproducible). :class:`RefinedStepping` is the
 part of :class:`~wire_fmu.core.units.hydraulics.model.HydraulicsModel` that
 does this.
 
+With the effort side's interface model (:mod:`.interface`) the rod force varies over
+the step, ``F(x, v, t)``; the step is then taken in the model's
+:attr:`~wire_fmu.core.units.hydraulics.model.HydraulicsModel.interface_layout`, whose
+last state integrates the power of the model's damper and rate terms, so that the
+work through the rod is booked exactly for the force the rod saw.
+
 With the compiled kernel (:mod:`~wire_fmu.core.units.hydraulics.kernel`) every
 fixed-step solver the cylinder makes is a
 :class:`~wire_fmu.core.framework.compiled_step.CompiledFixedStep`, and a step in
@@ -28,6 +34,7 @@ from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
 from wire_fmu.core.framework.hybrid import SolverSettings
 from wire_fmu.core.framework.step_limits import IntegrationError, internal_steps
 from wire_fmu.core.units.hydraulics import kernel
+from wire_fmu.core.units.hydraulics.interface import NO_INTERFACE, RodInterface
 
 __all__ = [
     "CONTACT_CHUNK_STEPS",
@@ -70,9 +77,11 @@ _FIXED_STEP = ("rk4", "ros2")
 class RefinedStepping:
     """Advance, settle and the refined integration of a cylinder model (a mixin).
 
-    The model provides ``state``, ``force``, ``settings``, ``solver``, ``stops``, ``seal``,
-    ``mass``, ``spec``, ``compiled``, ``step_report``, ``kernel_data``, ``project``,
-    ``_directions``, ``_limits_and_force``, ``_refuse_at_limit`` and ``_settle_friction``.
+    The model provides ``state``, ``force``, ``interface``, ``time``, ``initial_position``,
+    ``own_layout``, ``interface_layout``, ``use_layout``, ``load``, ``settings``,
+    ``solver``, ``stops``, ``seal``, ``mass``, ``spec``, ``compiled``, ``step_report``,
+    ``kernel_data``, ``project``, ``_directions``, ``_limits_and_force``,
+    ``_refuse_at_limit`` and ``_settle_friction``.
     """
 
     def _make_contact_solver(self, settings: SolverSettings):
@@ -95,8 +104,14 @@ class RefinedStepping:
         return self.kernel_solver(replace(settings, max_step=fine))
 
     # -------------------------------------------------------------- stepping
-    def advance(self, t: float, h: float, force: float) -> int:
-        """Advance from ``t`` by ``h`` (s) with the rod ``force`` (N) held; return events.
+    def advance(
+        self, t: float, h: float, force: float, interface: RodInterface = NO_INTERFACE
+    ) -> int:
+        """Advance from ``t`` by ``h`` (s) against the rod force; return the events.
+
+        The rod force is ``force`` held, or with ``interface`` the local model
+        ``F(x, v, t)`` about ``t`` (:mod:`.interface`); its work is added to
+        :attr:`external_work`.
 
         Parameters
         ----------
@@ -105,7 +120,11 @@ class RefinedStepping:
         h : float
             Step length, s.
         force : float
-            External force on the rod along extension (positive pushes it out), N.
+            External force on the rod along extension (positive pushes it out) at ``t``,
+            ``E0``, N.
+        interface : RodInterface
+            The effort side's interface model of the force over the step (its ``start``
+            is taken as ``t``).
 
         Returns
         -------
@@ -120,16 +139,47 @@ class RefinedStepping:
         self.last_events = []
         self.first_event_time = math.inf
         self.force = float(force)
+        self.interface = replace(interface, start=float(t)) if interface.active else NO_INTERFACE
+        self.time = t
         self.step_report = None
         start = float(self.state[0])
-        events = 0
-        if not self._quiet_step(t, t + h):
-            violated, rod_force = self._limits_and_force(self.state)
+        if not self.interface.active:
+            events = self._step(t, t + h)
+            self.external_work += self.force * (float(self.state[0]) - start)
+            return events
+        self.state = np.append(self.state, 0.0)  # the interface model's work, J
+        self.use_layout(self.interface_layout)
+        try:
+            events = self._step(t, t + h)
+        finally:
+            self.use_layout(self.own_layout)
+            self.state, varying = self.state[:-1], float(self.state[-1])
+        if self.step_report is not None:  # the report does not depend on the work state
+            self.step_report = (self.state, *self.step_report[1:])
+        self.external_work += self._interface_work(start, float(self.state[0]), varying)
+        return events
+
+    def _step(self, t: float, t_end: float) -> int:
+        """Integrate from ``t`` to ``t_end`` (s) in the present layout; the events located."""
+        try:
+            if self._quiet_step(t, t_end):
+                return 0
+            violated, rod_force = self._limits_and_force(self.state, t)
             self._refuse_at_limit(violated, t, self.state)
             self.state = self.settle(self.state, rod_force)
-            self.state, events = self._integrate(t, self.state, t + h)
-        self.external_work += self.force * (float(self.state[0]) - start)
-        return events
+            self.state, events = self._integrate(t, self.state, t_end)
+            return events
+        finally:
+            self.time = t_end
+
+    def _interface_work(self, x0: float, x1: float, varying: float) -> float:
+        """Work of the interface model's force on a rod moved from ``x0`` to ``x1`` (m), J.
+
+        ``E0 (x1 - x0)`` and the spring's work exactly; ``varying`` (J) is the damper's
+        and the rate's, as the step's solver integrated it.
+        """
+        x_ref = self.interface.reference_extension(self.initial_position)
+        return self.force * (x1 - x0) + self.interface.elastic_work(x0, x1, x_ref) + varying
 
     def _quiet_step(self, t: float, t_end: float) -> bool:
         """Take a step in which nothing happens in one call of the compiled kernel.
@@ -164,23 +214,23 @@ class RefinedStepping:
         )
         if taken:
             self.state = x
-            self.step_report = (x, self.force, values.tolist())
+            self.step_report = (x, (self.force, self.interface, t_end), values.tolist())
         return taken
 
     def settle(self, x: np.ndarray, force: float | None = None) -> np.ndarray:
-        """Seal mode consistent with the force now held (it may have jumped); the new state.
+        """Seal mode consistent with the rod force now (it may have jumped); the new state.
 
         Parameters
         ----------
         x : numpy.ndarray
-            The model's state (see :class:`HydraulicsModel`).
+            The model's state (see :class:`HydraulicsModel`) at its :attr:`time`.
         force : float or None
             Every force on the rod but seal friction at ``x``, N, if already known.
         """
         if self.seal is None:
             return self.project(np.array(x, dtype=float))
         before = self.seal.mode
-        x = self._settle_friction(np.array(x, dtype=float), [], force)
+        x = self._settle_friction(np.array(x, dtype=float), [], self.time, force)
         self.mode_changes += int(self.seal.mode != before)
         return self.project(x)
 

@@ -15,19 +15,38 @@ Port (power bond)
     start, for a block train whose reeving is drawn at the initial position.
     Power into the hydraulics through the rod is ``rod.force * rod.velocity``.
 
+Interface model (flow side of the bond)
+---------------------------------------
+Inputs ``rod.stiffness`` ``K`` (N/m), ``rod.damping`` ``D`` (N s/m),
+``rod.effort_rate`` ``R`` (N/s), ``rod.reference_position`` ``d_ref`` (m, in
+``rod.displacement``'s convention) and ``rod.reference_velocity`` ``v_ref`` (m/s):
+the block train's ``mover_a.stiffness`` ... ``mover_a.reference_velocity``. Over a
+step from ``t0`` the rod is then integrated against
+
+``F = rod.force - K (rod.displacement - d_ref) - D (rod.velocity - v_ref) + R (t - t0)``
+
+instead of the held ``rod.force``: the rope's stiff spring acts inside the cylinder's
+own implicit solver, a stuck seal breaks away where ``|F|`` reaches the breakaway
+force (located inside the step), and ``external_work`` books the work of ``F`` on the
+rod. All 0 (their start values): the held force, bit for bit. ``K`` and ``D`` must
+not be negative (the step is refused, naming the input). See
+:mod:`wire_fmu.core.units.hydraulics.interface`.
+
 Outputs that depend on the input within a step
 ----------------------------------------------
 ``rod.acceleration``, ``seal.friction_force`` (a stuck seal holds whatever
 the forces need), ``chamber.pressure`` and ``hydraulic_force`` (with
 ``line_inertance`` and incompressible oil the line's oil column is
-accelerated with the rod). Everything else is a function of the state.
+accelerated with the rod), through ``rod.force`` and its interface model (set
+inputs start the local model afresh at the present time). Everything else is a
+function of the state.
 
 Initial state
 -------------
 With ``initial_equilibrium`` (the default) the unit starts at rest at
 ``initial_position`` in static equilibrium with the value of ``rod.force``
-at initialisation: the gas pressure is set so that
-``s A (p - p_amb) + rod.force + m g_rod = 0`` (the gas having been charged
+at initialisation (with the interface model's, at the start): the gas pressure is set
+so that ``s A (p - p_amb) + rod.force + m g_rod = 0`` (the gas having been charged
 slowly from the pre-charge, so its volume is ``V_full p_precharge / p``),
 the line is at rest and a seal starts stuck with no load on it: no start-up
 transient. Otherwise the gas starts at ``initial_gas_pressure`` and the rod
@@ -80,7 +99,10 @@ travel: 4 x 356 kN = 1.42 MN on the rod over a 3.81 m (12.5 ft) stroke.
 Connecting it to a block train
 ------------------------------
 ``rope.mover_a.force -> rod.force`` and ``rod.velocity ->
-rope.mover_a.velocity``; for the position use ``rod.displacement`` when the
+rope.mover_a.velocity``, and with the interface model ``rope.mover_a.{stiffness,
+damping, effort_rate, reference_position, reference_velocity} -> rod.{...}`` (the
+port ``rod`` declares them); for the position use ``rod.displacement`` (what the
+port declares, and what ``reference_position`` is measured in) when the
 reeving is drawn at the initial extension (as
 :func:`~wire_fmu.core.units.block_train.reevings.riser_tensioner` is, at mid stroke, the default
 ``initial_position``), ``rod.position`` when it is drawn fully retracted.
@@ -101,6 +123,11 @@ from wire_fmu.core.errors import ConfigurationError, ModelError
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_settings
 from wire_fmu.core.framework.unit import OdeView, Unit
+from wire_fmu.core.units.hydraulics.interface import (
+    INTERFACE_INPUTS,
+    NO_INTERFACE,
+    RodInterface,
+)
 from wire_fmu.core.units.hydraulics.kernel import REPORT
 from wire_fmu.core.units.hydraulics.model import (
     HYDRAULICS_EFFECTS,
@@ -128,7 +155,7 @@ _OUTPUT_OF = {  # the model's report quantity: the output that shows it
     "gas_volume": "gas.volume",
     "flow": "line.flow",
     "oil_in_accumulator": "accumulator.oil_volume",
-    "stiffness": "rod.stiffness",
+    "stiffness": "hydraulic_stiffness",
     "stop_force": "end_stop.force",
     "friction_force": "seal.friction_force",
     "stored_energy": "stored_energy",
@@ -144,7 +171,16 @@ class HydraulicsUnit(Unit):
     DESCRIPTION = "Hydraulic cylinder with gas accumulator (hydro-pneumatic spring), wire_fmu"
     VARIABLES = variables()
     PORTS = (
-        port("rod", "translational", PortSide.flow, "force", "velocity", "displacement", "the rod"),
+        port(
+            "rod",
+            "translational",
+            PortSide.flow,
+            "force",
+            "velocity",
+            "displacement",
+            "the rod",
+            interface=True,
+        ),
     )
 
     def __init__(self, instance_name: str = "hydraulics") -> None:
@@ -247,12 +283,16 @@ class HydraulicsUnit(Unit):
         model = self._require_model()
         v = self.values
         pressure = None if bool(v["initial_equilibrium"]) else float(v["initial_gas_pressure"])
+        bad = self.input_problems()
+        if bad:
+            raise ConfigurationError(self.who, [f"initial inputs: {p}" for p in bad])
         try:
             model.initialize(
                 float(v["rod.force"]),
                 position=float(v["initial_position"]),
                 velocity=float(v["initial_velocity"]),
                 gas_pressure=pressure,
+                interface=self.rod_interface(start_time),
             )
         except ConfigurationError as err:
             raise ConfigurationError(self.who, err.problems) from None
@@ -262,21 +302,44 @@ class HydraulicsUnit(Unit):
         self.initial_energy = model.stored_energy()
         self._update_outputs()
 
+    def input_problems(self) -> list[str]:
+        """Inputs the cylinder cannot step with: not finite, or a negative spring or damper
+        in the interface model (each named)."""
+        return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + (
+            self.rod_interface(self.time).problems()
+        )
+
+    def rod_interface(self, start: float) -> RodInterface:
+        """The interface model of the rod force in the inputs now set, about ``start`` (s).
+
+        Parameters
+        ----------
+        start : float
+            The communication point ``t0`` the model is about, s.
+        """
+        v = self.values
+        values = (float(v[name]) for name in INTERFACE_INPUTS)
+        return RodInterface(*values, start=float(start))
+
     def _advance(self, time: float, step: float) -> list[str]:
-        """Integrate the cylinder with ``rod.force`` held; refuse at a limit (ModelError)."""
+        """Integrate the cylinder against ``rod.force`` (held, or its interface model);
+        refuse at a limit (ModelError)."""
         model = self._require_model()
-        model.advance(time, step, float(self.values["rod.force"]))
+        model.advance(time, step, float(self.values["rod.force"]), self.rod_interface(time))
         return list(model.last_events)
 
     def evaluate_outputs(self) -> None:
-        """Feedthrough outputs for the ``rod.force`` now set; the state is untouched."""
+        """Feedthrough outputs for the rod force and interface model now set, at the present
+        time; the state is untouched."""
         model = self._require_model()
-        held = model.force
+        held = model.load
         model.force = float(self.values["rod.force"])
+        model.interface = self.rod_interface(self.time)
+        model.time = self.time
         try:
             self._update_outputs()
         finally:
-            model.force = held
+            model.force, model.interface, model.time = held
 
     def ode(self) -> OdeView:
         """The cylinder's hybrid ODE, for a monolithic model."""
@@ -286,9 +349,19 @@ class HydraulicsUnit(Unit):
     def get_state(self) -> dict[str, Any]:
         """Complete state: continuous state, modes, held input, gas reference."""
         m = self._require_model()
+        interface = m.interface
         return {
             "x": m.state.tolist(),
             "force": float(m.force),
+            "interface": [
+                float(interface.stiffness),
+                float(interface.damping),
+                float(interface.effort_rate),
+                float(interface.reference_position),
+                float(interface.reference_velocity),
+                float(interface.start),
+            ],
+            "model_time": float(m.time),
             "stops": None if m.stops is None else m.stops.get_state(),
             "seal": None if m.seal is None else m.seal.get_state(),
             "mode_changes": int(m.mode_changes),
@@ -306,7 +379,7 @@ class HydraulicsUnit(Unit):
         m = self._require_model()
         return (
             m.state.copy(),
-            m.force,
+            m.load,
             None if m.stops is None else m.stops.snapshot(),
             None if m.seal is None else m.seal.snapshot(),
             m.mode_changes,
@@ -317,7 +390,8 @@ class HydraulicsUnit(Unit):
     def _restore_snapshot(self, saved: tuple) -> None:
         """Implements :meth:`Unit._restore_snapshot`."""
         m = self._require_model()
-        m.state, m.force, stops, seal, m.mode_changes, m.external_work, self.time = saved
+        m.state, load, stops, seal, m.mode_changes, m.external_work, self.time = saved
+        m.force, m.interface, m.time = load
         if m.stops is not None:
             m.stops.restore(stops)
         if m.seal is not None:
@@ -337,6 +411,9 @@ class HydraulicsUnit(Unit):
         m = self._require_model()
         m.state = np.array(state["x"], dtype=float)
         m.force = float(state["force"])
+        interface = state.get("interface")
+        m.interface = NO_INTERFACE if interface is None else RodInterface(*map(float, interface))
+        m.time = float(state.get("model_time", state["time"]))
         if m.stops is not None:
             m.stops.set_state(state["stops"])
         if m.seal is not None:
@@ -409,7 +486,7 @@ class _HydraulicsOde(OdeView):
         self.unit._update_outputs()
 
     def bind_inputs(self, t: float) -> None:
-        """``rod.force`` in ``values`` is the force at ``t``.
+        """``rod.force`` in ``values`` is the force at ``t`` (exact: no interface model).
 
         Parameters
         ----------
@@ -417,6 +494,8 @@ class _HydraulicsOde(OdeView):
             Time, s.
         """
         self.model.force = float(self.unit.values["rod.force"])
+        self.model.interface = NO_INTERFACE
+        self.model.time = t
 
     def publish(self, t: float, x: np.ndarray) -> None:
         """Outputs of ``x`` at ``t`` into ``values`` (state left alone).

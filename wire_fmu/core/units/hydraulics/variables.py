@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from wire_fmu.core.framework.solver_options import solver_parameters
 from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
+from wire_fmu.core.units.hydraulics.interface import INTERFACE_INPUTS
 from wire_fmu.core.units.hydraulics.model import HYDRAULICS_EFFECTS
 
 __all__ = ["DEFAULT_ROD_FORCE", "variables"]
@@ -11,7 +12,9 @@ __all__ = ["DEFAULT_ROD_FORCE", "variables"]
 DEFAULT_ROD_FORCE = -4.0 * 356.0e3
 """Start value of ``rod.force``: an 80 kip rope tension through a 4:1 reeving, N."""
 
-_FEEDTHROUGH = ("rod.force",)
+_FEEDTHROUGH = ("rod.force", *INTERFACE_INPUTS)
+"""What the outputs that depend on the rod force depend on: the force and its interface
+model (setting any of them starts the local model afresh at the present time)."""
 _LINE = ("line_losses", "line_inertance")
 _SEAL = ("seal_friction",)
 _STOPS = ("end_stops",)
@@ -142,6 +145,50 @@ def _physical_parameters():
     )
 
 
+def _interface_inputs():
+    """The effort side's interface model of the rod force (all 0: the force is held)."""
+    model = (
+        "the rod force over the step is rod.force - K (rod.displacement - reference_position) "
+        "- D (rod.velocity - reference_velocity) + R (t - t0)"
+    )
+    return (
+        input_(
+            "rod.stiffness",
+            0.0,
+            "N/m",
+            "Interface model: K = -d rod.force / d rod.displacement of the effort side, >= 0; "
+            + model,
+        ),
+        input_(
+            "rod.damping",
+            0.0,
+            "N.s/m",
+            "Interface model: D = -d rod.force / d rod.velocity of the effort side, >= 0",
+        ),
+        input_(
+            "rod.effort_rate",
+            0.0,
+            "N/s",
+            "Interface model: R = d rod.force / d t with the rod held still (the effort "
+            "side's other inputs), from the communication point t0",
+        ),
+        input_(
+            "rod.reference_position",
+            0.0,
+            "m",
+            "Interface model: rod.displacement at which the effort side took rod.force and "
+            "its derivatives",
+        ),
+        input_(
+            "rod.reference_velocity",
+            0.0,
+            "m/s",
+            "Interface model: rod.velocity at which the effort side took rod.force and its "
+            "derivatives",
+        ),
+    )
+
+
 def variables() -> tuple:
     """The unit's variables: effects and solver, physical parameters, start, inputs, outputs."""
     params = (
@@ -182,8 +229,10 @@ def variables() -> tuple:
             "rod.force",
             DEFAULT_ROD_FORCE,
             "N",
-            "External force on the rod along extension (positive pushes it out)",
+            "External force on the rod along extension (positive pushes it out); held over "
+            "the step, or E0 of the interface model",
         ),
+        *_interface_inputs(),
     )
     deps = _FEEDTHROUGH
     outputs = (
@@ -191,7 +240,7 @@ def variables() -> tuple:
         output("rod.velocity", "m/s", "Rod velocity along extension"),
         output("rod.displacement", "m", "Rod extension since the start"),
         output("rod.acceleration", "m/s2", "Rod acceleration along extension", depends_on=deps),
-        output("rod.stiffness", "N/m", "Quasi-static spring rate of gas and oil at the rod"),
+        output("hydraulic_stiffness", "N/m", "Quasi-static spring rate of gas and oil at the rod"),
         output("chamber.pressure", "Pa", "Absolute pressure at the cylinder port", depends_on=deps),
         output(
             "hydraulic_force",
