@@ -332,7 +332,7 @@ def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
         return float(np.sqrt(np.mean(apart**2)))
 
     assert rms_apart(held, 0.002) < 1.5e3 and 4.0e3 < rms_apart(held, 0.01) < 8.0e3
-    assert rms_apart(modelled, 0.002) < 0.5e3 and rms_apart(modelled, 0.01) < 1.0e3
+    assert rms_apart(modelled, 0.002) < 10.0 and rms_apart(modelled, 0.01) < 150.0
     residual = "bond.rod.energy_residual"
     assert abs(held[0.01][residual].iloc[-1]) > 5e3 and abs(held[0.002][residual].iloc[-1]) < 1e3
     assert abs(modelled[0.01][residual].iloc[-1]) < 1e3
@@ -342,6 +342,6 @@ def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
         "(5.7 kN rms apart)",
         "energy residual reaches 10 kJ",
         "within 1.1 kN rms of the 1 ms run",
-        "within 0.7 kN rms of its 1 ms run",
-        "at 2 ms within 0.3 kN",
+        "within 0.12 kN rms of its 1 ms run",
+        "at 2 ms within 8 N",
     )
