@@ -30,13 +30,18 @@ from collections.abc import Iterable, Mapping
 from xml.etree import ElementTree as ET
 
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.framework.ports import Port
+
+# re-exported: a Port element's interface="true" promises {port}.{quantity} variables of
+# these quantities, in these units by kind, which is the declaration a master reads
+from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS, Port
 from wire_fmu.core.framework.unit import Causality, Unit, Variable
 from wire_fmu.export.facade import PHYSICS_SECONDS
 from wire_fmu.export.units import UNITS
 
 __all__ = [
     "CAPABILITIES",
+    "INTERFACE_QUANTITIES",
+    "INTERFACE_UNITS",
     "PORTS_TOOL",
     "check_units",
     "patch_model_description",

@@ -12,7 +12,7 @@ flow side, the flow and (when both ports have one) the position back.
 Interface models: when both ports declare one (``interface="true"``), the
 bond also offers five links ``effort_unit.{port}.{quantity} ->
 flow_unit.{port}.{quantity}``, one per
-:data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` (stiffness,
+:data:`~wire_fmu.export.model_description.INTERFACE_QUANTITIES` (stiffness,
 damping, effort rate, reference position and velocity), and names the
 effort side's ``interface_switch`` parameter that turns their computation
 on. Whether the scene wires them is its choice (``run.interface_models``,
@@ -31,8 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES
-from wire_fmu.export.model_description import PORTS_TOOL
+from wire_fmu.export.model_description import INTERFACE_QUANTITIES, PORTS_TOOL
 from wire_fmu.master.archive import check_member_size
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR, resolve_fmu
 
@@ -75,7 +74,7 @@ class PortDeclaration:
         What the port is.
     interface : bool
         Whether the port carries the interface model
-        (:data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` as ``{port}.{quantity}``).
+        (:data:`~wire_fmu.export.model_description.INTERFACE_QUANTITIES` as ``{port}.{quantity}``).
     interface_switch : str or None
         The effort side's Boolean parameter that turns the interface model on.
     """
@@ -106,7 +105,7 @@ class PortLinks:
         Source and target of the position link, when both ports have a position.
     interface : tuple of (str, str)
         The interface model's links, effort side to flow side, one per
-        :data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES` in that order; empty
+        :data:`~wire_fmu.export.model_description.INTERFACE_QUANTITIES` in that order; empty
         unless both ports declare the model.
     switch : str or None
         The effort side's ``"unit.parameter"`` that turns its interface model on (None
@@ -277,7 +276,7 @@ def interface_links(
     -------
     links : tuple of (str, str)
         ``("effort_unit.{port}.{quantity}", "flow_unit.{port}.{quantity}")`` for each of
-        :data:`~wire_fmu.core.framework.ports.INTERFACE_QUANTITIES`, in that order; empty
+        :data:`~wire_fmu.export.model_description.INTERFACE_QUANTITIES`, in that order; empty
         unless both ports declare the model.
     switch : str or None
         ``"effort_unit.parameter"``: the effort side's interface switch, with the links.

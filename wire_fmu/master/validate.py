@@ -23,7 +23,7 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
-from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS
+from wire_fmu.export.model_description import INTERFACE_QUANTITIES, INTERFACE_UNITS
 
 from .catalog import DEFAULT_FMU_DIR, is_ours, resolve_fmu
 from .ports import read_ports
