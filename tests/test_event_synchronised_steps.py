@@ -75,6 +75,7 @@ def _mode_changes_inside_steps(out, synchronise: bool) -> tuple[int, int]:
         out,
         plots=False,
         stop_time=STOP_TIME,
+        step=0.002,
         synchronise_events=synchronise,
         observers=[Watch()],
     )

@@ -138,14 +138,15 @@ def test_riser_stiffest_mode_is_the_rod_on_one_67_8_m_span():
     assert ea / span == pytest.approx(1.92e6, rel=2e-3)
     assert rope == pytest.approx(3.07e7, rel=2e-3) and gas == pytest.approx(6e4, rel=0.05)
     assert round(omega, 1) == 93.7
-    assert round(omega * 0.002, 2) == 0.19 and round(omega * 0.01, 2) == 0.94
+    assert round(omega * 0.002, 2) == 0.19 and round(omega * 0.004, 2) == 0.37
+    assert round(omega * 0.01, 2) == 0.94
     assert (p / 1e6, (p - cyl["ambient_pressure"]) / 6894.757) == pytest.approx((14.75, 2125), 1e-3)
     _states(
         "riser_tensioner",
         "one span of 67.8 m (56 m of straight lines and 11.8 m on the sheaves)",
         "EA / L = 1.92e6 N/m",
         "16 EA / L = 3.07e7 N/m (the gas spring adds 6e4 N/m): 93.7 rad/s",
-        "omega H = 0.19",
+        "omega H = 0.37 (0.19 at 2 ms)",
         "at 10 ms (omega H = 0.94)",
         "14.75 MPa absolute (2125 psi gauge)",
     )
@@ -314,7 +315,8 @@ def test_compensator_isolation_measured_as_stated(fmu_dir, tmp_path):
 
 @pytest.mark.integration
 def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
-    """Held force: rings at 10 ms, close at 2 ms; the interface model: close even at 10 ms."""
+    """Held force: rings at 10 ms, close at 2 ms; the interface model: close at the scene's
+    4 ms and even at 10 ms."""
     held = {
         h: _run("riser_tensioner", fmu_dir, tmp_path / f"held{h}", step=h, interface_models=False)
         for h in (1e-3, 2e-3, 0.01)
@@ -322,7 +324,7 @@ def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
     modelled = {
         h: _run("riser_tensioner", fmu_dir, tmp_path / str(h), step=h) for h in (1e-3, 0.01)
     }
-    modelled[0.002] = _run("riser_tensioner", fmu_dir, tmp_path / "scene")
+    modelled[0.004] = _run("riser_tensioner", fmu_dir, tmp_path / "scene")
     tension = "rope.path_end.tension"
 
     def rms_apart(runs: dict, h: float) -> float:
@@ -332,16 +334,16 @@ def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
         return float(np.sqrt(np.mean(apart**2)))
 
     assert rms_apart(held, 0.002) < 1.5e3 and 4.0e3 < rms_apart(held, 0.01) < 8.0e3
-    assert rms_apart(modelled, 0.002) < 10.0 and rms_apart(modelled, 0.01) < 150.0
+    assert rms_apart(modelled, 0.004) < 30.0 and rms_apart(modelled, 0.01) < 150.0
     residual = "bond.rod.energy_residual"
     assert abs(held[0.01][residual].iloc[-1]) > 5e3 and abs(held[0.002][residual].iloc[-1]) < 1e3
     assert abs(modelled[0.01][residual].iloc[-1]) < 1e3
-    assert "rope.mover_b.position" in modelled[0.002].columns  # the vessel heave is recorded
+    assert "rope.mover_b.position" in modelled[0.004].columns  # the vessel heave is recorded
     _states(
         "riser_tensioner",
-        "(5.7 kN rms apart)",
+        "(5.6 kN rms apart)",
         "energy residual reaches 10 kJ",
-        "within 1.1 kN rms of the 1 ms run",
-        "within 0.12 kN rms of its 1 ms run",
-        "at 2 ms within 8 N",
+        "0.9 kN rms of the 1 ms run",
+        "within 0.12 kN rms of its 1 ms run at 10 ms",
+        "within 25 N at 4 ms",
     )

@@ -26,18 +26,27 @@ about the time ``t_0`` of the step's end. The derivatives are forward difference
 the model's own effort
 (:meth:`~wire_fmu.core.units.block_train.model.BlockTrainModel.summary`) with the
 internal state (blocks, sheaves) frozen: the instantaneous stiffness, which is what
-the coupling needs over one step.
+the coupling needs over one step. A compiled block train takes them all in one
+call (:mod:`.kernel_interface`, the same arithmetic).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 
 import numpy as np
 
+from wire_fmu.core.units.block_train import kernel_interface
+from wire_fmu.core.units.block_train.kernel import kernel_data
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS
 
-__all__ = ["PortLinearisation", "port_linearisations"]
+__all__ = [
+    "InterfacePlan",
+    "PortLinearisation",
+    "interface_plan",
+    "linearisation_table",
+    "port_linearisations",
+]
 
 RELATIVE_STEP = 1e-6
 """Differencing step of a position or velocity, relative to ``max(1, |value|)`` (m, m/s)."""
@@ -161,6 +170,74 @@ def _linearise(model, slot: _Slot, t: float, x: np.ndarray, base: tuple) -> Port
     )
 
 
+@dataclass(frozen=True)
+class InterfacePlan:
+    """The ports a block train linearises, made once per model.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The ports the reeving uses (``line_a``, ``mover_a``, ...).
+    slots : tuple of _Slot
+        Where each sits in the held-input vector, in the order of ``names``.
+    rows : numpy.ndarray
+        The slots as :func:`.kernel_interface.port_linearisations` takes them.
+    """
+
+    names: tuple[str, ...]
+    slots: tuple[_Slot, ...]
+    rows: np.ndarray
+
+
+def interface_plan(model) -> InterfacePlan:
+    """The ports ``model`` linearises (see :class:`InterfacePlan`)."""
+    slots = _slots(model)
+    rows = [
+        (
+            s.position,
+            s.rate,
+            s.sign,
+            -1 if s.tension is None else s.tension,
+            -1 if s.body is None else s.body,
+        )
+        for s in slots.values()
+    ]
+    table = np.array(rows, dtype=float).reshape(len(rows), 5)
+    return InterfacePlan(tuple(slots), tuple(slots.values()), table)
+
+
+def linearisation_table(model, plan: InterfacePlan, t: float, x: np.ndarray) -> np.ndarray:
+    """Every port's effort linearised at ``(t, x)``, one row a port.
+
+    Parameters
+    ----------
+    model : BlockTrainModel
+        The block train, holding the inputs of its last step.
+    plan : InterfacePlan
+        Its ports, from :func:`interface_plan`.
+    t : float
+        Time, s.
+    x : numpy.ndarray
+        State ``[q, v, dissipated, external work]``; left as it is.
+
+    Returns
+    -------
+    numpy.ndarray
+        In the order of ``plan.names``: stiffness (N/m), damping (N s/m), effort
+        rate (N/s), reference position (m), reference velocity (m/s) (the fields of
+        :class:`PortLinearisation`).
+    """
+    if model.compiled:
+        table = kernel_interface.port_linearisations(
+            t, x, kernel_data(model), plan.rows, RELATIVE_STEP, TIME_STEP
+        )
+        if np.isfinite(table).all():  # else the Python reference names what failed
+            return table
+    base = _efforts(model, t, x, model.held_vector)
+    rows = [astuple(_linearise(model, slot, t, x, base)) for slot in plan.slots]
+    return np.array(rows, dtype=float).reshape(len(rows), 5)
+
+
 def port_linearisations(model, t: float, x: np.ndarray) -> dict[str, PortLinearisation]:
     """Every port's effort linearised at ``(t, x)`` (see the module docstring).
 
@@ -178,5 +255,8 @@ def port_linearisations(model, t: float, x: np.ndarray) -> dict[str, PortLineari
     dict of str to PortLinearisation
         By port name (``line_a``, ``mover_a``, ...), for the ports the reeving uses.
     """
-    base = _efforts(model, t, x, model.held_vector)
-    return {name: _linearise(model, slot, t, x, base) for name, slot in _slots(model).items()}
+    plan = interface_plan(model)
+    table = linearisation_table(model, plan, t, x)
+    return {
+        name: PortLinearisation(*row) for name, row in zip(plan.names, table.tolist(), strict=True)
+    }

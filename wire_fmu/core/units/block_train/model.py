@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -129,8 +129,6 @@ class BlockTrainModel(
                 ],
             )
         if "rope_damping" not in effects:
-            from dataclasses import replace
-
             self.rope = replace(self.rope, damping=0.0)
         self._build_nodes()
         self._build_coordinates()
@@ -152,7 +150,20 @@ class BlockTrainModel(
         self.contact_mask = np.zeros(len(self.blocks), dtype=bool)
         self._build_kernel_arrays()
         self.compiled = self.kernel_applies() and use_compiled("block train")
-        self.solver = self.kernel_solver(solver)
+        self.solver = self.kernel_solver(self._internal_solver(solver))
+
+    def _internal_solver(self, settings: SolverSettings) -> SolverSettings:
+        """``settings``, with one internal step a communication step when nothing is dynamic.
+
+        A block train without coordinates (every body driven, sheaves massless) is
+        algebraic in its held inputs: its only states are the energy ledgers, whose
+        powers are quadratic in time over a step with the inputs held (a span's length
+        moves linearly, its damper force is constant), so one RK4 step integrates them
+        exactly (Simpson's rule), and a guard (slack, break) crosses at most once.
+        """
+        if self.n_coords:
+            return settings
+        return replace(settings, max_step=math.inf)
 
     # ------------------------------------------------------------------ build
     @property

@@ -31,7 +31,7 @@ import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, fastest_mode
-from wire_fmu.core.framework.ports import PortSide, port
+from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
 from wire_fmu.core.framework.unit import (
     ModelOdeView,
@@ -42,7 +42,7 @@ from wire_fmu.core.framework.unit import (
     output,
     parameter,
 )
-from wire_fmu.core.units.block_train.interface import port_linearisations
+from wire_fmu.core.units.block_train.interface import interface_plan, linearisation_table
 from wire_fmu.core.units.block_train.model import (
     BLOCK_TRAIN_EFFECTS,
     BlockTrainInputs,
@@ -476,14 +476,23 @@ class BlockTrainUnit(Unit):
         )
         out["mode_changes"] = int(m.mode_changes)
         if self.values["interface_model"]:
-            for name, lin in port_linearisations(m, self.time, m.state).items():
-                out[f"{name}.stiffness"] = lin.stiffness
-                out[f"{name}.damping"] = lin.damping
-                out[f"{name}.effort_rate"] = lin.effort_rate
-                out[f"{name}.reference_position"] = lin.reference_position
-                out[f"{name}.reference_velocity"] = lin.reference_velocity
+            self._update_interface_outputs(m)
         if not (math.isfinite(out["stored_energy"]) and math.isfinite(out["tension_max"])):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
+
+    def _update_interface_outputs(self, m: BlockTrainModel) -> None:
+        """Each port's interface model (see :mod:`.interface`) into its outputs."""
+        kept = getattr(self, "_interface", None)
+        if kept is None or kept[0] is not m:
+            plan = interface_plan(m)
+            names = [[f"{p}.{q}" for q in INTERFACE_QUANTITIES] for p in plan.names]
+            kept = self._interface = (m, plan, names)
+        _, plan, names = kept
+        out = self.values
+        table = linearisation_table(m, plan, self.time, m.state).tolist()
+        for port_names, row in zip(names, table, strict=True):
+            for name, value in zip(port_names, row, strict=True):
+                out[name] = value
 
 
 class _BlockTrainOde(ModelOdeView):
