@@ -317,14 +317,23 @@ def test_compensator_isolation_measured_as_stated(fmu_dir, tmp_path):
 def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
     """Held force: rings at 10 ms, close at 2 ms; the interface model: close at the scene's
     4 ms and even at 10 ms."""
+    common = {"output_interval": 0.02}  # a time every run records
     held = {
-        h: _run("riser_tensioner", fmu_dir, tmp_path / f"held{h}", step=h, interface_models=False)
+        h: _run(
+            "riser_tensioner",
+            fmu_dir,
+            tmp_path / f"held{h}",
+            step=h,
+            interface_models=False,
+            **common,
+        )
         for h in (1e-3, 2e-3, 0.01)
     }
     modelled = {
-        h: _run("riser_tensioner", fmu_dir, tmp_path / str(h), step=h) for h in (1e-3, 0.01)
+        h: _run("riser_tensioner", fmu_dir, tmp_path / str(h), step=h, **common)
+        for h in (1e-3, 0.01)
     }
-    modelled[0.004] = _run("riser_tensioner", fmu_dir, tmp_path / "scene")
+    modelled[0.004] = _run("riser_tensioner", fmu_dir, tmp_path / "scene", **common)
     tension = "rope.path_end.tension"
 
     def rms_apart(runs: dict, h: float) -> float:
