@@ -236,6 +236,40 @@ def test_drawworks_textbook_tensions_brake_and_floor():
     )
 
 
+def test_drawworks_rope_is_not_stiff_for_its_rk4():
+    """The fastest mode of the 10-line block train at its start, bearings slipping and
+    stuck: eigenvalues (scipy.linalg) of a central-difference Jacobian of its equations."""
+    import json
+
+    from wire_fmu.core.units.block_train.unit import BlockTrainUnit
+
+    data = _data("drawworks")
+    rope = data["units"]["rope"]
+    assert rope["parameters"]["solver"] == "rk4"
+    unit = BlockTrainUnit("rope")
+    unit.values["reeving"] = json.dumps(rope["parameters"]["reeving"])
+    unit.values["effects"] = ",".join(rope["effects"])
+    unit.configure()
+    unit.initialize(0.0)
+    model = unit.model
+    x, n = model.state.copy(), model.n_coords
+
+    def fastest() -> float:
+        jac = np.empty((2 * n, 2 * n))
+        for j in range(2 * n):
+            dx = np.zeros_like(x)
+            dx[j] = 1e-6
+            jac[:, j] = (model.rhs(0.0, x + dx) - model.rhs(0.0, x - dx))[: 2 * n] / 2e-6
+        return float(np.max(np.abs(scipy.linalg.eigvals(jac))))
+
+    stuck = fastest()
+    model.friction.set_mode([1] * len(model.friction.get_mode()))
+    slipping = fastest()
+    assert (round(stuck), round(slipping)) == (12, 147)
+    assert slipping * 1e-3 < 2.78 / 10  # RK4's stability limit on the imaginary axis
+    _states("drawworks", "147 rad/s, omega h = 0.15", "it is the hook's, 12 rad/s")
+
+
 def _winch_variables():
     from wire_fmu.core.units.winch.unit import WinchUnit
 
