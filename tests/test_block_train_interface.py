@@ -85,6 +85,29 @@ def test_fast_line_sees_the_whole_rope_as_one_spring():
     assert unit.values["line_a.damping"] == 0.0  # no rope damping among the effects
 
 
+def test_effort_rate_follows_the_blocks_own_motion():
+    """A hook moving at ``v`` stretches the one merged span at ``J v`` (``J = dL/dy``, the
+    4 parts it hangs in): the fast line, held still, sees its tension move at
+    ``(EA / l) J v`` -- the block's state is not frozen over the step.
+
+    Mutation: the coordinates left where they are (the rate taken at the frozen state):
+    the rate is 0 and this fails.
+    """
+    unit = make_unit(drilling_block_train(4), "", interface_model=True)
+    assert unit.advance(0.0, 1e-4).success
+    model = unit.model
+    assert model.n_coords == 1 and len(model.spans) == 1
+    speed = 0.3  # m/s, the hook moving along its direction
+    x = model.state.copy()
+    x[model.n_coords] = speed
+    lengths, jacobian = model.span_lengths(x[:1])
+    ea = model.rope.axial_stiffness
+    length = ea * float(lengths.sum()) / (unit.values["line_a.tension"] + ea)
+    rate = port_linearisations(model, unit.time, x)["line_a"].effort_rate
+    assert abs(jacobian[0, 0]) == pytest.approx(4.0, rel=1e-9)
+    assert rate == pytest.approx(ea / length * jacobian[0, 0] * speed, rel=1e-5)
+
+
 def test_without_the_interface_model_nothing_is_published():
     """Off by default: the outputs stay 0 and no differencing is paid for."""
     unit = riser(interface_model=False)

@@ -84,6 +84,9 @@ def port_linearisations(
     out = np.empty((slots.shape[0], 5))
     elapsed = t - held[0]
     base = summary(t, x, data)
+    n = data[0][0]
+    moved = x.copy()  # the coordinates moved on at their velocities
+    moved[:n] += time_step * x[n : 2 * n]
     for p in range(slots.shape[0]):
         slot = slots[p]
         position_at, rate_at, sign = int(slot[0]), int(slot[1]), slot[2]
@@ -105,7 +108,7 @@ def port_linearisations(
         still = held.copy()
         still[position_at] += rate * elapsed
         still[rate_at] = 0.0
-        later = _effort(t + time_step, x, data, still, slot) - effort
+        later = _effort(t + time_step, moved, data, still, slot) - effort
         now = _effort(t, x, data, still, slot) - effort
         out[p, 0] = -d_position
         out[p, 1] = -d_velocity
