@@ -152,7 +152,7 @@ def test_min_step_above_max_step_with_adaptive_is_refused(tmp_path, fmu_dir):
 
 
 def test_the_step_count_message_says_how_to_allow_it(tmp_path, fmu_dir):
-    path = variant(tmp_path, replace={"step = 0.002": "step = 1e-12"})
+    path = variant(tmp_path, replace={"step = 0.004": "step = 1e-12"})
     problem = only(problems_of(path, fmu_dir), "macro steps")
     assert "3e+13" in problem and "raise max_steps" in problem
 
@@ -245,7 +245,7 @@ def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
     path = variant(
         tmp_path,
         replace={
-            "step = 0.002": "step = -1.0",
+            "step = 0.004": "step = -1.0",
             "pretension = 356.0e3": 'pretension = "high"',
             PORTS: LONG_BOND,
         },
