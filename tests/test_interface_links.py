@@ -299,17 +299,18 @@ def test_an_interface_quantity_in_the_wrong_unit_is_named(declared):
 EFFORT_UNITS = '''
 """A coupled mass whose flange port offers an interface model (test unit)."""
 
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import (
+    INTERFACE_QUANTITIES,
+    INTERFACE_UNITS,
+    Port,
+    PortSide,
+)
 from wire_fmu.core.framework.unit import output, parameter
 from wire_fmu_master_units import CoupledMassUnit
 
-_QUANTITIES = {
-    "stiffness": "N/m",
-    "damping": "N.s/m",
-    "effort_rate": "N/s",
-    "reference_position": "m",
-    "reference_velocity": "m/s",
-}
+_QUANTITIES = dict(
+    zip(INTERFACE_QUANTITIES, INTERFACE_UNITS["translational"], strict=True)
+)
 
 
 class InterfaceMassUnit(CoupledMassUnit):
@@ -346,17 +347,18 @@ class InterfaceMassUnit(CoupledMassUnit):
 FLOW_UNITS = '''
 """An oscillator whose body port takes an interface model (test unit)."""
 
-from wire_fmu.core.framework.ports import Port, PortSide
+from wire_fmu.core.framework.ports import (
+    INTERFACE_QUANTITIES,
+    INTERFACE_UNITS,
+    Port,
+    PortSide,
+)
 from wire_fmu.core.framework.unit import input_, output
 from wire_fmu_test_units import OscillatorUnit
 
-_QUANTITIES = {
-    "stiffness": "N/m",
-    "damping": "N.s/m",
-    "effort_rate": "N/s",
-    "reference_position": "m",
-    "reference_velocity": "m/s",
-}
+_QUANTITIES = dict(
+    zip(INTERFACE_QUANTITIES, INTERFACE_UNITS["translational"], strict=True)
+)
 
 
 class InterfaceOscillatorUnit(OscillatorUnit):

@@ -156,10 +156,12 @@ class BlockTrainModel(
         """``settings``, with one internal step a communication step when nothing is dynamic.
 
         A block train without coordinates (every body driven, sheaves massless) is
-        algebraic in its held inputs: its only states are the energy ledgers, whose
-        powers are quadratic in time over a step with the inputs held (a span's length
-        moves linearly, its damper force is constant), so one RK4 step integrates them
-        exactly (Simpson's rule), and a guard (slack, break) crosses at most once.
+        algebraic in its held inputs: its only states are the energy ledgers, and RK4
+        on them is Simpson's rule. With no line paid out and lengths linear in the
+        body motion, a span's stretch moves linearly over a step with the inputs held
+        and its damper force stays constant: the powers are quadratic in time and one
+        step integrates them exactly; otherwise they are smooth over the step (error
+        of order ``h^5``). A guard (slack, break) then crosses at most once a step.
         """
         if self.n_coords:
             return settings
