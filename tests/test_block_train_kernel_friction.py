@@ -110,6 +110,9 @@ def quiet_step_with_payout_jump(model, jump: float) -> int:
         model._guard_dirs,
         model.kernel_data(),
         held,
+        0,
+        0.0,
+        False,
     )
     return int(result[0])
 

@@ -447,7 +447,8 @@ class KernelModel:
 
     The model sets :attr:`compiled` when it is built and names its kernel module
     in :attr:`KERNEL` (which offers ``kernel_data(model)`` and the entry point
-    ``advance``); its ``rhs``/``guards`` hand over to the kernel while
+    ``resume``, the loop of :func:`advance_structured` going on from an event, called
+    as ``advance`` is); its ``rhs``/``guards`` hand over to the kernel while
     :attr:`compiled` is True.
     """
 
@@ -483,5 +484,5 @@ class KernelModel:
         from wire_fmu.core.framework.hybrid import make_solver
 
         if self.compiled and settings.method in COMPILED_METHODS:
-            return CompiledFixedStep(settings, self.KERNEL.advance)
+            return CompiledFixedStep(settings, self.KERNEL.resume)
         return make_solver(settings)

@@ -162,6 +162,9 @@ class CompiledBlockTrain:
             self._guard_dirs,
             self.kernel_data(),
             held,
+            0,
+            t,
+            False,
         )
         if result[0] == STATUS_PYTHON:
             return False

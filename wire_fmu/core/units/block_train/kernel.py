@@ -86,6 +86,7 @@ __all__ = [
     "linearise",
     "project",
     "quiet_step",
+    "resume",
     "rhs",
     "rhs_parts",
     "solve",
@@ -555,7 +556,7 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
 
 
 @jit
-def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
+def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
     """A whole communication step in one call, when the new inputs switch no mode.
 
     What :meth:`BlockTrainModel.advance
@@ -566,17 +567,27 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     of the step or its first event, then the outputs' :func:`summary` at the end.
     It changes nothing it was given.
 
+    With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead (the loop going on
+    after an event Python switched, ``data`` as the model holds it, ``held`` unused):
+    the one entry point Python calls for both, so that one compiled function is
+    loaded from the cache, not two.
+
     Parameters
     ----------
     method, t0, t1, n, tol, directions
-        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them
-        (the loop starts at ``t0``, interval 0).
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     x : numpy.ndarray
-        State at ``t0``.
+        State at ``t0`` (at ``t`` with ``resume``).
     data : tuple
         See the module docstring; its held inputs are those of the last step.
     held : numpy.ndarray
         The held inputs from ``t0`` on (layout of ``data[11]``).
+    k : int
+        With ``resume``: the interval ``t`` lies in (else 0).
+    t : float
+        With ``resume``: the time the loop goes on from, s (else ``t0``).
+    resume : bool
+        Go on with :func:`advance` from ``(k, t, x)``, nothing else.
 
     Returns
     -------
@@ -588,6 +599,13 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
         them, a span has no unstretched rope or a segment no tangent: Python then
         takes the step.
     """
+    if resume:
+        status, x, t, k, fired, steps, calls, h = advance(
+            method, t0, t1, n, k, t, x, directions, tol, data
+        )
+        if status == STATUS_DONE:
+            return status, x, t, k, fired, steps, calls, h, summary(t1, x, data)
+        return status, x, t, k, fired, steps, calls, h, np.zeros(0)
     n_coords, n_links = data[0][0], data[17].shape[0]
     # the held inputs from t0 on, and a stuck coordinate held where the step starts
     new = data[:11] + (held,) + data[12:23] + (x[:n_coords].copy(),) + data[24:]
@@ -610,3 +628,14 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held):
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(t1, x, new)
     return status, x, t, k, fired, steps, calls, h, no_summary
+
+
+def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
+    """:func:`advance` through :func:`quiet_step` (the entry point the solver calls).
+
+    Parameters
+    ----------
+    method, t0, t1, n, k, t, x, directions, tol, data
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
+    """
+    return quiet_step(method, t0, t1, n, tol, x, directions, data, data[11], k, t, True)[:8]

@@ -57,6 +57,7 @@ __all__ = [
     "limits_and_force",
     "project",
     "quiet_step",
+    "resume",
     "report",
     "rhs",
 ]
@@ -72,3 +73,8 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
     return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+
+
+resume = advance
+"""The entry point the solver calls after an event: :func:`advance` itself (the quiet
+step, :func:`quiet_step`, is a loop of its own)."""

@@ -369,6 +369,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             self.kernel_data(),
             check_stick,
             hold_angle,
+            0,
+            t,
         )
         if result[0] == STATUS_PYTHON:
             return False

@@ -35,6 +35,7 @@ __all__ = [
     "kernel_data",
     "project",
     "quiet_step",
+    "resume",
     "rhs",
     "summary",
 ]
@@ -254,7 +255,7 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
 
 
 @jit
-def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle):
+def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle, k, t):
     """A whole communication step in one call, when the new inputs switch no brake mode.
 
     What :meth:`WinchModel.advance <wire_fmu.core.units.winch.drive.WinchModel.advance>`
@@ -263,19 +264,26 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
     :func:`advance` to the end of the step or its first event, the :func:`summary` at
     the end. It changes nothing it was given.
 
+    Without ``check_stick`` and ``hold_angle`` it is :func:`advance` from ``(k, t, x)``
+    (:func:`resume`): the one entry point Python calls, so that one compiled function
+    is loaded from the cache, not two.
+
     Parameters
     ----------
     method, t0, t1, n, tol, directions
-        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them
-        (the loop starts at ``t0``, interval 0).
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     x : numpy.ndarray
-        State at ``t0``.
+        State at ``t``.
     data : tuple
         See the module docstring, for the new inputs.
     check_stick : bool
         The brake holds the drum: leave the step to Python if it cannot hold any more.
     hold_angle : bool
         The brake is in the mode it keeps: a held drum stays at the angle it has now.
+    k : int
+        The interval ``t`` lies in (0 for a whole step).
+    t : float
+        The time the loop starts from, s (``t0`` for a whole step).
 
     Returns
     -------
@@ -286,7 +294,7 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         settle the brake first.
     """
     no_summary = np.zeros(0)
-    if check_stick and guards(t0, x, data)[0] < 0.0:
+    if check_stick and guards(t, x, data)[0] < 0.0:
         no_fire = np.zeros(directions.size, dtype=np.bool_)
         return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
     x = x.copy()
@@ -297,8 +305,19 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         data = (modes, inertia, stiffness, damping, held)
         x = project(x, data)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
+        rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data
     )
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(x, data)
     return status, x, t, k, fired, steps, calls, h, no_summary
+
+
+def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
+    """:func:`advance` through :func:`quiet_step` (the entry point the solver calls).
+
+    Parameters
+    ----------
+    method, t0, t1, n, k, t, x, directions, tol, data
+        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
+    """
+    return quiet_step(method, t0, t1, n, tol, x, directions, data, False, False, k, t)[:8]
