@@ -32,6 +32,7 @@ sliding magnitudes separately, in the same shape.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,12 +100,12 @@ class StickSlip:
         """The modes as plain ints (0 stuck, +1/-1 sliding direction)."""
         return [int(m) for m in self.mode]
 
-    def set_mode(self, mode: list[int]) -> None:
-        """Restore modes saved by :meth:`get_mode`.
+    def set_mode(self, mode: Sequence[int] | np.ndarray) -> None:
+        """Restore modes saved by :meth:`get_mode` (or a copy of :attr:`mode`).
 
         Parameters
         ----------
-        mode : list of int
+        mode : sequence of int
             Per link: 0 stuck, +1 or -1 the sliding direction.
         """
         self.mode = np.array(mode, dtype=np.int64)

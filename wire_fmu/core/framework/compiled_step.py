@@ -401,6 +401,26 @@ class CompiledFixedStep(FixedStepSolver):
                 self.rhs_calls += system.jacobian_evaluations(x)
         return x, events
 
+    def preload(self, system, t: float, x: np.ndarray) -> None:
+        """Load the compiled loop now, by a call that takes no step (interval 1 of 1).
+
+        The first call of a compiled function loads it from the on-disk cache (tens of
+        milliseconds for a kernel's loop); made at initialisation, that cost is part of
+        the start, not of the first step.
+
+        Parameters
+        ----------
+        system : HybridSystem
+            The model, with its compiled kernel.
+        t : float
+            The present time, s.
+        x : numpy.ndarray
+            The present state (not changed).
+        """
+        directions = np.asarray(system.guard_directions(), dtype=float)
+        tol = self.settings.event_time_tolerance
+        self.entry(self.method, t, t, 1, 1, t, x, directions, tol, system.kernel_data())
+
     def finish_quiet_step(
         self, system, t0: float, x0: np.ndarray, t1: float, result: tuple
     ) -> tuple[np.ndarray, int, np.ndarray | None]:
@@ -458,6 +478,19 @@ class KernelModel:
     def kernel_data(self) -> tuple:
         """The tuple of arrays the compiled kernel takes, for the present modes and inputs."""
         return self.KERNEL.kernel_data(self)
+
+    def preload_kernel(self, t: float) -> None:
+        """Load the compiled step from the cache now rather than in the first step
+        (:meth:`CompiledFixedStep.preload`); nothing without one.
+
+        Parameters
+        ----------
+        t : float
+            The present time, s.
+        """
+        solver = getattr(self, "solver", None)
+        if isinstance(solver, CompiledFixedStep):
+            solver.preload(self, t, self.state)
 
     def jacobian_evaluations(self, x: np.ndarray) -> int:
         """Right-hand sides ROS2 evaluates for one Jacobian at state ``x`` (all differenced)."""

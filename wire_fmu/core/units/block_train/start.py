@@ -69,6 +69,7 @@ class StartingState:
         )
         self.friction.set_mode([0] * len(self.friction.links))
         self.state = self._settle_modes(t0, self.state, [])
+        self.preload_kernel(t0)
         return tension
 
     def _equilibrium_tension(self, dl_dy: np.ndarray) -> float:

@@ -369,7 +369,7 @@ class BlockTrainUnit(Unit):
             m.broken_mask.copy(),
             m.taut_mask.copy(),
             m.contact_mask.copy(),
-            m.friction.get_mode(),
+            m.friction.mode.copy(),
             m.mode_changes,
             m.inputs,
             m._t_step,

@@ -21,8 +21,8 @@ class InitialState:
     """Initialisation of a cylinder model (a mixin).
 
     The model provides ``cyl``, ``sa``, ``spec``, ``line``, ``exponent``, ``layout``,
-    ``r_l``, ``r_t``, ``stops``, ``seal``, ``rod_force``, ``_settle_friction`` and
-    ``check_limits``.
+    ``r_l``, ``r_t``, ``stops``, ``seal``, ``rod_force``, ``_settle_friction``,
+    ``check_limits`` and ``_preload_quiet_step``.
     """
 
     def equilibrium_pressure(self, force: float) -> float:
@@ -99,6 +99,7 @@ class InitialState:
         self.last_events = []
         self.state = self._settle_friction(self.state, [], self.time)
         self.check_limits(self.time, self.state)
+        self._preload_quiet_step()
 
     def _initial_state(self, position: float, velocity: float, p0: float, v0: float) -> np.ndarray:
         lay = self.layout

@@ -61,6 +61,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.state = np.zeros(2 * self.n + 2)
         self._held_angle = 0.0
         self._step_summary: tuple[np.ndarray, np.ndarray] | None = None  # (x, its summary)
+        self._kernel_layer: tuple | None = None  # (layer, its constants), by kernel_data
+        self._kernel_modes: tuple | None = None  # (brake modes, their array), by kernel_data
         self._n_brake_guards = 2 * len(brake)
         self._guard_dirs = -np.ones(self._n_brake_guards + self.drum.layer_guard_count)
         self.settings = solver
@@ -329,6 +331,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.last_events = []
         self.state = self._settle_modes(t0, x, [])
         self._forces(self.state)
+        self.preload_kernel(t0)
 
     def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
         """Advance by ``h`` with ``inputs`` held; return the number of events.
@@ -380,7 +383,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         if values is not None:
             self._step_summary = (x, values)
         self.state = x
-        self._forces(x)
+        if values is None:  # after an event; else the outputs come from the kernel's summary
+            self._forces(x)
         return True
 
     # ---------------------------------------------------------- outputs

@@ -38,7 +38,7 @@ class DriveSnapshots:
         saved = (
             self.inputs,
             self.engaged,
-            self.friction.get_mode(),
+            self.friction.mode.copy(),
             self.mode_changes,
             list(self.last_events),
             self._held_angle,
@@ -82,7 +82,7 @@ class DriveSnapshots:
             self.state,  # never changed in place: every step makes a new array
             self.layer,
             self.engaged,
-            self.friction.get_mode(),
+            self.friction.mode.copy(),
             self._held_angle,
             self.mode_changes,
             self.inputs,

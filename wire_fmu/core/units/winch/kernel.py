@@ -67,21 +67,17 @@ def kernel_data(model) -> tuple:
     model : WinchModel
         A winch with drum inertia.
     """
-    drum, k, inputs = model.drum, model.layer, model.inputs
-    low, high = drum.phi_bounds(k)
-    offset = drum.rope_inertia(0.0, k)
-    mode = int(model.friction.mode[0]) if model.friction.links else 0
-    brake_guards, layer_guards = model.guard_counts
-    modes = np.array([brake_guards, int(model.engaged), mode, layer_guards])
+    inputs = model.inputs
+    radius, offset, slope, low, high = _layer_constants(model)
     held = np.array(
         [
             model.motor_ratio * inputs.motor_command,
             model.motor_b,
             inputs.tension,
             inputs.lever_force,
-            drum.layer_radius(k),
+            radius,
             offset,
-            drum.rope_inertia_slope(k),
+            slope,
             model._caps[0, 0],
             model._caps[0, 1],
             low,
@@ -89,7 +85,40 @@ def kernel_data(model) -> tuple:
             model._held_angle,
         ]
     )
-    return modes, model.base_inertia, model.stiffness, model.damping, held
+    return _modes(model), model.base_inertia, model.stiffness, model.damping, held
+
+
+def _layer_constants(model) -> tuple[float, float, float, float, float]:
+    """The present layer's radius (m), rope inertia at 0 (kg m^2) and its slope
+    (kg m^2/rad), lowest and highest drum angle (rad); kept on the model per layer."""
+    kept = model._kernel_layer
+    if kept is not None and kept[0] == model.layer:
+        return kept[1]
+    drum, k = model.drum, model.layer
+    low, high = drum.phi_bounds(k)
+    constants = (
+        drum.layer_radius(k),
+        drum.rope_inertia(0.0, k),
+        drum.rope_inertia_slope(k),
+        low,
+        high,
+    )
+    model._kernel_layer = (k, constants)
+    return constants
+
+
+def _modes(model) -> np.ndarray:
+    """The ``modes`` array for the brake's present modes (kept on the model while they hold;
+    never changed in place)."""
+    mode = int(model.friction.mode[0]) if model.friction.links else 0
+    key = (int(model.engaged), mode)
+    kept = model._kernel_modes
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    brake_guards, layer_guards = model.guard_counts
+    modes = np.array([brake_guards, key[0], mode, layer_guards])
+    model._kernel_modes = (key, modes)
+    return modes
 
 
 @jit
