@@ -122,7 +122,9 @@ class CoreFacade(FacadeState, Fmi2Slave):
         self._inputs_changed = False
         self._initial_outputs_stale = True
         self._core_reals: dict[int, Variable] = {}  # value reference -> declared Real
+        self._core_integers: dict[int, Variable] = {}  # value reference -> declared Integer
         self._read_plans: dict[tuple[int, ...], tuple[tuple[str, ...], bool] | None] = {}
+        self._integer_plans: dict[tuple[int, ...], tuple[tuple[str, ...], bool] | None] = {}
         self._write_plans: dict[tuple[int, ...], tuple[str, ...] | None] = {}
         for var in unit_class.variables():
             self._register(var)
@@ -163,6 +165,8 @@ class CoreFacade(FacadeState, Fmi2Slave):
         self.register_variable(scalar, nested=False)
         if var.type is float:
             self._core_reals[scalar.value_reference] = var
+        elif var.type is int:
+            self._core_integers[scalar.value_reference] = var
 
     def _register_timing(self) -> None:
         # the unit base's timing hook, readable by any master (studies time the physics)
@@ -244,9 +248,10 @@ class CoreFacade(FacadeState, Fmi2Slave):
             self._reconfigure = True
 
     # The FMU binary's variable access, each failure logged (fmi2GetReal ... fmi2SetString).
-    # Reals, read and set every step, take a plan worked out once per list of references.
+    # Reals and Integers, read every step, take a plan worked out once per list of references
+    # (and Reals, set every step, another).
     _get_reals = fmi_access("fmi2GetReal", Fmi2Slave.get_real)
-    get_integer = fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
+    _get_integers = fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
     get_boolean = fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
     get_string = fmi_access("fmi2GetString", Fmi2Slave.get_string)
     _set_reals = fmi_access("fmi2SetReal", Fmi2Slave.set_real)
@@ -264,20 +269,43 @@ class CoreFacade(FacadeState, Fmi2Slave):
         vrs : list of int
             Value references.
         """
-        key = tuple(vrs)
-        plan = self._read_plans.get(key, False)
-        if plan is False:
-            plan = self._read_plans[key] = self._read_plan(key)
-        if plan is not None and self._phase is Phase.step:
-            names, feedthrough = plan
-            if not (feedthrough and self._inputs_changed):
-                values = self.unit.values
-                return [float(values[name]) for name in names]
-        return self._get_reals(vrs)
+        values = self._planned_read(vrs, self._read_plans, self._core_reals, float)
+        return self._get_reals(vrs) if values is None else values
 
-    def _read_plan(self, vrs: tuple[int, ...]) -> tuple[tuple[str, ...], bool] | None:
-        # None: not all declared Reals of the unit (the generic path answers, or refuses)
-        found = [self._core_reals.get(vr) for vr in vrs]
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        """fmi2GetInteger: the values of ``vrs``, planned as :meth:`get_real` plans its reads.
+
+        Parameters
+        ----------
+        vrs : list of int
+            Value references.
+        """
+        values = self._planned_read(vrs, self._integer_plans, self._core_integers, int)
+        return self._get_integers(vrs) if values is None else values
+
+    def _planned_read(
+        self, vrs: list[int], plans: dict, declared: dict[int, Variable], kind: type
+    ) -> list | None:
+        """The values of ``vrs`` from their read plan while stepping; None where the
+        generic, checked path must answer (another phase, or outputs to re-evaluate)."""
+        key = tuple(vrs)
+        plan = plans.get(key, False)
+        if plan is False:
+            plan = plans[key] = self._read_plan(key, declared)
+        if plan is None or self._phase is not Phase.step:
+            return None
+        names, feedthrough = plan
+        if feedthrough and self._inputs_changed:
+            return None
+        values = self.unit.values
+        return [kind(values[name]) for name in names]
+
+    def _read_plan(
+        self, vrs: tuple[int, ...], declared: dict[int, Variable]
+    ) -> tuple[tuple[str, ...], bool] | None:
+        # None: not all declared variables of the unit, of one type (the generic path
+        # answers, or refuses)
+        found = [declared.get(vr) for vr in vrs]
         if not all(found):
             return None
         feedthrough = any(v.causality is Causality.output and v.depends_on for v in found)

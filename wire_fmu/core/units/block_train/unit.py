@@ -65,6 +65,8 @@ _KINEMATIC_INPUTS = tuple(
     + [f"{p}.position" for p in MOVER_PORTS]
     + [f"{p}.velocity" for p in MOVER_PORTS]
 )
+_LINE_INPUTS = tuple((p, f"{p}.payout", f"{p}.payout_rate") for p in LINE_PORTS)
+_MOVER_INPUTS = tuple((p, f"{p}.position", f"{p}.velocity") for p in MOVER_PORTS)
 
 
 def _variables():
@@ -415,10 +417,10 @@ class BlockTrainUnit(Unit):
     def _inputs(self) -> BlockTrainInputs:
         v = self.values
         return BlockTrainInputs(
-            payout={p: float(v[f"{p}.payout"]) for p in LINE_PORTS},
-            payout_rate={p: float(v[f"{p}.payout_rate"]) for p in LINE_PORTS},
-            mover_position={p: float(v[f"{p}.position"]) for p in MOVER_PORTS},
-            mover_velocity={p: float(v[f"{p}.velocity"]) for p in MOVER_PORTS},
+            payout={p: float(v[name]) for p, name, _ in _LINE_INPUTS},
+            payout_rate={p: float(v[rate]) for p, _, rate in _LINE_INPUTS},
+            mover_position={p: float(v[name]) for p, name, _ in _MOVER_INPUTS},
+            mover_velocity={p: float(v[rate]) for p, _, rate in _MOVER_INPUTS},
         )
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
