@@ -137,9 +137,12 @@ class _WinchBase:
         inputs : WinchInputs
             Inputs held from now on.
         """
+        lever_force = self.inputs.lever_force
         self.inputs = inputs
         self._step_summary = None  # outputs a compiled step computed are for other inputs
-        if self.brake is not None:
+        if self.brake is not None and (
+            inputs.lever_force != lever_force or self._caps is _NO_CAPACITY
+        ):  # a new array, never changed in place: snapshots and kernel data keep the old one
             self._caps = np.array([self.brake.capacities(inputs.lever_force)])
 
     @property
