@@ -1,0 +1,96 @@
+"""One compiled entry point per kernel, loaded when the unit is initialised (issue 16).
+
+A compiled function is loaded from the on-disk cache at its first call with given
+argument types. The block train's and the winch's loops after an event go through
+their quiet step's own function (``resume``), and initialisation calls it once with a
+step of nothing, so that no loading falls inside the stepping. These tests check that
+that call takes the very argument types of the steps that follow (else it would load
+a specialisation no step uses) and that it changes nothing.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+
+import numba
+import numpy as np
+import pytest
+
+from wire_fmu.core.framework import compiled
+from wire_fmu.core.framework.compiled_step import CompiledFixedStep
+from wire_fmu.core.units.block_train import kernel as block_train_kernel
+from wire_fmu.core.units.block_train.unit import BlockTrainUnit
+from wire_fmu.core.units.winch import kernel as winch_kernel
+from wire_fmu.master.run import find_scene
+
+from .winch_helpers import make_unit as make_winch
+
+pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
+
+
+def recorded_calls(monkeypatch, module) -> list[tuple]:
+    """The numba types of every call of ``module.quiet_step`` from now on (still called)."""
+    calls: list[tuple] = []
+    original = module.quiet_step
+
+    def recording(*args):
+        calls.append(tuple(numba.typeof(a) for a in args))
+        return original(*args)
+
+    monkeypatch.setattr(module, "quiet_step", recording)
+    return calls
+
+
+def drawworks_rope() -> BlockTrainUnit:
+    """The drawworks scene's block train (12 coordinates, bearing friction), not initialised."""
+    scene = tomllib.loads(find_scene("drawworks").read_text())["units"]["rope"]
+    unit = BlockTrainUnit("rope")
+    unit.values["reeving"] = json.dumps(scene["parameters"]["reeving"])
+    unit.values["effects"] = ",".join(scene["effects"])
+    unit.values["solver"] = "rk4"
+    unit.configure()
+    return unit
+
+
+def test_the_block_train_loads_its_step_with_the_types_its_steps_use(monkeypatch):
+    calls = recorded_calls(monkeypatch, block_train_kernel)
+    unit = drawworks_rope()
+    assert unit.model.compiled and isinstance(unit.model.solver, CompiledFixedStep)
+    unit.initialize(0.0)
+    assert calls  # the preload, at initialisation
+    unit.values["line_a.payout_rate"] = -1.0  # lowering: the bearings break loose
+    for k in range(50):
+        unit.values["line_a.payout"] = -1.0 * k * 0.002
+        assert unit.advance(k * 0.002, 0.002).success
+    assert unit.model.mode_changes > 0  # events: the loop went on through ``resume``
+    assert len(calls) > 50
+    assert set(calls) == {calls[0]}
+
+
+def test_the_preload_changes_nothing():
+    unit = drawworks_rope()
+    unit.initialize(0.0)
+    model = unit.model
+    state, held = model.state.copy(), model.held_vector.copy()
+    counts = (model.solver.steps, model.solver.rhs_calls)
+    outputs = dict(unit.values)
+    model.preload_kernel(0.0)
+    np.testing.assert_array_equal(model.state, state)
+    np.testing.assert_array_equal(model.held_vector, held)
+    assert (model.solver.steps, model.solver.rhs_calls) == counts
+    assert unit.values == outputs
+
+
+def test_the_winch_loads_its_step_with_the_types_its_steps_use(monkeypatch):
+    calls = recorded_calls(monkeypatch, winch_kernel)
+    unit = make_winch("drum_inertia,band_brake", solver="rk4", brake__lever_force=0.0)
+    assert isinstance(unit.model.solver, CompiledFixedStep)
+    assert calls
+    unit.values["tension"] = 5e4
+    for k in range(50):
+        unit.values["brake.lever_force"] = 2000.0 if k >= 20 else 0.0  # the brake catches
+        assert unit.advance(k * 0.002, 0.002).success
+    assert unit.model.mode_changes > 0
+    assert len(calls) > 50
+    assert set(calls) == {calls[0]}
