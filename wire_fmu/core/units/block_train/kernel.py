@@ -567,10 +567,10 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
     of the step or its first event, then the outputs' :func:`summary` at the end.
     It changes nothing it was given.
 
-    With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead (the loop going on
-    after an event Python switched, ``data`` as the model holds it, ``held`` unused):
-    the one entry point Python calls for both, so that one compiled function is
-    loaded from the cache, not two.
+    With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead, without the
+    summary (the loop going on after an event Python switched, ``data`` as the model
+    holds it, ``held`` unused): the one entry point Python calls for both, so that one
+    compiled function is loaded from the cache, not two.
 
     Parameters
     ----------
@@ -603,8 +603,6 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
         status, x, t, k, fired, steps, calls, h = advance(
             method, t0, t1, n, k, t, x, directions, tol, data
         )
-        if status == STATUS_DONE:
-            return status, x, t, k, fired, steps, calls, h, summary(t1, x, data)
         return status, x, t, k, fired, steps, calls, h, np.zeros(0)
     n_coords, n_links = data[0][0], data[17].shape[0]
     # the held inputs from t0 on, and a stuck coordinate held where the step starts

@@ -374,6 +374,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             hold_angle,
             0,
             t,
+            False,
         )
         if result[0] == STATUS_PYTHON:
             return False

@@ -284,7 +284,7 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
 
 
 @jit
-def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle, k, t):
+def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle, k, t, resume):
     """A whole communication step in one call, when the new inputs switch no brake mode.
 
     What :meth:`WinchModel.advance <wire_fmu.core.units.winch.drive.WinchModel.advance>`
@@ -293,16 +293,17 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
     :func:`advance` to the end of the step or its first event, the :func:`summary` at
     the end. It changes nothing it was given.
 
-    Without ``check_stick`` and ``hold_angle`` it is :func:`advance` from ``(k, t, x)``
-    (:func:`resume`): the one entry point Python calls, so that one compiled function
-    is loaded from the cache, not two.
+    With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead, without the
+    summary (:func:`resume`, after an event Python switched): the one entry point
+    Python calls for both, so that one compiled function is loaded from the cache,
+    not two.
 
     Parameters
     ----------
     method, t0, t1, n, tol, directions
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     x : numpy.ndarray
-        State at ``t``.
+        State at ``t0`` (at ``t`` with ``resume``).
     data : tuple
         See the module docstring, for the new inputs.
     check_stick : bool
@@ -310,9 +311,11 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
     hold_angle : bool
         The brake is in the mode it keeps: a held drum stays at the angle it has now.
     k : int
-        The interval ``t`` lies in (0 for a whole step).
+        With ``resume``: the interval ``t`` lies in (else 0).
     t : float
-        The time the loop starts from, s (``t0`` for a whole step).
+        With ``resume``: the time the loop goes on from, s (else ``t0``).
+    resume : bool
+        Go on with :func:`advance` from ``(k, t, x)``, nothing else.
 
     Returns
     -------
@@ -323,7 +326,12 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         settle the brake first.
     """
     no_summary = np.zeros(0)
-    if check_stick and guards(t, x, data)[0] < 0.0:
+    if resume:
+        status, x, t, k, fired, steps, calls, h = advance_to_event(
+            rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+        )
+        return status, x, t, k, fired, steps, calls, h, no_summary
+    if check_stick and guards(t0, x, data)[0] < 0.0:
         no_fire = np.zeros(directions.size, dtype=np.bool_)
         return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
     x = x.copy()
@@ -334,7 +342,7 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         data = (modes, inertia, stiffness, damping, held)
         x = project(x, data)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
     )
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(x, data)
@@ -349,4 +357,4 @@ def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return quiet_step(method, t0, t1, n, tol, x, directions, data, False, False, k, t)[:8]
+    return quiet_step(method, t0, t1, n, tol, x, directions, data, False, False, k, t, True)[:8]
