@@ -34,6 +34,17 @@ SCENES = {
     "sliding": (ALL, {"brake.lever_force": 500.0, "rope.tension": 1.5e5, "motor.command": -500.0}),
     "free": ("drum_inertia,elastic_drive_train", {"rope.tension": 1e5, "motor.command": 1e3}),
 }
+_ROPE_MODEL = {
+    "rope.stiffness": 2.0e5,
+    "rope.damping": 3.0e3,
+    "rope.effort_rate": 1.0e4,
+    "rope.reference_position": 0.5,
+    "rope.reference_velocity": 0.5,
+}
+SCENES |= {  # the tension from the block train's interface model
+    "kinetostatic, rope model": ("band_brake", {**SCENES["kinetostatic"][1], **_ROPE_MODEL}),
+    "held, rope model": ("drum_inertia,band_brake", {**SCENES["held"][1], **_ROPE_MODEL}),
+}
 
 
 def scene(name: str) -> WinchUnit:
@@ -85,11 +96,12 @@ def test_rope_port_outputs_come_from_the_drum_state():
 
 
 def perturbed(unit: WinchUnit, name: str, delta: float) -> tuple[dict, dict]:
+    unit.evaluate_outputs()  # a rope model's tension about now, not about the last step's start
     before = dict(unit.values)
     unit.values[name] += delta
     unit.evaluate_outputs()
     after = dict(unit.values)
-    unit.values[name] -= delta
+    unit.values[name] = before[name]
     unit.evaluate_outputs()
     assert unit.values == before
     return before, after

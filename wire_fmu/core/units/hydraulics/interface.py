@@ -29,50 +29,23 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from wire_fmu.core.framework.interface_model import EffortModel, interface_input_names
+
 __all__ = ["INTERFACE_INPUTS", "NO_INTERFACE", "RodInterface"]
 
-INTERFACE_INPUTS = (
-    "rod.stiffness",
-    "rod.damping",
-    "rod.effort_rate",
-    "rod.reference_position",
-    "rod.reference_velocity",
-)
+INTERFACE_INPUTS = interface_input_names("rod")
 """The unit's inputs of the interface model, in the order of :class:`RodInterface`'s fields."""
 
 
 @dataclass(frozen=True)
-class RodInterface:
+class RodInterface(EffortModel):
     """The effort side's local model of the rod force about a communication point.
 
-    Parameters
-    ----------
-    stiffness : float
-        ``K = -dF/dx``, N/m (>= 0).
-    damping : float
-        ``D = -dF/dv``, N s/m (>= 0).
-    effort_rate : float
-        ``R = dF/dt`` with the rod held still, N/s.
-    reference_position : float
-        Rod displacement ``d_ref`` the force was linearised at (``rod.displacement``'s
-        convention: extension since the start), m.
-    reference_velocity : float
-        Rod velocity ``v_ref`` it was linearised at, m/s.
-    start : float
-        The communication point ``t0`` the model is about, s.
+    The fields and their units are :class:`~wire_fmu.core.framework.interface_model.EffortModel`'s
+    (``reference_position`` in ``rod.displacement``'s convention: extension since
+    the start); the rod's position in the cylinder's equations is its extension from
+    fully retracted (:meth:`reference_extension`).
     """
-
-    stiffness: float = 0.0
-    damping: float = 0.0
-    effort_rate: float = 0.0
-    reference_position: float = 0.0
-    reference_velocity: float = 0.0
-    start: float = 0.0
-
-    @property
-    def active(self) -> bool:
-        """Whether the force varies over the step (any of ``K``, ``D``, ``R`` nonzero)."""
-        return self.stiffness != 0.0 or self.damping != 0.0 or self.effort_rate != 0.0
 
     def reference_extension(self, initial_position: float) -> float:
         """``x_ref``: the rod's extension (from fully retracted) at ``d_ref``, m.
@@ -85,10 +58,7 @@ class RodInterface:
         return initial_position + self.reference_position
 
     def force(self, held: float, t: float, x: float, v: float, x_ref: float) -> float:
-        """``F(x, v, t)``: the rod force of the local model, N.
-
-        Each term is added only when its coefficient is nonzero, so that without the
-        model the force is ``held`` exactly (the compiled kernel does the same).
+        """``F(x, v, t)``: the rod force of the local model (:meth:`effort`), N.
 
         Parameters
         ----------
@@ -103,57 +73,17 @@ class RodInterface:
         x_ref : float
             :meth:`reference_extension`, m.
         """
-        force = held
-        if self.stiffness != 0.0:
-            force = force - self.stiffness * (x - x_ref)
-        if self.damping != 0.0:
-            force = force - self.damping * (v - self.reference_velocity)
-        if self.effort_rate != 0.0:
-            force = force + self.effort_rate * (t - self.start)
-        return force
+        return self.effort(held, t, x, v, x_ref)
 
-    def power(self, t: float, v: float) -> float:
-        """Power of the damper and rate terms into the rod, ``(R (t - t0) - D (v - v_ref)) v``, W.
+    def problems(self, port: str = "rod") -> list[str]:
+        """A spring or damper of the wrong sign, naming the input (NaN is checked apart).
 
         Parameters
         ----------
-        t : float
-            Time, s.
-        v : float
-            Rod velocity, m/s.
+        port : str
+            The port's name in the inputs' names.
         """
-        return (
-            self.effort_rate * (t - self.start) - self.damping * (v - self.reference_velocity)
-        ) * v
-
-    def elastic_work(self, x0: float, x1: float, x_ref: float) -> float:
-        """Work of the spring term as the rod moves from ``x0`` to ``x1`` (m), J.
-
-        ``-K [(x1 - x_ref)^2 - (x0 - x_ref)^2] / 2``, written as a product so that a
-        small move about a far reference loses no digits.
-
-        Parameters
-        ----------
-        x0, x1 : float
-            Rod extension at the step's start and end, m.
-        x_ref : float
-            :meth:`reference_extension`, m.
-        """
-        return -0.5 * self.stiffness * (x1 - x0) * ((x1 - x_ref) + (x0 - x_ref))
-
-    def problems(self) -> list[str]:
-        """A spring or damper of the wrong sign, naming the input (NaN is checked apart)."""
-        out = []
-        for name, value, unit in (
-            ("rod.stiffness", self.stiffness, "N/m"),
-            ("rod.damping", self.damping, "N.s/m"),
-        ):
-            if value < 0.0:
-                out.append(
-                    f"input {name!r} must be >= 0 {unit} (the effort side's spring and damper "
-                    f"resist the rod's motion), got {value!r}"
-                )
-        return out
+        return super().problems(port)
 
 
 NO_INTERFACE = RodInterface()

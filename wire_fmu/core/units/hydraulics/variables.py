@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from wire_fmu.core.framework.interface_model import interface_inputs
 from wire_fmu.core.framework.solver_options import solver_parameters
 from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
 from wire_fmu.core.units.hydraulics.interface import INTERFACE_INPUTS
@@ -145,50 +146,6 @@ def _physical_parameters():
     )
 
 
-def _interface_inputs():
-    """The effort side's interface model of the rod force (all 0: the force is held)."""
-    model = (
-        "the rod force over the step is rod.force - K (rod.displacement - reference_position) "
-        "- D (rod.velocity - reference_velocity) + R (t - t0)"
-    )
-    return (
-        input_(
-            "rod.stiffness",
-            0.0,
-            "N/m",
-            "Interface model: K = -d rod.force / d rod.displacement of the effort side, >= 0; "
-            + model,
-        ),
-        input_(
-            "rod.damping",
-            0.0,
-            "N.s/m",
-            "Interface model: D = -d rod.force / d rod.velocity of the effort side, >= 0",
-        ),
-        input_(
-            "rod.effort_rate",
-            0.0,
-            "N/s",
-            "Interface model: R = d rod.force / d t with the rod held still (the effort "
-            "side's other inputs), from the communication point t0",
-        ),
-        input_(
-            "rod.reference_position",
-            0.0,
-            "m",
-            "Interface model: rod.displacement at which the effort side took rod.force and "
-            "its derivatives",
-        ),
-        input_(
-            "rod.reference_velocity",
-            0.0,
-            "m/s",
-            "Interface model: rod.velocity at which the effort side took rod.force and its "
-            "derivatives",
-        ),
-    )
-
-
 def variables() -> tuple:
     """The unit's variables: effects and solver, physical parameters, start, inputs, outputs."""
     params = (
@@ -232,7 +189,7 @@ def variables() -> tuple:
             "External force on the rod along extension (positive pushes it out); held over "
             "the step, or E0 of the interface model",
         ),
-        *_interface_inputs(),
+        *interface_inputs("rod", "translational", "rod.force", "rod.displacement", "rod.velocity"),
     )
     deps = _FEEDTHROUGH
     outputs = (

@@ -7,16 +7,22 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 
 import numpy as np
 
 from wire_fmu.core.components.drive_train import DriveChain
 from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ModelError
+from wire_fmu.core.framework.interface_model import EffortModel, interface_input_names
 from wire_fmu.core.units.winch.brake import BandBrake
 
-__all__ = ["WinchInputs", "WinchConfig", "WinchReport"]
+__all__ = ["NO_ROPE_MODEL", "ROPE_MODEL_INPUTS", "WinchInputs", "WinchConfig", "WinchReport"]
+
+ROPE_MODEL_INPUTS = interface_input_names("rope")
+"""The unit's inputs of the rope's interface model, in :class:`EffortModel`'s order."""
+NO_ROPE_MODEL = EffortModel()
+"""The held tension: no interface model."""
 
 logger = logging.getLogger(__name__)
 
@@ -28,7 +34,8 @@ class WinchInputs:
     Attributes
     ----------
     tension : float
-        Rope tension at the drum, N.
+        Rope tension at the drum, N: held over the step, or the block train's
+        tension ``E0`` at the step's start about which ``rope_model`` is taken.
     lever_force : float
         Force on the brake lever, N.
     motor_command : float
@@ -36,22 +43,62 @@ class WinchInputs:
         characteristic, its zero-speed torque ``a``.
     speed_command : float
         Drum speed the drive imposes in kinetostatic mode, rad/s.
+    rope_model : EffortModel
+        The block train's interface model of the tension about the step's start
+        (:mod:`~wire_fmu.core.framework.interface_model`; position ``rope.payout``,
+        velocity ``rope.payout_rate``); :data:`NO_ROPE_MODEL` holds the tension.
     """
 
     tension: float = 0.0
     lever_force: float = 0.0
     motor_command: float = 0.0
     speed_command: float = 0.0
+    rope_model: EffortModel = NO_ROPE_MODEL
+
+    def tension_at(self, t: float, payout: float, payout_rate: float) -> float:
+        """Rope tension at time ``t`` with the drum at ``payout`` and ``payout_rate``, N.
+
+        The held ``tension`` without an interface model; with one, its local model
+        ``E0 - K (payout - x_ref) - D (payout_rate - v_ref) + R (t - t0)``, and at
+        least 0: a rope cannot push (a model that would is a rope gone slack).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        payout : float
+            Rope paid out, m.
+        payout_rate : float
+            Its rate, m/s.
+        """
+        model = self.rope_model
+        if not model.active:
+            return self.tension
+        tension = model.effort(self.tension, t, payout, payout_rate, model.reference_position)
+        return tension if tension > 0.0 else 0.0
 
     def problems(self) -> list[str]:
-        """Names of non-finite inputs."""
-        names = ("rope.tension", "brake.lever_force", "motor.command", "drum.speed_command")
-        values = (self.tension, self.lever_force, self.motor_command, self.speed_command)
-        return [
+        """Non-finite inputs and a rope model's spring or damper of the wrong sign, named."""
+        names = (
+            "rope.tension",
+            "brake.lever_force",
+            "motor.command",
+            "drum.speed_command",
+            *ROPE_MODEL_INPUTS,
+        )
+        values = (
+            self.tension,
+            self.lever_force,
+            self.motor_command,
+            self.speed_command,
+            *astuple(self.rope_model)[: len(ROPE_MODEL_INPUTS)],
+        )
+        out = [
             f"input {n!r} is not finite ({v})"
             for n, v in zip(names, values, strict=True)
             if not math.isfinite(v)
         ]
+        return out + self.rope_model.problems("rope")
 
 
 @dataclass(frozen=True)
@@ -127,6 +174,7 @@ class _WinchBase:
         self.mode_changes = 0
         self.last_events: list[tuple[float, str]] = []
         self.first_event_time = math.inf  # of the last step's located events, s
+        self.time = 0.0  # of the state, s: where the rope model's tension is taken
         self._caps = _NO_CAPACITY
 
     def set_inputs(self, inputs: WinchInputs) -> None:
@@ -179,6 +227,7 @@ class _WinchBase:
             "lever_force": i.lever_force,
             "motor_command": i.motor_command,
             "speed_command": i.speed_command,
+            "rope_model": list(astuple(i.rope_model)),
         }
 
     def restore_held_inputs(self, data: dict[str, float]) -> None:
@@ -187,7 +236,11 @@ class _WinchBase:
         Parameters
         ----------
         data : dict
-            Tension (N), lever force (N), motor command (N m) and speed command
-            (rad/s) as from :meth:`held_inputs`.
+            Tension (N), lever force (N), motor command (N m), speed command
+            (rad/s) and the rope model's fields as from :meth:`held_inputs`.
         """
-        self.set_inputs(WinchInputs(**{k: float(v) for k, v in data.items()}))
+        data = dict(data)
+        fields = data.pop("rope_model", None)
+        model = NO_ROPE_MODEL if fields is None else EffortModel(*map(float, fields))
+        inputs = WinchInputs(**{k: float(v) for k, v in data.items()}, rope_model=model)
+        self.set_inputs(inputs)

@@ -102,8 +102,25 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         """Motor torque reduced to the drum shaft at reduced speed ``omega0``."""
         return self.motor_ratio * self.inputs.motor_command - self.motor_b * omega0
 
-    def _forces(self, x: np.ndarray) -> np.ndarray:
-        """All torques except the brake's on every mass (reduced), N m; updates I(phi)."""
+    def rope_tension(self, t: float, x: np.ndarray) -> float:
+        """Rope tension at ``(t, x)``: held, or the rope's interface model, N.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        x : ndarray
+            State ``[theta (rad), omega (rad/s), dissipated (J), external work (J)]``.
+        """
+        n, k = self.n, self.layer
+        phi, w = x[n - 1], x[2 * n - 1]
+        return self.inputs.tension_at(
+            t, self.drum.payout(phi, k), self.drum.layer_radius(k) * w
+        )
+
+    def _forces(self, x: np.ndarray, t: float) -> np.ndarray:
+        """All torques except the brake's on every mass (reduced) at time ``t`` (s), N m;
+        updates I(phi)."""
         n = self.n
         theta, omega = x[:n], x[n : 2 * n]
         if n > 1:
@@ -114,14 +131,15 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         phi, w = theta[n - 1], omega[n - 1]
         drum, k = self.drum, self.layer
         forces[n - 1] += (
-            self.inputs.tension * drum.layer_radius(k) - 0.5 * drum.rope_inertia_slope(k) * w * w
+            self.rope_tension(t, x) * drum.layer_radius(k)
+            - 0.5 * drum.rope_inertia_slope(k) * w * w
         )
         self.masses[n - 1] = self.base_inertia[n - 1] + drum.rope_inertia(phi, k)
         return forces
 
-    def _dynamics(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Accelerations and brake torque (shape (0,) or (1,)) in the current mode."""
-        forces = self._forces(x)
+    def _dynamics(self, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Accelerations and brake torque (shape (0,) or (1,)) in the current mode at ``t``."""
+        forces = self._forces(x, t)
         if self.engaged:
             return self.friction.accelerations(forces, self._caps)
         return forces / self.masses, np.zeros(len(self.friction.links))
@@ -145,7 +163,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             return kernel.rhs(t, x, self.kernel_data())
         n = self.n
         omega = x[n : 2 * n]
-        acc, link = self._dynamics(x)
+        acc, link = self._dynamics(x, t)
         out = np.empty_like(x)
         out[:n] = omega
         out[n : 2 * n] = acc
@@ -157,7 +175,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         r = self.drum.layer_radius(self.layer)
         out[2 * n] = loss
         out[2 * n + 1] = (
-            self._motor_reduced(omega[0]) * omega[0] + self.inputs.tension * r * omega[n - 1]
+            self._motor_reduced(omega[0]) * omega[0] + self.rope_tension(t, x) * r * omega[n - 1]
         )
         return out
 
@@ -191,13 +209,13 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         layer = self.drum.layer_guards(x[self.n - 1], self.layer)
         if not self.friction.links:
             return layer
-        return np.concatenate((self._brake_guards(x), layer))
+        return np.concatenate((self._brake_guards(x, t), layer))
 
-    def _brake_guards(self, x: np.ndarray) -> list[float]:
-        """Stick/slip and engagement guards of the brake at ``x``."""
+    def _brake_guards(self, x: np.ndarray, t: float) -> list[float]:
+        """Stick/slip and engagement guards of the brake at ``(t, x)``."""
         if not self.engaged:
             return [1.0, -self.inputs.lever_force]
-        _, link = self._dynamics(x)
+        _, link = self._dynamics(x, t)
         stick_slip = self.friction.guards(x[self.n : 2 * self.n], link, self._caps)
         return [*stick_slip, self.inputs.lever_force]
 
@@ -316,11 +334,12 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             Inputs at the start.
         """
         self.set_inputs(inputs)
+        self.time = float(t0)
         self.layer = self.drum.initial_layer()
         n = self.n
         x = np.zeros(2 * n + 2)
         x[n : 2 * n] = self.config.initial_speed
-        forces = self._forces(x)
+        forces = self._forces(x, t0)
         acc = self._rigid_acceleration(float(forces.sum()), float(self.masses.sum()), x[2 * n - 1])
         twists = np.cumsum(forces[:-1] - self.masses[:-1] * acc) / np.asarray(
             self.chain.stiffnesses, dtype=float
@@ -330,7 +349,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.mode_changes = 0
         self.last_events = []
         self.state = self._settle_modes(t0, x, [])
-        self._forces(self.state)
+        self._forces(self.state, t0)
         self.preload_kernel(t0)
 
     def advance(self, t: float, h: float, inputs: WinchInputs) -> int:
@@ -350,11 +369,13 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.set_inputs(inputs)
         kept = self._kept_brake_mode()
         if kept is not None and self._quiet_step(t, h, *kept):
+            self.time = t + h
             return self._quiet_events
         self.state = self._settle_modes(t, self.state)
         x, events = self.solver.advance(self, t, self.state, t + h)
         self.state = x
-        self._forces(x)
+        self.time = t + h
+        self._forces(x, self.time)
         return events
 
     def _quiet_step(self, t: float, h: float, check_stick: bool, hold_angle: bool) -> bool:
@@ -385,7 +406,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             self._step_summary = (x, values)
         self.state = x
         if values is None:  # after an event; else the outputs come from the kernel's summary
-            self._forces(x)
+            self._forces(x, t1)
         return True
 
     # ---------------------------------------------------------- outputs
@@ -399,10 +420,10 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         """
         x = self.state if x is None else x
         if self.compiled:
-            return float(kernel.summary(x, self.kernel_data())[1])
+            return float(kernel.summary(self.time, x, self.kernel_data())[1])
         n = self.n
         theta, omega = x[:n], x[n : 2 * n]
-        self._forces(x)
+        self._forces(x, self.time)
         return 0.5 * float(self.masses @ omega**2) + 0.5 * float(theta @ self.stiffness @ theta)
 
     def report(self) -> WinchReport:
@@ -413,10 +434,11 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             done = self._step_summary
             values = done[1] if done is not None and done[0] is x else None
             if values is None:
-                values = kernel.summary(x, self.kernel_data())
+                values = kernel.summary(self.time, x, self.kernel_data())
             brake, stored = values.tolist()
         else:
-            brake, stored = float(self._dynamics(x)[1][0]) if self.engaged else 0.0, None
+            brake = float(self._dynamics(x, self.time)[1][0]) if self.engaged else 0.0
+            stored = None
         w, k = float(x[2 * n - 1]), self.layer
         radius = self.drum.layer_radius(k)
         motor_speed = self.motor_ratio * float(x[n])

@@ -41,7 +41,7 @@ class DrumBrakeModes:
         Without a brake the capacities are zero: it stays released, nothing changes.
         """
         x = np.array(x, dtype=float)
-        if fired is None and self.compiled and self._brake_mode_holds(x):
+        if fired is None and self.compiled and self._brake_mode_holds(t, x):
             self._held_angle = float(x[self.n - 1])
             return self.project(x)
         before = self._mode_key()
@@ -52,7 +52,7 @@ class DrumBrakeModes:
             if not self.engaged:
                 self.friction.set_mode([int(np.sign(x[2 * n - 1]))])
                 self.engaged = True
-            forces = self._forces(x)
+            forces = self._forces(x, t)
             x[n : 2 * n] = self.friction.switch(x[n : 2 * n], forces, self._caps, fired or [])
         if self._mode_key() != before or fired:
             self._event(t, f"brake {_BRAKE_WORDS[self.brake_state()]}")
@@ -61,8 +61,8 @@ class DrumBrakeModes:
         self._held_angle = float(x[n - 1])
         return self.project(x)
 
-    def _brake_mode_holds(self, x: np.ndarray) -> bool:
-        """Whether the brake's present mode fits the inputs at ``x`` (nothing to settle).
+    def _brake_mode_holds(self, t: float, x: np.ndarray) -> bool:
+        """Whether the brake's present mode fits the inputs at ``(t, x)`` (nothing to settle).
 
         Released and without capacity; or engaged with capacity, and sliding, or
         stuck with a holding margin left (the compiled kernel's stick guard).
@@ -73,7 +73,7 @@ class DrumBrakeModes:
             return False
         if self.friction.mode[0] != 0:
             return True
-        return bool(kernel.guards(0.0, x, self.kernel_data())[0] >= 0.0)
+        return bool(kernel.guards(t, x, self.kernel_data())[0] >= 0.0)
 
     def _rigid_acceleration(self, torque: float, inertia: float, omega: float) -> float:
         """Acceleration of the chain locked rigid under ``torque`` (N m) and the brake."""

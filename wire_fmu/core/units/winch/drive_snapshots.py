@@ -21,7 +21,7 @@ __all__ = ["DriveSnapshots"]
 class DriveSnapshots:
     """State keeping and trials (a mixin of the model).
 
-    The model provides ``state``, ``layer``, ``engaged``, ``friction``, ``inputs``,
+    The model provides ``state``, ``time``, ``layer``, ``engaged``, ``friction``, ``inputs``,
     ``mode_changes``, ``last_events``, ``solver``, ``_held_angle``, ``set_inputs``,
     ``held_inputs``, ``restore_held_inputs``, ``_settle_modes`` and ``_forces``.
     """
@@ -46,7 +46,7 @@ class DriveSnapshots:
         )
         try:
             self.set_inputs(inputs)
-            self._settle_modes(0.0, self.state)
+            self._settle_modes(self.time, self.state)
             self.mode_changes = saved[3]  # a trial is not an event
             yield
         finally:
@@ -61,12 +61,13 @@ class DriveSnapshots:
             ) = saved
             self.friction.set_mode(mode)
             self.set_inputs(inputs_)
-            self._forces(self.state)
+            self._forces(self.state, self.time)
 
     def get_state(self) -> dict:
         """Complete model state as plain data."""
         return {
             "x": [float(c) for c in self.state],
+            "time": float(self.time),
             "layer": int(self.layer),
             "engaged": bool(self.engaged),
             "friction_mode": self.friction.get_mode(),
@@ -80,6 +81,7 @@ class DriveSnapshots:
         """What undoing a step needs, kept in this process (cheaper than :meth:`get_state`)."""
         return (
             self.state,  # never changed in place: every step makes a new array
+            self.time,
             self.layer,
             self.engaged,
             self.friction.mode.copy(),
@@ -98,11 +100,11 @@ class DriveSnapshots:
         saved : tuple
             A snapshot of this model.
         """
-        (self.state, self.layer, self.engaged, mode, self._held_angle, self.mode_changes,
-         inputs, self.solver.rhs_calls, self.solver.steps) = saved  # fmt: skip
+        (self.state, self.time, self.layer, self.engaged, mode, self._held_angle,
+         self.mode_changes, inputs, self.solver.rhs_calls, self.solver.steps) = saved  # fmt: skip
         self.friction.set_mode(mode)
         self.set_inputs(inputs)
-        self._forces(self.state)
+        self._forces(self.state, self.time)
 
     def set_state(self, data: dict) -> None:
         """Restore a state from :meth:`get_state`.
@@ -113,6 +115,7 @@ class DriveSnapshots:
             A state from :meth:`get_state`.
         """
         self.state = np.array(data["x"], dtype=float)
+        self.time = float(data["time"])
         self.layer = int(data["layer"])
         self.engaged = bool(data["engaged"])
         self.friction.set_mode(list(data["friction_mode"]))
@@ -121,4 +124,4 @@ class DriveSnapshots:
         self.restore_held_inputs(data["inputs"])
         self.solver.rhs_calls = int(data["solver"]["rhs_calls"])
         self.solver.steps = int(data["solver"]["steps"])
-        self._forces(self.state)
+        self._forces(self.state, self.time)

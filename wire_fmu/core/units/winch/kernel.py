@@ -37,6 +37,7 @@ __all__ = [
     "quiet_step",
     "resume",
     "rhs",
+    "rope_tension",
     "summary",
 ]
 
@@ -44,7 +45,7 @@ __all__ = [
 HELD = (
     "motor torque at zero speed reduced to the drum shaft (N m)",
     "motor slope reduced to the drum shaft (N m s/rad)",
-    "rope tension (N)",
+    "rope tension, or E0 of the rope's interface model (N)",
     "brake lever force (N)",
     "winding radius of the layer (m)",
     "rope inertia on the drum at phi = 0 for the layer (kg m^2)",
@@ -54,9 +55,18 @@ HELD = (
     "lowest drum angle of the layer (rad)",
     "highest drum angle of the layer (rad)",
     "drum angle the brake holds (rad)",
+    "rope model: stiffness K (N/m)",
+    "rope model: damping D (N s/m)",
+    "rope model: effort rate R (N/s)",
+    "rope model: reference payout (m)",
+    "rope model: reference payout rate (m/s)",
+    "rope model: the time it is about (s)",
+    "rope paid out at drum angle 0 on the layer (m)",
 )
 """What the ``held`` array holds, in order: inputs and the present layer's constants."""
-_HELD_ANGLE = len(HELD) - 1
+_HELD_ANGLE = 11
+_ROPE_MODEL = 12  # K, D, R, reference payout, reference rate, start: six entries from here
+_PAYOUT_OFFSET = 18
 
 
 def kernel_data(model) -> tuple:
@@ -68,7 +78,8 @@ def kernel_data(model) -> tuple:
         A winch with drum inertia.
     """
     inputs = model.inputs
-    radius, offset, slope, low, high = _layer_constants(model)
+    radius, offset, slope, low, high, paid = _layer_constants(model)
+    rope = inputs.rope_model
     held = np.array(
         [
             model.motor_ratio * inputs.motor_command,
@@ -83,14 +94,22 @@ def kernel_data(model) -> tuple:
             low,
             high,
             model._held_angle,
+            rope.stiffness,
+            rope.damping,
+            rope.effort_rate,
+            rope.reference_position,
+            rope.reference_velocity,
+            rope.start,
+            paid,
         ]
     )
     return _modes(model), model.base_inertia, model.stiffness, model.damping, held
 
 
-def _layer_constants(model) -> tuple[float, float, float, float, float]:
+def _layer_constants(model) -> tuple[float, float, float, float, float, float]:
     """The present layer's radius (m), rope inertia at 0 (kg m^2) and its slope
-    (kg m^2/rad), lowest and highest drum angle (rad); kept on the model per layer."""
+    (kg m^2/rad), lowest and highest drum angle (rad) and rope paid out at angle 0 (m);
+    kept on the model per layer."""
     kept = model._kernel_layer
     if kept is not None and kept[0] == model.layer:
         return kept[1]
@@ -102,6 +121,7 @@ def _layer_constants(model) -> tuple[float, float, float, float, float]:
         drum.rope_inertia_slope(k),
         low,
         high,
+        drum.payout(0.0, k),
     )
     model._kernel_layer = (k, constants)
     return constants
@@ -122,7 +142,35 @@ def _modes(model) -> np.ndarray:
 
 
 @jit
-def _dynamics(x: np.ndarray, data):
+def rope_tension(t: float, x: np.ndarray, data) -> float:
+    """Rope tension at ``(t, x)``: held, or the rope's interface model (at least 0), N.
+
+    :meth:`WinchInputs.tension_at <wire_fmu.core.units.winch.base.WinchInputs.tension_at>`
+    with the same operations in the same order.
+
+    Parameters
+    ----------
+    t, x, data
+        Time (s), state and kernel data, as :func:`rhs` takes them.
+    """
+    held = data[4]
+    n = data[1].size
+    stiffness, damping, rate = held[_ROPE_MODEL], held[_ROPE_MODEL + 1], held[_ROPE_MODEL + 2]
+    tension = held[2]
+    if stiffness == 0.0 and damping == 0.0 and rate == 0.0:
+        return tension
+    if stiffness != 0.0:
+        payout = held[_PAYOUT_OFFSET] + held[4] * x[n - 1]
+        tension = tension - stiffness * (payout - held[_ROPE_MODEL + 3])
+    if damping != 0.0:
+        tension = tension - damping * (held[4] * x[2 * n - 1] - held[_ROPE_MODEL + 4])
+    if rate != 0.0:
+        tension = tension + rate * (t - held[_ROPE_MODEL + 5])
+    return tension if tension > 0.0 else 0.0
+
+
+@jit
+def _dynamics(t: float, x: np.ndarray, data):
     """Accelerations (rad/s^2) and the brake torque on the drum (N m) in the present mode."""
     modes, inertia, stiffness, damping, held = data
     n = inertia.size
@@ -139,7 +187,7 @@ def _dynamics(x: np.ndarray, data):
         forces[0] = -damping[0, 0] * x[1]
     forces[0] += held[0] - held[1] * x[n]
     w = x[2 * n - 1]
-    forces[n - 1] += held[2] * held[4] - 0.5 * held[6] * w * w
+    forces[n - 1] += rope_tension(t, x, data) * held[4] - 0.5 * held[6] * w * w
     masses = inertia.copy()
     masses[n - 1] += held[5] + held[6] * x[n - 1]
     brake = 0.0
@@ -169,7 +217,7 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     """
     modes, inertia, _, damping, held = data
     n = inertia.size
-    acc, brake = _dynamics(x, data)
+    acc, brake = _dynamics(t, x, data)
     out = np.empty_like(x)
     loss = 0.0
     for i in range(n):
@@ -186,7 +234,8 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
             out[n - 1] = 0.0
     out[2 * n] = loss
     omega0 = x[n]
-    out[2 * n + 1] = (held[0] - held[1] * omega0) * omega0 + held[2] * held[4] * x[2 * n - 1]
+    rope = rope_tension(t, x, data)
+    out[2 * n + 1] = (held[0] - held[1] * omega0) * omega0 + rope * held[4] * x[2 * n - 1]
     return out
 
 
@@ -206,7 +255,7 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     if modes[0] == 2:
         if modes[1] == 1:
             if modes[2] == 0:
-                brake = _dynamics(x, data)[1]
+                brake = _dynamics(t, x, data)[1]
                 against = held[7] if (-brake if brake != 0.0 else 1.0) > 0 else held[8]
                 out[0] = against - abs(brake)
             else:
@@ -224,11 +273,13 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
 
 
 @jit
-def summary(x: np.ndarray, data) -> np.ndarray:
+def summary(t: float, x: np.ndarray, data) -> np.ndarray:
     """What the outputs need beyond the state: brake torque (N m) and stored energy (J).
 
     Parameters
     ----------
+    t : float
+        Time, s (the rope model's tension acts on a held drum's brake torque).
     x : numpy.ndarray
         State (see the module docstring).
     data : tuple
@@ -236,7 +287,7 @@ def summary(x: np.ndarray, data) -> np.ndarray:
     """
     modes, inertia, stiffness, _, held = data
     n = inertia.size
-    brake = _dynamics(x, data)[1] if modes[1] == 1 else 0.0
+    brake = _dynamics(t, x, data)[1] if modes[1] == 1 else 0.0
     kinetic = 0.0
     for i in range(n):
         mass = inertia[i] + (held[5] + held[6] * x[n - 1] if i == n - 1 else 0.0)
@@ -345,7 +396,7 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
     )
     if status == STATUS_DONE:
-        return status, x, t, k, fired, steps, calls, h, summary(x, data)
+        return status, x, t, k, fired, steps, calls, h, summary(t, x, data)
     return status, x, t, k, fired, steps, calls, h, no_summary
 
 

@@ -10,7 +10,10 @@ the rest. The drive takes up a new command at the start of a step and
 holds it over the step; the speed outputs report the speed over the step
 just finished (their left limit), so the payout outputs depend on no input
 in this mode either. Without inertia nothing is integrated: payout, work
-and losses are exact for the held inputs.
+and losses are exact for the held inputs. With the rope's interface model the
+tension varies over the step (the motion does not: it is commanded); the rope's
+work is the trapezoid of the model's tension at the step's ends times the rope
+paid out, exact while the rope stays taut and on one layer.
 """
 
 from __future__ import annotations
@@ -52,6 +55,7 @@ class KinetostaticWinch(_WinchBase):
             Inputs at the start.
         """
         self.set_inputs(inputs)
+        self.time = float(t0)
         self.layer = self.drum.initial_layer()
         self.state = np.array([0.0, inputs.speed_command, 0.0, 0.0])
         self._brake_state = self._brake_state_for(inputs.speed_command)
@@ -63,9 +67,17 @@ class KinetostaticWinch(_WinchBase):
             return BRAKE_FREE
         return BRAKE_SLIPPING if omega != 0.0 else BRAKE_HOLDING
 
-    def _brake_and_motor(self, omega: float) -> tuple[float, float]:
-        """(brake torque, motor torque) on the drum shaft by (32), N m."""
-        rope = self.inputs.tension * self.drum.layer_radius(self.layer)
+    def _tension(self, t: float, phi: float, omega: float, layer: int | None = None) -> float:
+        """Rope tension at time ``t`` (s), drum angle ``phi`` (rad), speed ``omega`` (rad/s)
+        with the rope leaving ``layer`` (default: the present one), N."""
+        k = self.layer if layer is None else layer
+        return self.inputs.tension_at(
+            t, self.drum.payout(phi, k), self.drum.layer_radius(k) * omega
+        )
+
+    def _brake_and_motor(self, omega: float, tension: float) -> tuple[float, float]:
+        """(brake torque, motor torque) on the drum shaft by (32) under ``tension`` (N), N m."""
+        rope = tension * self.drum.layer_radius(self.layer)
         plus, minus = self.capacities
         if omega > 0.0:
             brake = -plus
@@ -105,13 +117,17 @@ class KinetostaticWinch(_WinchBase):
             self.mode_changes += 1
             self._event(t, f"brake {_BRAKE_WORDS[state]}")
         paid = self.drum.payout(phi1, self.layer) - self.drum.payout(phi0, k0)
-        brake = self._brake_and_motor(omega)[0]
+        tension = self._tension(t + h, phi1, omega)
+        brake = self._brake_and_motor(omega, tension)[0]
         dissipated = -brake * (phi1 - phi0) + self.beta * omega * omega * h
-        rope_work = inputs.tension * paid
+        if inputs.rope_model.active:  # the trapezoid of a tension linear in time
+            tension = 0.5 * (self._tension(t, phi0, omega, k0) + tension)
+        rope_work = tension * paid
         motor_work = dissipated - rope_work  # what (32) makes the motor do
         self.state = np.array(
             [phi1, omega, self.state[2] + dissipated, self.state[3] + rope_work + motor_work]
         )
+        self.time = t + h
         return len(self.last_events)
 
     def _cross_layers(self, t: float, h: float, phi0: float, phi1: float) -> None:
@@ -146,8 +162,9 @@ class KinetostaticWinch(_WinchBase):
             State ``[phi (rad), omega (rad/s), dissipated (J), external work (J)]``.
         """
         omega = self.inputs.speed_command
-        brake, motor = self._brake_and_motor(omega)
-        rope = self.inputs.tension * self.drum.layer_radius(self.layer)
+        tension = self._tension(t, x[0], omega)
+        brake, motor = self._brake_and_motor(omega, tension)
+        rope = tension * self.drum.layer_radius(self.layer)
         loss = -brake * omega + self.beta * omega * omega
         return np.array([omega, 0.0, loss, (rope + motor) * omega])
 
@@ -198,7 +215,7 @@ class KinetostaticWinch(_WinchBase):
         """Outputs for the drum speed of the last step and the held inputs."""
         phi, omega = float(self.state[0]), float(self.state[1])
         radius = self.drum.layer_radius(self.layer)
-        brake, motor = self._brake_and_motor(omega)
+        brake, motor = self._brake_and_motor(omega, self._tension(self.time, phi, omega))
         return WinchReport(
             rope_payout=self.drum.payout(phi, self.layer),
             rope_payout_rate=radius * omega,
@@ -236,6 +253,7 @@ class KinetostaticWinch(_WinchBase):
         """Complete model state as plain data."""
         return {
             "x": [float(c) for c in self.state],
+            "time": float(self.time),
             "layer": int(self.layer),
             "brake_state": int(self._brake_state),
             "mode_changes": int(self.mode_changes),
@@ -251,6 +269,7 @@ class KinetostaticWinch(_WinchBase):
             A state from :meth:`get_state`.
         """
         self.state = np.array(data["x"], dtype=float)
+        self.time = float(data["time"])
         self.layer = int(data["layer"])
         self._brake_state = int(data["brake_state"])
         self.mode_changes = int(data["mode_changes"])

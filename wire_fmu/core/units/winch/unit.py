@@ -8,7 +8,15 @@ Ports (power bonds)
     ``payout_rate`` (m/s), taken by the block train as ``line_a.payout`` /
     ``line_a.payout_rate``. Power into the winch: ``+tension *
     payout_rate`` (paying out under tension drives the drum). The payout
-    outputs come from the drum's state and depend on no input.
+    outputs come from the drum's state and depend on no input. The port
+    accepts the block train's interface model of the tension (inputs
+    ``rope.stiffness``, ``rope.damping``, ``rope.effort_rate``,
+    ``rope.reference_position``, ``rope.reference_velocity``;
+    :mod:`~wire_fmu.core.framework.interface_model`): the drum is then
+    integrated against ``T0 - K (payout - x_ref) - D (payout_rate - v_ref) +
+    R (t - t0)``, at least 0 (a rope cannot push), instead of the held
+    tension, so the rope's spring acts inside the winch's own solver and
+    brake stick/slip events (issue 17).
 ``motor``
     Input ``command`` (N m at the motor shaft): the motor torque, or with
     the effect ``motor_characteristic`` the zero-speed torque ``a`` of
@@ -54,6 +62,7 @@ from wire_fmu.core.components.drum import Drum, LayeredDrum
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, SolverSettings
+from wire_fmu.core.framework.interface_model import EffortModel
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.report_outputs import ReportOutputs
 from wire_fmu.core.framework.solver_options import solver_settings
@@ -62,7 +71,12 @@ from wire_fmu.core.framework.unit import (
     ModelOdeView,
     OdeView,
 )
-from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs
+from wire_fmu.core.units.winch.base import (
+    NO_ROPE_MODEL,
+    ROPE_MODEL_INPUTS,
+    WinchConfig,
+    WinchInputs,
+)
 from wire_fmu.core.units.winch.brake import BandBrake
 from wire_fmu.core.units.winch.drive import WinchModel
 from wire_fmu.core.units.winch.kinetostatic import KinetostaticWinch
@@ -92,7 +106,16 @@ class WinchUnit(HeldInputsUnit):
     DESCRIPTION = "Winch (drawworks): drum, band brake, motor, drive train, wire_fmu"
     VARIABLES = winch_parameters() + winch_inputs() + winch_outputs()
     PORTS = (
-        port("rope", "rope", PortSide.flow, "tension", "payout_rate", "payout", "the fast line"),
+        port(
+            "rope",
+            "rope",
+            PortSide.flow,
+            "tension",
+            "payout_rate",
+            "payout",
+            "the fast line",
+            interface=True,
+        ),
     )
 
     def __init__(self, instance_name: str = "winch") -> None:
@@ -130,6 +153,32 @@ class WinchUnit(HeldInputsUnit):
             float(self.values["initial_drum_speed"]),
         )
         self.model = build_winch(config, settings)
+
+    def initialize(self, start_time: float) -> None:
+        """Initial state for the parameters and inputs set (a rope model about ``start_time``).
+
+        Implements :meth:`Unit.initialize`.
+        """
+        self.time = float(start_time)
+        super().initialize(start_time)
+
+    def input_problems(self) -> list[str]:
+        """Inputs the winch cannot step with (each named), also a rope model with a solver
+        that integrates against a held tension only."""
+        problems = super().input_problems()
+        model = self._require_model()
+        settings = getattr(model, "settings", None)
+        if (
+            settings is not None
+            and settings.method in ENERGY_SOLVERS
+            and self._rope_model().active
+        ):
+            problems.append(
+                f"inputs {', '.join(ROPE_MODEL_INPUTS[:3])}: solver {settings.method!r} "
+                "integrates the drum against a held rope tension; choose 'rk4' or 'ros2' "
+                "to integrate it against the rope's interface model"
+            )
+        return problems
 
     def evaluate_outputs(self) -> None:
         """Feedthrough outputs for the inputs now set; the state is untouched."""
@@ -190,7 +239,16 @@ class WinchUnit(HeldInputsUnit):
             float(v["brake.lever_force"]),
             float(v["motor.command"]),
             float(v["drum.speed_command"]),
+            self._rope_model(),
         )
+
+    def _rope_model(self) -> EffortModel:
+        """The block train's interface model of the tension set now, about the present time."""
+        v = self.values
+        fields = [float(v[name]) for name in ROPE_MODEL_INPUTS]
+        if fields[0] == 0.0 and fields[1] == 0.0 and fields[2] == 0.0:
+            return NO_ROPE_MODEL
+        return EffortModel(*fields, start=float(self.time))
 
     def _settings(self, problems: list[str]) -> SolverSettings:
         settings, solver_problems = solver_settings(self.values, also=ENERGY_SOLVERS)

@@ -9,13 +9,23 @@ import json
 
 from wire_fmu.core.components.drive_train import default_drive_train
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
+from wire_fmu.core.framework.interface_model import interface_input_names, interface_inputs
 from wire_fmu.core.framework.solver_options import solver_parameters
 from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS
 
 __all__ = ["winch_parameters", "winch_inputs", "winch_outputs"]
 
-_FEEDTHROUGH = ("rope.tension", "brake.lever_force", "motor.command")
+_FEEDTHROUGH = (
+    "rope.tension",
+    *interface_input_names("rope")[:2],
+    *interface_input_names("rope")[3:],
+    "brake.lever_force",
+    "motor.command",
+)
+"""What the outputs that depend on the rope's tension depend on: the tension, its interface
+model's spring and damper with their reference motion (its rate acts from the time the
+inputs are set on, not at that instant), the brake's lever and the motor's command."""
 _INERTIA = ("drum_inertia",)
 _BRAKE = ("band_brake",)
 _LAYERS = ("rope_layers",)
@@ -177,9 +187,16 @@ def winch_parameters():
 
 
 def winch_inputs():
-    """The winch's inputs: rope tension, brake lever force, motor and drum speed commands."""
+    """The winch's inputs: rope tension and its interface model, brake lever force, motor and
+    drum speed commands."""
     return (
-        input_("rope.tension", 0.0, "N", "Rope tension at the drum"),
+        input_(
+            "rope.tension",
+            0.0,
+            "N",
+            "Rope tension at the drum: held over the step, or E0 of the interface model",
+        ),
+        *interface_inputs("rope", "rope", "rope.tension", "rope.payout", "rope.payout_rate"),
         input_(
             "brake.lever_force",
             0.0,
