@@ -114,9 +114,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         """
         n, k = self.n, self.layer
         phi, w = x[n - 1], x[2 * n - 1]
-        return self.inputs.tension_at(
-            t, self.drum.payout(phi, k), self.drum.layer_radius(k) * w
-        )
+        return self.inputs.tension_at(t, self.drum.payout(phi, k), self.drum.layer_radius(k) * w)
 
     def _forces(self, x: np.ndarray, t: float) -> np.ndarray:
         """All torques except the brake's on every mass (reduced) at time ``t`` (s), N m;

@@ -168,11 +168,7 @@ class WinchUnit(HeldInputsUnit):
         problems = super().input_problems()
         model = self._require_model()
         settings = getattr(model, "settings", None)
-        if (
-            settings is not None
-            and settings.method in ENERGY_SOLVERS
-            and self._rope_model().active
-        ):
+        if settings is not None and settings.method in ENERGY_SOLVERS and self._rope_model().active:
             problems.append(
                 f"inputs {', '.join(ROPE_MODEL_INPUTS[:3])}: solver {settings.method!r} "
                 "integrates the drum against a held rope tension; choose 'rk4' or 'ros2' "
