@@ -173,6 +173,10 @@ def test_a_negative_spring_and_an_energy_form_solver_are_refused_by_name():
     unit = free_drum(stiffness=-1.0)
     problems = unit.input_problems()
     assert any("'rope.stiffness' must be >= 0" in p for p in problems), problems
+    unit.values["rope.damping"] = math.nan
+    problems = unit.input_problems()
+    assert "input 'rope.damping' is not finite (nan)" in problems, problems
+    assert any("'rope.stiffness' must be >= 0" in p for p in problems), problems  # all at once
     energy = make_unit(
         "drum_inertia",
         drive_train=one_mass(J),

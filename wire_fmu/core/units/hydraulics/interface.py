@@ -17,12 +17,13 @@ velocity the effort side took ``E0`` and its derivatives at. With ``K = D = R = 
 the force is ``E0``, bit for bit.
 
 :class:`RodInterface` holds ``K, D, R, d_ref, v_ref`` and ``t0``; the model
-evaluates ``F`` (in the readable reference and, the same operations in the same
-order, in its compiled kernel) and books the work the force does on the rod:
-``E0 (x1 - x0)`` and the spring's ``-K [(x1 - x_ref)^2 - (x0 - x_ref)^2] / 2``
-exactly (:meth:`RodInterface.elastic_work`), the damper's and the rate's
-``integral of (-D (v - v_ref) + R (t - t0)) v dt`` (:meth:`RodInterface.power`) as
-a state integrated by the step's own solver.
+evaluates ``F`` (:meth:`RodInterface.effort` in the readable reference and, the
+same operations in the same order, in its compiled kernel) and books the work the
+force does on the rod: ``E0 (x1 - x0)`` and the spring's
+``-K [(x1 - x_ref)^2 - (x0 - x_ref)^2] / 2`` exactly
+(:meth:`RodInterface.elastic_work`), the damper's and the rate's
+``integral of (-D (v - v_ref) + R (t - t0)) v dt`` (:meth:`RodInterface.power`)
+as a state integrated by the step's own solver.
 """
 
 from __future__ import annotations
@@ -56,34 +57,6 @@ class RodInterface(EffortModel):
             The rod's extension at the start, where its displacement is 0, m.
         """
         return initial_position + self.reference_position
-
-    def force(self, held: float, t: float, x: float, v: float, x_ref: float) -> float:
-        """``F(x, v, t)``: the rod force of the local model (:meth:`effort`), N.
-
-        Parameters
-        ----------
-        held : float
-            ``E0``, the effort side's force at the communication point, N.
-        t : float
-            Time, s.
-        x : float
-            Rod extension, m.
-        v : float
-            Rod velocity, m/s.
-        x_ref : float
-            :meth:`reference_extension`, m.
-        """
-        return self.effort(held, t, x, v, x_ref)
-
-    def problems(self, port: str = "rod") -> list[str]:
-        """A spring or damper of the wrong sign, naming the input (NaN is checked apart).
-
-        Parameters
-        ----------
-        port : str
-            The port's name in the inputs' names.
-        """
-        return super().problems(port)
 
 
 NO_INTERFACE = RodInterface()

@@ -346,7 +346,7 @@ def _stop_forces(pos: float, vel: float, c: Cylinder):
 
 @jit
 def rod_force(t: float, pos: float, vel: float, c: Cylinder) -> float:
-    """The external rod force ``F(x, v, t)`` over the step, N (``RodInterface.force``).
+    """The external rod force ``F(x, v, t)`` over the step, N (``RodInterface.effort``).
 
     ``E0 - K (x - x_ref) - D (v - v_ref) + R (t - t0)``, each term added only when its
     coefficient is nonzero: without the interface model the held force, bit for bit.

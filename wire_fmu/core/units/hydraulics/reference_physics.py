@@ -69,7 +69,7 @@ class ReferencePhysics:
 
     def rod_force(self, t: float, pos: float, vel: float) -> float:
         """The external rod force ``F(x, v, t)`` over the step: held or the interface
-        model's (:meth:`RodInterface.force <.interface.RodInterface.force>`), N.
+        model's (:meth:`RodInterface.effort <.interface.RodInterface.effort>`), N.
 
         Parameters
         ----------
@@ -80,7 +80,7 @@ class ReferencePhysics:
         """
         interface = self.interface
         x_ref = interface.reference_extension(self.initial_position)
-        return interface.force(self.force, t, pos, vel, x_ref)
+        return interface.effort(self.force, t, pos, vel, x_ref)
 
     def evaluate(self, t: float, x: np.ndarray, energy: bool = False) -> _Point:
         """Pressures, flow, forces, losses (and stored energy if ``energy``) at ``(t, x)``.

@@ -306,7 +306,7 @@ class HydraulicsUnit(Unit):
         """Inputs the cylinder cannot step with: not finite, or a negative spring or damper
         in the interface model (each named)."""
         return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + (
-            self.rod_interface(self.time).problems()
+            self.rod_interface(self.time).problems("rod")
         )
 
     def rod_interface(self, start: float) -> RodInterface:

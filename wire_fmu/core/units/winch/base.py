@@ -78,7 +78,23 @@ class WinchInputs:
         return tension if tension > 0.0 else 0.0
 
     def problems(self) -> list[str]:
-        """Non-finite inputs and a rope model's spring or damper of the wrong sign, named."""
+        """Non-finite inputs and a rope model's spring or damper of the wrong sign, named.
+
+        Checked before every step: the names are put together only for a bad input."""
+        rope = self.rope_model
+        values = (
+            self.tension,
+            self.lever_force,
+            self.motor_command,
+            self.speed_command,
+            rope.stiffness,
+            rope.damping,
+            rope.effort_rate,
+            rope.reference_position,
+            rope.reference_velocity,
+        )
+        if all(map(math.isfinite, values)) and rope.stiffness >= 0.0 and rope.damping >= 0.0:
+            return []
         names = (
             "rope.tension",
             "brake.lever_force",
@@ -86,19 +102,12 @@ class WinchInputs:
             "drum.speed_command",
             *ROPE_MODEL_INPUTS,
         )
-        values = (
-            self.tension,
-            self.lever_force,
-            self.motor_command,
-            self.speed_command,
-            *astuple(self.rope_model)[: len(ROPE_MODEL_INPUTS)],
-        )
         out = [
             f"input {n!r} is not finite ({v})"
             for n, v in zip(names, values, strict=True)
             if not math.isfinite(v)
         ]
-        return out + self.rope_model.problems("rope")
+        return out + rope.problems("rope")
 
 
 @dataclass(frozen=True)

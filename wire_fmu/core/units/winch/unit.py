@@ -165,10 +165,10 @@ class WinchUnit(HeldInputsUnit):
     def input_problems(self) -> list[str]:
         """Inputs the winch cannot step with (each named), also a rope model with a solver
         that integrates against a held tension only."""
-        problems = super().input_problems()
-        model = self._require_model()
-        settings = getattr(model, "settings", None)
-        if settings is not None and settings.method in ENERGY_SOLVERS and self._rope_model().active:
+        inputs = self._inputs()
+        problems = inputs.problems()
+        settings = getattr(self._require_model(), "settings", None)  # None: kinetostatic
+        if inputs.rope_model.active and settings is not None and settings.method in ENERGY_SOLVERS:
             problems.append(
                 f"inputs {', '.join(ROPE_MODEL_INPUTS[:3])}: solver {settings.method!r} "
                 "integrates the drum against a held rope tension; choose 'rk4' or 'ros2' "

@@ -18,8 +18,7 @@ __all__ = ["winch_parameters", "winch_inputs", "winch_outputs"]
 
 _FEEDTHROUGH = (
     "rope.tension",
-    *interface_input_names("rope")[:2],
-    *interface_input_names("rope")[3:],
+    *(name for name in interface_input_names("rope") if name != "rope.effort_rate"),
     "brake.lever_force",
     "motor.command",
 )
