@@ -89,6 +89,7 @@ def _riser_data(**run) -> dict:
     """The shipped riser scene without its own choice of coupling, ``run`` settings added."""
     data = tomllib.loads((SCENES / "riser_tensioner.toml").read_text())
     data["run"].pop("interface_models", None)
+    data["run"].pop("ramped_flows", None)
     data["run"].update(run)
     return data
 

@@ -90,6 +90,7 @@ def test_every_fmu_declares_its_core_units_ports(unit):
             p.description,
             p.interface,
             p.interface_switch,
+            p.flow_ramp,
         )
         for p in unit.core_class().PORTS
     }

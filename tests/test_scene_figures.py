@@ -349,8 +349,8 @@ def test_compensator_isolation_measured_as_stated(fmu_dir, tmp_path):
 
 @pytest.mark.integration
 def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
-    """Held force: rings at 10 ms, close at 2 ms; the interface model: close at the scene's
-    4 ms and even at 10 ms."""
+    """Held force and rod velocity: rings at 10 ms, close at 2 ms; the interface model and
+    the ramped rod velocity: close at the scene's 4 ms and even at 10 ms."""
     common = {"output_interval": 0.02}  # a time every run records
     held = {
         h: _run(
@@ -359,6 +359,7 @@ def test_riser_step_sizes_behave_as_stated(fmu_dir, tmp_path):
             tmp_path / f"held{h}",
             step=h,
             interface_models=False,
+            ramped_flows=False,
             **common,
         )
         for h in (1e-3, 2e-3, 0.01)

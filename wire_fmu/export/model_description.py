@@ -189,7 +189,8 @@ def vendor_annotations(ports: Iterable[Port]) -> ET.Element:
         ``<VendorAnnotations><Tool name="wire_fmu"><Ports><Port .../>...``, one ``Port``
         element per port with the attributes ``name``, ``kind``, ``side``, ``effort``,
         ``flow``, ``description``, (when the port has one) ``position`` and (when it
-        carries the interface model) ``interface="true"`` and its ``interface_switch``.
+        carries the interface model) ``interface="true"`` and its ``interface_switch``, and
+        (on an effort side that takes one) the ``flow_ramp`` input.
     """
     annotations = ET.Element("VendorAnnotations")
     tool = ET.SubElement(annotations, "Tool", name=PORTS_TOOL)
@@ -209,6 +210,8 @@ def vendor_annotations(ports: Iterable[Port]) -> ET.Element:
             attrs["interface"] = "true"
         if port.interface_switch:
             attrs["interface_switch"] = port.interface_switch
+        if port.flow_ramp:
+            attrs["flow_ramp"] = port.flow_ramp
         ET.SubElement(section, "Port", attrs)
     return annotations
 

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from collections import defaultdict
 
-from .extrapolation import History, held_value
+from .extrapolation import History, held_value, ramp
+from .scene.data import RAMP_ROLE
 from .unit_io import EndValues, InputPlan, Link, Watch, read_plan
 
 __all__ = ["MODE_OUTPUT", "UnitExchange"]
@@ -35,12 +36,16 @@ class UnitExchange:
         self.links_into: dict[str, list[Link]] = defaultdict(list)
         self.source_keys: dict[str, list[str]] = defaultdict(list)
         self.histories: dict[str, History] = {}
+        ramped = {b.name for b in self.scene.bonds if b.ramped}
         for c in self.scene.all_connections:
             slave = self.slaves[c.target.unit]
             scheme = c.extrapolation or self.run_settings.extrapolation
             key = str(c.source)
             history = self.histories.setdefault(key, History())
-            link = Link(c, key, slave.vr(c.target.variable), scheme, history)
+            ramp = "slope" if c.role == RAMP_ROLE else ""
+            if c.role == "flow" and c.bond in ramped:
+                ramp = "start"
+            link = Link(c, key, slave.vr(c.target.variable), scheme, history, ramp)
             self.links_into[c.target.unit].append(link)
             if key not in self.source_keys[c.source.unit]:
                 self.source_keys[c.source.unit].append(key)
@@ -184,6 +189,14 @@ class UnitExchange:
         for link in plan.links:
             if link.position:
                 value = link.history.points[-1][1]  # the unit advances it with the held velocity
+            elif link.ramp:
+                start, slope = ramp(
+                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+                )
+                value = slope if link.ramp == "slope" else start
+                values.append(value)
+                held[link.target] = slope if link.ramp == "slope" else start + 0.5 * slope * h
+                continue
             else:
                 value = held_value(
                     link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)

@@ -20,6 +20,15 @@ second order (SPEC section 15).
 With fewer past values than a scheme needs (at the start, after a reset)
 the order drops accordingly.
 
+A ramped flow (a bond wired with ``run.ramped_flows``, :func:`ramp`) is not held:
+the effort side takes its value at the step's start and its slope over the step,
+the same polynomial's change from the step's start to its end divided by the step,
+with the start chosen so that the ramp's average over the step is the held value
+above. The position the effort side integrates from the flow therefore ends the step
+where a held flow would take it, and the flow itself ends it at the polynomial's end
+value (exactly, for a line): a feedthrough output that depends on the flow (a rope's
+damper) no longer sees the step's average at the step's end.
+
 An interface model's links (a port's stiffness, damping, effort rate and
 reference motion) and the effort of their bond are never extrapolated: the
 scene holds them ``constant`` whatever the run's scheme
@@ -32,7 +41,7 @@ from __future__ import annotations
 
 from collections import deque
 
-__all__ = ["History", "held_value", "SCHEME_POINTS"]
+__all__ = ["History", "held_value", "ramp", "SCHEME_POINTS"]
 
 SCHEME_POINTS = {"constant": 1, "linear": 2, "quadratic": 3}
 
@@ -132,3 +141,43 @@ def held_value(
     return (
         _lagrange(pts, t) + 4.0 * _lagrange(pts, t + 0.5 * step) + _lagrange(pts, t + step)
     ) / 6.0
+
+
+def _polynomial(
+    history: History, t: float, step: float, scheme: str, fresh: float | None
+) -> list[tuple[float, float]]:
+    """The points the scheme's polynomial over ``[t, t + step]`` goes through."""
+    need = SCHEME_POINTS[scheme]
+    if fresh is None:
+        return list(history.points)[-need:]
+    return list(history.points)[-(need - 1) :] + [(t + step, fresh)] if need > 1 else []
+
+
+def ramp(
+    history: History, t: float, step: float, scheme: str, fresh: float | None = None
+) -> tuple[float, float]:
+    """The ramp to set over ``[t, t + step]``: its value at ``t`` and its slope.
+
+    The slope is the scheme's polynomial's change over the step divided by the step;
+    the value at ``t`` is :func:`held_value` less half the change, so that the ramp's
+    average over the step is the held value (see the module docstring). ``constant``
+    gives a slope of 0 and the held value.
+
+    Parameters
+    ----------
+    history, t, step, scheme, fresh
+        As for :func:`held_value`.
+
+    Returns
+    -------
+    start : float
+        The value at ``t``, in the source's unit.
+    slope : float
+        Its rate of change over the step, in the source's unit per second.
+    """
+    average = held_value(history, t, step, scheme, fresh)
+    points = _polynomial(history, t, step, scheme, fresh)
+    if len(points) < 2 or step <= 0.0:
+        return average, 0.0
+    change = _lagrange(points, t + step) - _lagrange(points, t)
+    return average - 0.5 * change, change / step

@@ -19,6 +19,12 @@ on. Whether the scene wires them is its choice (``run.interface_models``,
 or the bond's ``interface_model``; see :mod:`wire_fmu.master.scene.bonds`);
 when a side declares no model, :attr:`PortLinks.lacking` says which.
 
+Ramped flows: an effort side that declares a ``flow_ramp`` input takes the flow's
+rate of change over the step there; the bond then offers a ramp link from the flow
+side's flow, whose value the master works out from the flow's extrapolation (the
+slope over the step), and the flow input becomes the value at the step's start.
+Whether the scene wires it is ``run.ramped_flows``.
+
 The declarations are read from the FMU file itself, so any FMU that carries
 them can be bonded by port; for others the long form is the way.
 """
@@ -77,6 +83,8 @@ class PortDeclaration:
         (:data:`~wire_fmu.export.model_description.INTERFACE_QUANTITIES` as ``{port}.{quantity}``).
     interface_switch : str or None
         The effort side's Boolean parameter that turns the interface model on.
+    flow_ramp : str or None
+        The effort side's input that takes the flow's rate of change over the step.
     """
 
     name: str
@@ -88,6 +96,7 @@ class PortDeclaration:
     description: str = ""
     interface: bool = False
     interface_switch: str | None = None
+    flow_ramp: str | None = None
 
 
 @dataclass(frozen=True)
@@ -112,6 +121,9 @@ class PortLinks:
         without interface links, or when the effort side names none).
     lacking : tuple of str
         The ports that declare no interface model, as ``"unit.port (side side)"``.
+    ramp : tuple of str or None
+        Source and target of the flow's ramp: the flow side's flow to the effort side's
+        ``flow_ramp`` input (None when the effort side takes none).
     """
 
     kind: str
@@ -121,6 +133,7 @@ class PortLinks:
     interface: tuple[tuple[str, str], ...] = ()
     switch: str | None = None
     lacking: tuple[str, ...] = ()
+    ramp: tuple[str, str] | None = None
 
 
 def parse_port_pair(text: object) -> tuple[tuple[str, str], tuple[str, str]] | None:
@@ -183,6 +196,7 @@ def _declaration(attrs: dict[str, str]) -> PortDeclaration:
         attrs.get("description", ""),
         attrs.get("interface") == "true",
         attrs.get("interface_switch") or None,
+        attrs.get("flow_ramp") or None,
     )
 
 
@@ -251,6 +265,9 @@ def port_links(
     if e_port.position:
         position = (f"{f_unit}.{f_port.position}", f"{e_unit}.{e_port.position}")
     interface, switch, lacking = interface_links((e_unit, e_port), (f_unit, f_port))
+    ramp = None
+    if e_port.flow_ramp:
+        ramp = (f"{f_unit}.{f_port.flow}", f"{e_unit}.{e_port.flow_ramp}")
     return PortLinks(
         a_port.kind,
         (f"{e_unit}.{e_port.effort}", f"{f_unit}.{f_port.effort}"),
@@ -259,6 +276,7 @@ def port_links(
         interface,
         switch,
         lacking,
+        ramp,
     ), []
 
 

@@ -49,6 +49,10 @@ class Link:
         Its extrapolation (``"constant"``, ``"linear"``, ``"quadratic"``).
     history : History
         Its source's history (shared by every link from that source).
+    ramp : str
+        ``"start"`` for a ramped bond's flow link (set to the ramp's value at the step's
+        start), ``"slope"`` for its ramp link (set to the slope), ``""`` otherwise
+        (see :func:`~wire_fmu.master.extrapolation.ramp`).
     """
 
     connection: Connection
@@ -56,6 +60,7 @@ class Link:
     target_vr: int
     scheme: str
     history: History
+    ramp: str = ""
     target: str = field(init=False)
     """The input it sets, ``"unit.variable"``."""
     position: bool = field(init=False)

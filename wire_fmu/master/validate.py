@@ -32,11 +32,13 @@ from .scene import (
     BOND_KINDS,
     INTERFACE_ROLE,
     Bond,
+    Connection,
     Scene,
     SceneError,
     VarRef,
     unknown_unit_problems,
 )
+from .scene.data import RAMP_ROLE
 from .slave import value_problem
 
 __all__ = [
@@ -152,6 +154,15 @@ def _variable_problem(structure: Structure, ref: VarRef, causality: str, what: s
     return None
 
 
+def _target_unit(connection: Connection, source_unit: str | None) -> str:
+    """The unit the target of ``connection`` must have: the source's, or for a ramp link
+    (the source's rate of change) the source's per second (``m/s`` to ``m/s2``)."""
+    unit = source_unit or ""
+    if connection.role != RAMP_ROLE:
+        return unit
+    return f"{unit}2" if unit.endswith("/s") else f"{unit}/s"
+
+
 def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
     problems, fed = [], defaultdict(list)
     for c in scene.all_connections:
@@ -170,10 +181,11 @@ def _connection_problems(scene: Scene, structure: Structure) -> list[str]:
             )
         elif src.type != dst.type:
             problems.append(f"{what} {c.source} -> {c.target}: type {src.type} feeds {dst.type}")
-        elif src.type == "Real" and (src.unit or "") != (dst.unit or ""):
+        elif src.type == "Real" and _target_unit(c, src.unit) != (dst.unit or ""):
             problems.append(
                 f"{what} {c.source} -> {c.target}: unit mismatch, "
                 f"{src.unit or 'no unit'} feeds {dst.unit or 'no unit'}"
+                + (f" (a ramp takes {_target_unit(c, src.unit)})" if c.role == RAMP_ROLE else "")
             )
     for d in scene.drivers:
         for ref in (d.target, d.rate_target):

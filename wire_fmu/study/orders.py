@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wire_fmu.master.scene import Scene
-from wire_fmu.master.scene.data import INTERFACE_ROLE
+from wire_fmu.master.scene.data import INTERFACE_ROLE, RAMP_ROLE
 
 from .measures import RunRow
 from .plan import coupled_scene
@@ -112,7 +112,7 @@ def theoretical_order(scene: Scene, extrapolation: str) -> int | None:
         if c.role == "position":
             continue
         scheme = c.extrapolation or extrapolation
-        if c.role == "flow" and c.bond in with_position:
+        if c.role in ("flow", RAMP_ROLE) and c.bond in with_position:
             orders.append(2)
         elif c.bond in modelled and c.role in ("effort", INTERFACE_ROLE):
             orders.append(2)  # the effort's first-order model in x, v and t over the step

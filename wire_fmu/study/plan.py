@@ -47,6 +47,7 @@ __all__ = [
     "QUICK_STOP_TIME",
     "GRIDS",
     "COUPLINGS",
+    "DEFAULT_COUPLINGS",
     "StudySettings",
     "study_settings",
     "with_stop_time",
@@ -72,11 +73,23 @@ class StudyError(WireFmuError):
     """A study cannot be made (no reference, no key outputs, ...)."""
 
 
+def _coupling(interface: bool, ramped: bool, synchronised: bool) -> dict[str, bool]:
+    return {
+        "interface_models": interface,
+        "ramped_flows": ramped,
+        "synchronise_events": synchronised,
+    }
+
+
 COUPLINGS = {
-    "held": {"interface_models": False, "synchronise_events": False},
-    "interface": {"interface_models": True, "synchronise_events": False},
-    "synchronised": {"interface_models": False, "synchronise_events": True},
-    "interface+synchronised": {"interface_models": True, "synchronise_events": True},
+    "held": _coupling(False, False, False),
+    "interface": _coupling(True, False, False),
+    "ramped": _coupling(False, True, False),
+    "interface+ramped": _coupling(True, True, False),
+    "synchronised": _coupling(False, False, True),
+    "interface+synchronised": _coupling(True, False, True),
+    "ramped+synchronised": _coupling(False, True, True),
+    "interface+ramped+synchronised": _coupling(True, True, True),
 }
 """How the units meet at a bond, by name, as the run settings that make it:
 
@@ -85,11 +98,23 @@ COUPLINGS = {
 ``interface``
     the flow side of a bond that offers an interface model integrates its step against
     the effort's local model (``[run] interface_models``);
+``ramped``
+    the effort side of a bond that takes a flow ramp gets the flow at the step's start
+    and its slope over the step instead of its average (``[run] ramped_flows``);
 ``synchronised``
     a mode change inside a step rolls every unit back to it (``[run] synchronise_events``);
-``interface+synchronised``
-    both.
+and the combinations joined by ``+``.
 """
+DEFAULT_COUPLINGS = (
+    "held",
+    "interface",
+    "ramped",
+    "interface+ramped",
+    "synchronised",
+    "interface+synchronised",
+)
+"""The couplings a study compares unless told otherwise (those of :data:`COUPLINGS` with
+both ramps and synchronisation are left to an explicit choice)."""
 
 GRIDS = ("slices", "product")
 """``slices``: every coupling with the scene's own solvers, and every solver with the
@@ -147,7 +172,7 @@ class StudySettings:
     output_interval: float
     algorithms: tuple[str, ...] = ALGORITHMS
     extrapolations: tuple[str, ...] = EXTRAPOLATIONS
-    couplings: tuple[str, ...] = tuple(COUPLINGS)
+    couplings: tuple[str, ...] = DEFAULT_COUPLINGS
     solvers: tuple[SolverChoice, ...] = DEFAULT_SOLVERS
     grid: str = "slices"
     reference_rtol: float = 1e-10
@@ -286,17 +311,16 @@ def scene_coupling(scene: Scene) -> str:
     scene : Scene
         The scene.
     """
-    own = {
-        "interface_models": scene.run.interface_models,
-        "synchronise_events": scene.run.synchronise_events,
-    }
+    run = scene.run
+    own = _coupling(run.interface_models, run.ramped_flows, run.synchronise_events)
     return next(k for k, settings in COUPLINGS.items() if settings == own)
 
 
 def coupling_choices(scene: Scene, settings: StudySettings) -> list[str]:
     """The scene's own coupling, then every other of the plan that would change a run.
 
-    ``interface`` couplings need a bond whose two ports offer an interface model.
+    ``interface`` couplings need a bond whose two ports offer an interface model,
+    ``ramped`` ones a bond whose effort side takes a flow ramp.
 
     Parameters
     ----------
@@ -306,10 +330,15 @@ def coupling_choices(scene: Scene, settings: StudySettings) -> list[str]:
         The plan, with its couplings.
     """
     own = scene_coupling(scene)
-    offered = any(b.interface for b in scene.bonds)
+    offered = {
+        "interface_models": any(b.interface for b in scene.bonds),
+        "ramped_flows": any(b.ramp is not None for b in scene.bonds),
+        "synchronise_events": True,
+    }
     out = [own]
     for name in settings.couplings:
-        if name not in out and (offered or not COUPLINGS[name]["interface_models"]):
+        wanted = [key for key, on in COUPLINGS[name].items() if on]
+        if name not in out and all(offered[key] for key in wanted):
             out.append(name)
     return out
 

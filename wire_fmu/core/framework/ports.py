@@ -18,7 +18,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
-__all__ = ["INTERFACE_QUANTITIES", "INTERFACE_UNITS", "PORT_KINDS", "Port", "PortSide", "port"]
+__all__ = [
+    "FLOW_RAMP_UNITS",
+    "INTERFACE_QUANTITIES",
+    "INTERFACE_UNITS",
+    "PORT_KINDS",
+    "Port",
+    "PortSide",
+    "port",
+]
 
 PORT_KINDS = {
     # kind: (effort unit, flow unit, position unit)
@@ -48,6 +56,8 @@ INTERFACE_UNITS = {
     "rotational": ("N.m/rad", "N.m.s/rad", "N.m/s", "rad", "rad/s"),
 }
 """SI units of the :data:`INTERFACE_QUANTITIES` by port kind."""
+FLOW_RAMP_UNITS = {"translational": "m/s2", "rope": "m/s2", "rotational": "rad/s2"}
+"""SI unit of a flow's rate of change (a port's ``flow_ramp`` input) by port kind."""
 
 
 class PortSide(StrEnum):
@@ -83,6 +93,10 @@ class Port:
     interface_switch : str or None
         On the effort side, the Boolean parameter that turns the interface model's
         computation on (the master sets it when it wires the model).
+    flow_ramp : str or None
+        On the effort side, the input that takes the flow's rate of change over the
+        step (:data:`FLOW_RAMP_UNITS`): the flow input is then its value at the step's
+        start and ramps from there (a ramped flow), instead of being held.
     """
 
     name: str
@@ -94,6 +108,7 @@ class Port:
     description: str = ""
     interface: bool = False
     interface_switch: str | None = None
+    flow_ramp: str | None = None
 
     @property
     def variables(self) -> tuple[str, ...]:
@@ -129,6 +144,8 @@ class Port:
             units_wanted = INTERFACE_UNITS[self.kind]
             names = self.interface_variables.values()
             expected += [((n, gives), u) for n, u in zip(names, units_wanted, strict=True)]
+        if self.flow_ramp:
+            expected.append(((self.flow_ramp, takes), FLOW_RAMP_UNITS[self.kind]))
         problems = []
         for (name, want), unit in expected:
             if causality.get(name) != want:
@@ -145,6 +162,8 @@ class Port:
                 f"port {self.name!r}: interface switch {self.interface_switch!r} must be a "
                 "parameter of the unit"
             )
+        if self.flow_ramp and self.side is not PortSide.effort:
+            problems.append(f"port {self.name!r}: a flow ramp belongs to an effort-side port")
         return problems
 
 
@@ -158,6 +177,7 @@ def port(
     description: str = "",
     interface: bool = False,
     interface_switch: str | None = None,
+    flow_ramp: str | None = None,
 ) -> Port:
     """A :class:`Port` whose variable names without a dot are taken under the port's name.
 
@@ -167,8 +187,9 @@ def port(
 
     Parameters
     ----------
-    name, kind, side, effort, flow, position, description, interface, interface_switch
-        As for :class:`Port`; ``effort``, ``flow`` and ``position`` may be short names.
+    name, kind, side, effort, flow, position, description, interface, interface_switch, flow_ramp
+        As for :class:`Port`; ``effort``, ``flow``, ``position`` and ``flow_ramp`` may be
+        short names.
     """
 
     def full(variable: str | None) -> str | None:
@@ -191,4 +212,5 @@ def port(
         description,
         interface,
         interface_switch,
+        full(flow_ramp),
     )

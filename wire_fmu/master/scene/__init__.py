@@ -22,6 +22,8 @@ Format::
     synchronise_events = false  # a mode change inside a step: every unit steps to it
     interface_models = false  # true: bonds whose two ports declare an interface model
                               # carry it (see wire_fmu.master.scene.bonds)
+    ramped_flows = false      # true: a bond whose effort side takes a flow ramp gets the
+                              # flow at the step's start and its slope over the step
     energy_tolerance = 10.0   # J per step, with adaptive; the energy guard's floor
     energy_guard = 0.1        # stop once a bond's coupling created this share of
                               # the energy it carried (inf: off); see energy_guard.py

@@ -20,6 +20,11 @@ by the run setting, it keeps its three links and ``wire-fmu check`` warns
 (:func:`.checks.interface_warnings`). A long-form bond lists the model's links
 itself, ``interface = ["rope.mover_a.stiffness -> cylinder.rod.stiffness",
 ...]``, effort side to flow side, and its scene sets the effort unit's switch.
+
+Ramped flows: when the effort port of a short-form bond declares a ``flow_ramp``
+input, the bond offers a ramp link from the flow side's flow to it, wired by
+``ramped_flows = true`` in ``[run]`` (:class:`.data.Bond`); long-form bonds hold
+their flow over the step.
 """
 
 from __future__ import annotations
@@ -28,7 +33,16 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from ..ports import PortDeclaration, PortLinks, parse_port_pair, port_links
-from .data import BOND_KINDS, EXTRAPOLATIONS, HELD, INTERFACE_ROLE, Bond, Connection, VarRef
+from .data import (
+    BOND_KINDS,
+    EXTRAPOLATIONS,
+    HELD,
+    INTERFACE_ROLE,
+    RAMP_ROLE,
+    Bond,
+    Connection,
+    VarRef,
+)
 from .sections import _as_list, _parse_link, _text, _unknown_keys
 
 __all__ = ["PortsOf", "parse_bonds"]
@@ -240,7 +254,7 @@ def _bond_of_links(
         pair : (str, str)
             Source and target, ``"unit.variable"`` each.
         role : str
-            ``"effort"``, ``"flow"``, ``"position"`` or ``"interface"``.
+            ``"effort"``, ``"flow"``, ``"position"``, ``"interface"`` or ``"ramp"``.
         scheme : str or None
             Its extrapolation (None: the run's).
         """
@@ -259,6 +273,7 @@ def _bond_of_links(
         interface_model=choice,
         interface_lacking=links.lacking,
         extrapolation=extrapolation,
+        ramp=connection(links.ramp, RAMP_ROLE, extrapolation) if links.ramp else None,
     )
 
 

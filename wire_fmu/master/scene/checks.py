@@ -70,11 +70,12 @@ def unknown_unit_problems(scene: Scene) -> list[str]:
 
 
 def interface_warnings(scene: Scene) -> list[str]:
-    """Each bond asked for its interface model by ``run.interface_models`` that has none.
+    """Each bond asked for its interface model by ``run.interface_models`` that has none,
+    and each bond asked for a ramped flow by ``run.ramped_flows`` that cannot take one.
 
     Such a bond keeps its effort, flow and position links (a bond that asks by its own
     ``interface_model = true`` and cannot have it is a problem instead, found where the
-    scene is read).
+    scene is read), and holds its flow over the step.
 
     Parameters
     ----------
@@ -99,6 +100,14 @@ def interface_warnings(scene: Scene) -> list[str]:
             f"bond {bond.name!r}: run.interface_models asks for interface models, but {why}; "
             "the bond keeps its effort, flow and position links"
         )
+    if scene.run.ramped_flows is True:
+        warnings += [
+            f"bond {bond.name!r}: run.ramped_flows asks for ramped flows, but no flow ramp "
+            f"goes with its flow input {bond.flow.target} (the effort side's port declares "
+            "none, or the bond is written link by link); its flow is held over the step"
+            for bond in scene.bonds
+            if not bond.ramped
+        ]
     return warnings
 
 
@@ -164,7 +173,7 @@ def _check_run(s: RunSettings, problems: list[str]) -> None:
             f"run.iterations = {s.iterations}: at most {MAX_ITERATIONS} sweeps of "
             "one step (a coupling that needs more does not converge)"
         )
-    for key in ("adaptive", "synchronise_events", "interface_models"):
+    for key in ("adaptive", "synchronise_events", "interface_models", "ramped_flows"):
         if not isinstance(getattr(s, key), bool):
             problems.append(f"run.{key} must be true or false, got {getattr(s, key)!r}")
     if not isinstance(s.order, tuple) or not all(isinstance(u, str) for u in s.order):

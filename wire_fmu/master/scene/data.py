@@ -40,12 +40,16 @@ __all__ = [
     "BOND_KINDS",
     "HELD",
     "INTERFACE_ROLE",
+    "RAMP_ROLE",
 ]
 
 ALGORITHMS = ("jacobi", "gauss_seidel")
 EXTRAPOLATIONS = ("constant", "linear", "quadratic")
 INTERFACE_ROLE = "interface"
 """The role of an interface model's links (effort side to flow side) in a bond."""
+RAMP_ROLE = "ramp"
+"""The role of a ramped flow's slope link (flow side's flow to the effort side's
+``flow_ramp`` input) in a bond; wired by ``run.ramped_flows``."""
 HELD = "constant"
 """The extrapolation of a wired interface model's links and of its bond's effort: the
 effort side's values at the step's start, about which the model is taken (the flow side
@@ -154,8 +158,9 @@ class UnitSpec:
 class Connection:
     """An output feeding an input.
 
-    ``role`` is ``"effort"``, ``"flow"``, ``"position"`` or ``"interface"`` (one of an
-    interface model's links) inside a bond, ``"signal"`` otherwise.
+    ``role`` is ``"effort"``, ``"flow"``, ``"position"``, ``"interface"`` (one of an
+    interface model's links) or ``"ramp"`` (the flow's slope) inside a bond, ``"signal"``
+    otherwise.
     """
 
     source: VarRef
@@ -191,6 +196,12 @@ class Bond:
         The bond's own extrapolation (its ``extrapolation`` key).
     wired : bool
         Whether the interface links are among the connections (set by the :class:`Scene`).
+    ramp : Connection or None
+        The flow's slope link (role ``"ramp"``) when the effort side takes one.
+    ramped : bool
+        Whether the ramp link is among the connections (``run.ramped_flows``; set by the
+        :class:`Scene`): the flow input is then the flow at the step's start, ramping
+        with the slope the master sets on the ramp link.
     """
 
     name: str
@@ -204,12 +215,16 @@ class Bond:
     interface_lacking: tuple[str, ...] = ()
     extrapolation: str | None = None
     wired: bool = False
+    ramp: Connection | None = None
+    ramped: bool = False
 
     @property
     def connections(self) -> tuple[Connection, ...]:
-        """The bond's connections: effort, flow, position, and the interface links if wired."""
+        """The bond's connections: effort, flow, position, the interface links if wired and
+        the ramp link if ramped."""
         links = tuple(c for c in (self.effort, self.flow, self.position) if c is not None)
-        return links + (self.interface if self.wired else ())
+        links += self.interface if self.wired else ()
+        return links + ((self.ramp,) if self.ramped and self.ramp is not None else ())
 
     def asks_interface(self, run: RunSettings) -> bool:
         """Whether the scene asks this bond for its interface model.
@@ -222,8 +237,9 @@ class Bond:
         choice = run.interface_models if self.interface_model is None else self.interface_model
         return choice is True
 
-    def wire(self, on: bool) -> Bond:
-        """The bond with its interface links wired (``on``, when it has them) or not.
+    def wire(self, on: bool, ramp: bool = False) -> Bond:
+        """The bond with its interface links wired (``on``, when it has them) or not, and
+        its flow ramped (``ramp``, when the effort side takes a ramp) or not.
 
         Wired, the effort is held like the links (:data:`HELD`): the flow side takes
         the effort and its model about the same instant.
@@ -232,12 +248,16 @@ class Bond:
         ----------
         on : bool
             Whether the scene asks for the interface model.
+        ramp : bool
+            Whether the scene asks for ramped flows (``run.ramped_flows``).
         """
         wired = bool(on and self.interface)
+        ramped = bool(ramp and self.ramp is not None)
         scheme = HELD if wired else self.extrapolation
-        if wired == self.wired and self.effort.extrapolation == scheme:
+        if wired == self.wired and ramped == self.ramped and self.effort.extrapolation == scheme:
             return self
-        return replace(self, effort=replace(self.effort, extrapolation=scheme), wired=wired)
+        effort = replace(self.effort, extrapolation=scheme)
+        return replace(self, effort=effort, wired=wired, ramped=ramped)
 
 
 @dataclass(frozen=True)
@@ -282,6 +302,7 @@ class RunSettings:
     adaptive: bool = False
     synchronise_events: bool = False
     interface_models: bool = False
+    ramped_flows: bool = False
     energy_tolerance: float = 10.0
     energy_guard: float = DEFAULT_SHARE
     min_step: float = 1e-5
@@ -310,7 +331,8 @@ class Scene:
 
     def __post_init__(self) -> None:
         """Wire each bond's interface model as the run and the bond ask (module docstring)."""
-        bonds = tuple(b.wire(b.asks_interface(self.run)) for b in self.bonds)
+        ramp = self.run.ramped_flows is True
+        bonds = tuple(b.wire(b.asks_interface(self.run), ramp) for b in self.bonds)
         switches: dict[str, list[str]] = {}
         for bond in bonds:
             if bond.wired and bond.interface_switch is not None:

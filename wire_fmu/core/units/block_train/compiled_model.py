@@ -124,7 +124,7 @@ class CompiledBlockTrain:
         if not result[13]:  # the Python kernel raises the error that names the span
             return self._python_evaluate(t, x)
         n, nb = self.n_coords, len(self.blocks)
-        dt = t - self._t_step
+        _, line_rate, mover_y, mover_v = self.held_motion(t)
         return {
             "forces": forces,
             "tension": tension,
@@ -138,8 +138,9 @@ class CompiledBlockTrain:
             "span_energy": span_energy,
             "potential": potential,
             "loss": loss,
-            "y": np.concatenate((x[:nb], self._mover_y0 + self._mover_v * dt)),
-            "ydot": np.concatenate((x[n : n + nb], self._mover_v)),
+            "y": np.concatenate((x[:nb], mover_y)),
+            "ydot": np.concatenate((x[n : n + nb], mover_v)),
+            "line_rate": line_rate,
         }
 
     def _quiet_step(self, t: float, h: float, inputs: BlockTrainInputs) -> bool:

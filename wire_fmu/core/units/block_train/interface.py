@@ -91,6 +91,7 @@ class _Slot:
 
     position: int
     rate: int
+    acceleration: int  # the rate's ramp over the step
     sign: float  # held value = sign * the port's own variable (a line's payout)
     tension: int | None = None  # span, for a line end
     body: int | None = None  # body index, for a driven body
@@ -99,6 +100,8 @@ class _Slot:
 def _slots(model) -> dict[str, _Slot]:
     """The ports the reeving uses, by name, with their places in the held-input vector."""
     n_lines = len(LINE_PORTS)
+    nd, nb = len(model.drivers), len(model.blocks)
+    ramps = 1 + 2 * n_lines + 2 * nd
     slots = {}
     for k in (0, model.n_nodes - 1):
         node = model.nodes[k]
@@ -106,11 +109,10 @@ def _slots(model) -> dict[str, _Slot]:
             i = LINE_PORTS.index(node.name)
             span = 0 if k == 0 else len(model.spans) - 1
             sign = model.line_sign[i]
-            slots[node.name] = _Slot(1 + i, 1 + n_lines + i, sign, tension=span)
-    nd, nb = len(model.drivers), len(model.blocks)
+            slots[node.name] = _Slot(1 + i, 1 + n_lines + i, ramps + i, sign, tension=span)
     for j, body in enumerate(model.drivers):
         first = 1 + 2 * n_lines
-        slots[body.port] = _Slot(first + j, first + nd + j, 1.0, body=nb + j)
+        slots[body.port] = _Slot(first + j, first + nd + j, ramps + n_lines + j, 1.0, body=nb + j)
     return slots
 
 
@@ -129,9 +131,11 @@ def _effort(slot: _Slot, efforts: tuple) -> float:
 
 def _reference(held: np.ndarray, slot: _Slot, elapsed: float) -> tuple[float, float]:
     """The port's position (m) and velocity (m/s) at ``elapsed`` (s) into the held step,
-    in the port's own variables (a held line payout is signed, see :class:`_Slot`)."""
-    rate = held[slot.rate]
-    return slot.sign * (held[slot.position] + rate * elapsed), slot.sign * rate
+    in the port's own variables (a held line payout is signed, see :class:`_Slot`); the
+    rate ramps with its acceleration from the step's start."""
+    rate, acceleration = held[slot.rate], held[slot.acceleration]
+    position = held[slot.position] + (rate + 0.5 * acceleration * elapsed) * elapsed
+    return slot.sign * position, slot.sign * (rate + acceleration * elapsed)
 
 
 def _moved(model, x: np.ndarray) -> np.ndarray:
@@ -152,7 +156,8 @@ def _linearise(model, slot: _Slot, t: float, x: np.ndarray, base: tuple) -> Port
     """
     held = model.held_vector
     elapsed = t - held[0]
-    rate = held[slot.rate]
+    acceleration = held[slot.acceleration]
+    rate = held[slot.rate] + acceleration * elapsed  # the held rate at t
     position, velocity = _reference(held, slot, elapsed)
     effort = _effort(slot, base)
 
@@ -172,8 +177,9 @@ def _linearise(model, slot: _Slot, t: float, x: np.ndarray, base: tuple) -> Port
     d_velocity = change(up) / step
     # d/d t with this port still where it is at t (still, not moving: its own base)
     still = held.copy()
-    still[slot.position] += rate * elapsed
+    still[slot.position] += (held[slot.rate] + 0.5 * acceleration * elapsed) * elapsed
     still[slot.rate] = 0.0
+    still[slot.acceleration] = 0.0
     return PortLinearisation(
         stiffness=-d_position,
         damping=-d_velocity,
@@ -212,10 +218,11 @@ def interface_plan(model) -> InterfacePlan:
             s.sign,
             -1 if s.tension is None else s.tension,
             -1 if s.body is None else s.body,
+            s.acceleration,
         )
         for s in slots.values()
     ]
-    table = np.array(rows, dtype=float).reshape(len(rows), 5)
+    table = np.array(rows, dtype=float).reshape(len(rows), 6)
     return InterfacePlan(tuple(slots), tuple(slots.values()), table)
 
 

@@ -29,7 +29,8 @@ index  name                contents
 10     ``contact``         per block: on its floor
 11     ``held``            time the inputs hold from (s), line rope positions
                            ``s`` (m) and rates (m/s), mover positions (m) and
-                           velocities (m/s)
+                           velocities (m/s), the line rates' and the mover
+                           velocities' accelerations (m/s², a ramped flow)
 12     ``path_nodes``      moving geometry, per path node: plane coordinates
                            ``x``, ``z`` of its centre with every body at 0 (m),
                            signed radius ``sense * r`` (m); else empty
@@ -82,6 +83,7 @@ __all__ = [
     "evaluate",
     "factor",
     "guards",
+    "held_motion",
     "kernel_data",
     "linearise",
     "project",
@@ -174,6 +176,43 @@ def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
 
 
 @jit
+def held_motion(t: float, held: np.ndarray, nd: int) -> tuple:
+    """The held inputs' motion at ``t`` (:meth:`BlockTrainModel.held_motion`).
+
+    Parameters
+    ----------
+    t : float
+        Time, s.
+    held : numpy.ndarray
+        The held inputs (the module docstring's index 11).
+    nd : int
+        Number of driven bodies.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Line rope positions (m) and rates (m/s), driven bodies' positions (m) and
+        velocities (m/s): each rate ramps with its acceleration from the step's start,
+        each position advances with the rate.
+    """
+    dt = t - held[0]
+    ramps = 1 + 2 * N_LINES + 2 * nd
+    line_s = np.empty(N_LINES)
+    line_rate = np.empty(N_LINES)
+    for i in range(N_LINES):
+        rate, acc = held[1 + N_LINES + i], held[ramps + i]
+        line_rate[i] = rate + acc * dt
+        line_s[i] = held[1 + i] + (rate + 0.5 * acc * dt) * dt
+    mover_y = np.empty(nd)
+    mover_v = np.empty(nd)
+    for j in range(nd):
+        rate, acc = held[1 + 2 * N_LINES + nd + j], held[ramps + N_LINES + j]
+        mover_v[j] = rate + acc * dt
+        mover_y[j] = held[1 + 2 * N_LINES + j] + (rate + 0.5 * acc * dt) * dt
+    return line_s, line_rate, mover_y, mover_v
+
+
+@jit
 def evaluate(t: float, x: np.ndarray, data):
     """Forces, tensions, energies and guard inputs at ``(t, x)``.
 
@@ -203,16 +242,14 @@ def evaluate(t: float, x: np.ndarray, data):
     n, nb, nd = sizes[0], sizes[1], sizes[2]
     ea, damping = rope[0], rope[1]
     n_spans = len0.size
-    dt = t - held[0]
-    line_rate = held[3 : 3 + N_LINES]
-    mover_v = held[3 + N_LINES + nd : 3 + N_LINES + 2 * nd]
+    line_s, line_rate, mover_y, mover_v = held_motion(t, held, nd)
     y = np.empty(nb + nd)
     ydot = np.empty(nb + nd)
     for j in range(nb):
         y[j] = x[j]
         ydot[j] = x[n + j]
     for j in range(nd):
-        y[nb + j] = held[3 + N_LINES + j] + mover_v[j] * dt
+        y[nb + j] = mover_y[j]
         ydot[nb + j] = mover_v[j]
     flow_q = np.empty(n + N_LINES)
     flow_v = np.empty(n + N_LINES)
@@ -220,7 +257,7 @@ def evaluate(t: float, x: np.ndarray, data):
         flow_q[i] = x[i]
         flow_v[i] = x[n + i]
     for i in range(N_LINES):
-        flow_q[n + i] = held[1 + i] + line_rate[i] * dt
+        flow_q[n + i] = line_s[i]
         flow_v[n + i] = line_rate[i]
     if sizes[3]:
         big_l, jac, ok = span_geometry(y, data)
@@ -350,8 +387,7 @@ def rhs_parts(t: float, x: np.ndarray, data):
     flow, held = data[5], data[11]
     result = evaluate(t, x, data)
     tension, jac, on_unstretched = result[1], result[14], result[16]
-    line_rate = held[3 : 3 + N_LINES]
-    mover_v = held[3 + N_LINES + nd : 3 + N_LINES + 2 * nd]
+    _, line_rate, _, mover_v = held_motion(t, held, nd)
     span_power = np.empty(tension.size)
     for i in range(tension.size):
         p = 0.0

@@ -16,6 +16,7 @@ index  name          contents
 2      ``sign``      held value = sign x the port's own variable
 3      ``tension``   span whose tension is the effort, or -1
 4      ``body``      body whose force is the effort, or -1
+5      ``ramp``      index of its rate's acceleration there
 =====  ============  =======================================================
 """
 
@@ -89,11 +90,13 @@ def port_linearisations(
     moved[:n] += time_step * x[n : 2 * n]
     for p in range(slots.shape[0]):
         slot = slots[p]
-        position_at, rate_at, sign = int(slot[0]), int(slot[1]), slot[2]
-        rate = held[rate_at]
+        position_at, rate_at, sign, ramp_at = int(slot[0]), int(slot[1]), slot[2], int(slot[5])
+        acceleration = held[ramp_at]
+        rate = held[rate_at] + acceleration * elapsed  # the held rate at t
         effort = _pick(base, data[3].size, slot)
         # d/d position: the held position moves, so the position at t does too
-        position = sign * (held[position_at] + rate * elapsed)
+        travel = (held[rate_at] + 0.5 * acceleration * elapsed) * elapsed
+        position = sign * (held[position_at] + travel)
         step = relative_step * max(1.0, abs(position))
         up = held.copy()
         up[position_at] += sign * step
@@ -106,8 +109,9 @@ def port_linearisations(
         d_velocity = (_effort(t, x, data, up, slot) - effort) / step
         # d/d t with this port still where it is at t
         still = held.copy()
-        still[position_at] += rate * elapsed
+        still[position_at] += travel
         still[rate_at] = 0.0
+        still[ramp_at] = 0.0
         later = _effort(t + time_step, moved, data, still, slot) - effort
         now = _effort(t, x, data, still, slot) - effort
         out[p, 0] = -d_position

@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -79,7 +79,8 @@ BLOCK_TRAIN_EFFECTS = EffectCatalogue(
 
 @dataclass
 class BlockTrainInputs:
-    """Inputs held over one step (positions advance with their rates).
+    """Inputs held over one step, from its start: each rate ramps with its acceleration
+    (held when that is 0) and each position advances with the rate.
 
     Attributes
     ----------
@@ -89,12 +90,16 @@ class BlockTrainInputs:
         Its rate, m/s.
     mover_position, mover_velocity : dict of str to float
         Displacement (m) and velocity (m/s) of each driven body's port.
+    payout_acceleration, mover_acceleration : dict of str to float
+        The rates' change over the step, m/s² (a ramped flow); none: held.
     """
 
     payout: dict[str, float]
     payout_rate: dict[str, float]
     mover_position: dict[str, float]
     mover_velocity: dict[str, float]
+    payout_acceleration: dict[str, float] = field(default_factory=dict)
+    mover_acceleration: dict[str, float] = field(default_factory=dict)
 
 
 class BlockTrainModel(
@@ -248,6 +253,8 @@ class BlockTrainModel(
         held += [sign * inputs.payout_rate.get(p, 0.0) for p, sign in lines]
         held += [inputs.mover_position.get(p, 0.0) for p in self.driver_ports]
         held += [inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports]
+        held += [sign * inputs.payout_acceleration.get(p, 0.0) for p, sign in lines]
+        held += [inputs.mover_acceleration.get(p, 0.0) for p in self.driver_ports]
         return np.array(held)
 
     def _hold(self, t: float, inputs: BlockTrainInputs, vector: np.ndarray) -> None:
@@ -256,10 +263,29 @@ class BlockTrainModel(
         self._t_step = t
         self._step_summary = None
         self.held_vector = vector
-        lines, movers = 1 + len(LINE_PORTS), 1 + 2 * len(LINE_PORTS)
+        nl, nd = len(LINE_PORTS), len(self.driver_ports)
+        lines, movers, ramps = 1 + nl, 1 + 2 * nl, 1 + 2 * nl + 2 * nd
         self._line_s0, self._line_rate = vector[1:lines], vector[lines:movers]
-        self._mover_y0 = vector[movers : movers + len(self.driver_ports)]
-        self._mover_v = vector[movers + len(self.driver_ports) :]
+        self._mover_y0 = vector[movers : movers + nd]
+        self._mover_v = vector[movers + nd : ramps]
+        self._line_acc = vector[ramps : ramps + nl]
+        self._mover_acc = vector[ramps + nl :]
+
+    def held_motion(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The held inputs' motion at ``t``: line rope positions and rates, driven bodies'
+        positions and velocities (m, m/s; the kernel's :func:`kernel.held_motion`).
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        """
+        dt = t - self._t_step
+        line_rate = self._line_rate + self._line_acc * dt
+        mover_v = self._mover_v + self._mover_acc * dt
+        line_s = self._line_s0 + (self._line_rate + 0.5 * self._line_acc * dt) * dt
+        mover_y = self._mover_y0 + (self._mover_v + 0.5 * self._mover_acc * dt) * dt
+        return line_s, line_rate, mover_y, mover_v
 
     @contextmanager
     def holding(self, vector: np.ndarray) -> Iterator[None]:
@@ -339,12 +365,12 @@ class BlockTrainModel(
             return self._evaluate_compiled(t, x)
         n, nb = self.n_coords, len(self.blocks)
         q, v = x[:n], x[n : 2 * n]
-        dt = t - self._t_step
-        y = np.concatenate((q[:nb], self._mover_y0 + self._mover_v * dt))
-        ydot = np.concatenate((v[:nb], self._mover_v))
+        line_s, line_rate, mover_y, mover_v = self.held_motion(t)
+        y = np.concatenate((q[:nb], mover_y))
+        ydot = np.concatenate((v[:nb], mover_v))
         big_l, dl_dy = self.span_lengths(y)
-        flow = np.concatenate((q, self._line_s0 + self._line_rate * dt))
-        flow_rate = np.concatenate((v, self._line_rate))
+        flow = np.concatenate((q, line_s))
+        flow_rate = np.concatenate((v, line_rate))
         small_l = self.offsets + ordered_matvec(self.flow_matrix, flow)
         if np.any(small_l <= 0.0):
             i = int(np.argmin(small_l))
@@ -401,12 +427,13 @@ class BlockTrainModel(
             "y": y,
             "ydot": ydot,
             "span_jacobian": dl_dy,
+            "line_rate": line_rate,
         }
 
     def _external_power(self, ev: dict) -> float:
         """Power delivered into the block train through its ports, W."""
         nb = len(self.blocks)
-        power = -float(ev["line_force"] @ self._line_rate)
+        power = -float(ev["line_force"] @ ev["line_rate"])
         power -= float(ev["body_force"][nb:] @ ev["ydot"][nb:])
         return power
 
@@ -454,9 +481,9 @@ class BlockTrainModel(
         span_power = np.empty(len(self.spans))
         for i in range(len(self.spans)):
             p = 0.0
-            for line, rate in enumerate(self._line_rate):
+            for line, rate in enumerate(ev["line_rate"]):
                 p -= on_unstretched[i] * self.flow_matrix[i, n + line] * rate
-            for j, velocity in enumerate(self._mover_v):
+            for j, velocity in enumerate(ev["ydot"][nb:]):
                 p += tension[i] * dl_dy[i, nb + j] * velocity
             span_power[i] = p
         out, link_force = self._rhs_of(x, ev)
@@ -543,6 +570,8 @@ class BlockTrainModel(
             "payout_rate": dict(inp.payout_rate),
             "mover_position": dict(inp.mover_position),
             "mover_velocity": dict(inp.mover_velocity),
+            "payout_acceleration": dict(inp.payout_acceleration),
+            "mover_acceleration": dict(inp.mover_acceleration),
         }
 
     def restore_held_inputs(self, data: dict) -> None:
@@ -558,6 +587,8 @@ class BlockTrainModel(
             {k: float(v) for k, v in data["payout_rate"].items()},
             {k: float(v) for k, v in data["mover_position"].items()},
             {k: float(v) for k, v in data["mover_velocity"].items()},
+            {k: float(v) for k, v in data.get("payout_acceleration", {}).items()},
+            {k: float(v) for k, v in data.get("mover_acceleration", {}).items()},
         )
         self.set_inputs(float(data["time"]), inputs)
 

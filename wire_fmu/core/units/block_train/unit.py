@@ -112,15 +112,18 @@ def _variables():
         ),
     )
     inputs = []
+    ramp = "over the step, its rate ramping from the value set at the step's start (0: held)"
     for line in LINE_PORTS:
         inputs += [
             input_(f"{line}.payout", 0.0, "m", f"Rope paid in through {line} since the start"),
             input_(f"{line}.payout_rate", 0.0, "m/s", f"Rate of rope paid in through {line}"),
+            input_(f"{line}.payout_acceleration", 0.0, "m/s2", f"Change of that rate {ramp}"),
         ]
     for mover in MOVER_PORTS:
         inputs += [
             input_(f"{mover}.position", 0.0, "m", f"Displacement of driven body {mover}"),
             input_(f"{mover}.velocity", 0.0, "m/s", f"Velocity of driven body {mover}"),
+            input_(f"{mover}.acceleration", 0.0, "m/s2", f"Change of that velocity {ramp}"),
         ]
     inputs.append(
         input_("break_segment", 0, "", "Break this rope segment (1-based) now; 0: none", type=int)
@@ -221,11 +224,29 @@ class BlockTrainUnit(Unit):
     DATA_FIELDS = MappingProxyType({"reeving": REEVING_FIELDS})
     PORTS = (
         *(
-            port(n, "rope", PortSide.effort, "tension", "payout_rate", "payout", **_INTERFACE)
+            port(
+                n,
+                "rope",
+                PortSide.effort,
+                "tension",
+                "payout_rate",
+                "payout",
+                flow_ramp="payout_acceleration",
+                **_INTERFACE,
+            )
             for n in LINE_PORTS
         ),
         *(
-            port(n, "translational", PortSide.effort, "force", "velocity", "position", **_INTERFACE)
+            port(
+                n,
+                "translational",
+                PortSide.effort,
+                "force",
+                "velocity",
+                "position",
+                flow_ramp="acceleration",
+                **_INTERFACE,
+            )
             for n in MOVER_PORTS
         ),
     )
@@ -421,6 +442,8 @@ class BlockTrainUnit(Unit):
             payout_rate={p: float(v[rate]) for p, _, rate in _LINE_INPUTS},
             mover_position={p: float(v[name]) for p, name, _ in _MOVER_INPUTS},
             mover_velocity={p: float(v[rate]) for p, _, rate in _MOVER_INPUTS},
+            payout_acceleration={p: float(v[f"{p}.payout_acceleration"]) for p in LINE_PORTS},
+            mover_acceleration={p: float(v[f"{p}.acceleration"]) for p in MOVER_PORTS},
         )
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
