@@ -130,7 +130,8 @@ def test_both_kernels_agree_on_ramped_steps(monkeypatch):
         for steps in (10, 20, 30):
             rod_ramps(unit, steps)
             rows.append([unit.values[name] for name in record])
-        tables.append({name: np.array(column) for name, column in zip(record, zip(*rows))})
+        columns = np.array(rows).T
+        tables.append({name: column for name, column in zip(record, columns, strict=True)})
     assert_tables_agree(*tables, "ramped riser")
 
 
