@@ -14,6 +14,8 @@ at ``v0 + a h``; the rope's work on the rod closes its ledger; both kernels agre
 from __future__ import annotations
 
 import math
+import zipfile
+from pathlib import Path
 from dataclasses import replace
 from types import SimpleNamespace
 from xml.etree import ElementTree as ET
@@ -261,3 +263,65 @@ def test_the_drawworks_release_is_within_1e_3_of_the_monolithic_solve(tmp_path):
     errors = {row.coupling: row.error for row in study.rows if row.algorithm != "monolithic"}
     assert errors["ramped"] < 1e-3
     assert errors["held"] > 3.0 * errors["ramped"]
+
+
+@pytest.mark.integration
+def test_ssp_names_the_ramp_without_connecting_it_and_reads_it_back(tmp_path):
+    """Another tool must not connect the payout rate to the ramp input (it would set the
+    acceleration to the rate): the ramp is named on the flow's annotation, and our master
+    reading the package back wires it again."""
+    from lxml import etree
+
+    from wire_fmu.interop.ssp import NS, export_ssp
+    from wire_fmu.interop.ssp_read import read_ssp
+    from wire_fmu.master.scene import load_scene
+    from wire_fmu.master.run import find_scene
+
+    scene = load_scene(find_scene("drawworks"))
+    assert scene.bonds[0].ramped
+    package = export_ssp(scene, tmp_path / "drawworks.ssp")
+    with zipfile.ZipFile(package) as archive:
+        ssd = etree.fromstring(archive.read("SystemStructure.ssd"))
+    targets = [c.get("endConnector") for c in ssd.iter(f"{{{NS['ssd']}}}Connection")]
+    assert "line_a.payout_rate" in targets and "line_a.payout_acceleration" not in targets
+    marks = [m.get("ramp") for m in ssd.iter(f"{{{NS['wf']}}}Bond") if m.get("role") == "flow"]
+    assert marks == ["line_a.payout_acceleration"]
+    back = read_ssp(package, extract_to=tmp_path / "extracted")
+    (bond,) = back.bonds
+    assert back.run.ramped_flows and bond.ramped
+    assert (str(bond.ramp.source), str(bond.ramp.target)) == (
+        "winch.rope.payout_rate",
+        "rope.line_a.payout_acceleration",
+    )
+
+
+def _long_form(ramp: str, **run) -> dict:
+    return {
+        "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
+        "run": run,
+        "bonds": [
+            {
+                "name": "rope",
+                "kind": "rope",
+                "effort": "r.line_a.tension -> w.rope.tension",
+                "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
+                "position": "w.rope.payout -> r.line_a.payout",
+                "ramp": ramp,
+            }
+        ],
+    }
+
+
+def test_a_long_form_bond_names_its_ramp_from_the_flows_source():
+    from wire_fmu.master.scene import SceneError, parse_scene
+
+    scene = parse_scene(
+        _long_form("w.rope.payout_rate -> r.line_a.payout_acceleration", ramped_flows=True),
+        base_dir=Path("."),
+    )
+    assert scene.bonds[0].ramped
+    with pytest.raises(SceneError) as refused:
+        parse_scene(
+            _long_form("w.rope.tension -> r.line_a.payout_acceleration"), base_dir=Path(".")
+        )
+    assert "the ramp must go from the flow's source w.rope.payout_rate" in str(refused.value)

@@ -11,7 +11,9 @@ OSP know no time signals. The SSP and OSP writers only serialise an
 What another tool cannot be told (and is therefore logged as a warning):
 the coupling algorithm (libcosim's fixed-step algorithm is Jacobi with
 inputs held constant, see ``docs/interop.md``), extrapolation, iteration,
-adaptive steps, and event times off the fixed step grid. A bond's wired
+adaptive steps, ramped flows (a ramp link's value is the master's work: it is
+not exported, the run settings keep the choice for our master to read back),
+and event times off the fixed step grid. A bond's wired
 interface model needs no warning: its links are ordinary connections
 (:attr:`ExportPlan.all_connections`), held over the step as another tool
 holds every input, and the effort unit's switch is among its start values.
@@ -339,6 +341,8 @@ def _warn_about_run_settings(scene: Scene) -> None:
         differs.append(f"{s.iterations} iterations per step")
     if s.adaptive:
         differs.append("adaptive steps")
+    if any(b.ramped for b in scene.bonds):
+        differs.append("ramped flows")
     if differs:
         logger.warning(
             "scene %r asks for %s; the exported fixed-step system is run by other "
@@ -415,8 +419,11 @@ def plan_export(
             )
         )
         connections += built.connections
+    # a ramp's value is the master's work (the flow's slope), no connection: another tool
+    # leaves the ramp input at 0 and holds the flow; the run settings keep the choice
+    bonds = tuple(b.wire(b.wired, ramp=False) for b in scene.bonds)
     plan = ExportPlan(
-        scene, tuple(units), scene.bonds, tuple(connections), signals_name, _metadata(scene)
+        scene, tuple(units), bonds, tuple(connections), signals_name, _metadata(scene)
     )
     json.dumps(plan.metadata)  # fail here, not half-way through writing, if not JSON-ready
     return plan

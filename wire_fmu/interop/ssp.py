@@ -25,7 +25,10 @@ Mapping
   interface model is wired adds the model's five links (stiffness, damping,
   effort rate, reference position and velocity, effort side to flow side),
   ordinary connections too, with the role ``interface``; the effort unit's
-  switch parameter is in its parameter set like any other.
+  switch parameter is in its parameter set like any other. A bond whose
+  effort side takes a flow ramp names the ramp input on its flow connection's
+  annotation (``ramp``): the ramp's value is the master's work, so it is no
+  connection, and another tool leaves it at 0 (the held flow).
 * Drivers and scheduled events become the generated signals component
   (:mod:`wire_fmu.interop.signals`) and plain connections from it.
 * ``ssd:DefaultExperiment`` gives the start and stop time; an annotation of
@@ -178,7 +181,10 @@ def _connections(system: etree._Element, plan: ExportPlan) -> None:
         bond = roles.get(id(c))
         if bond is not None:
             note = _annotation(element, BOND_ANNOTATION)
-            _sub(note, "wf", "Bond", name=bond.name, kind=bond.kind, role=c.role)
+            marks = {"name": bond.name, "kind": bond.kind, "role": c.role}
+            if c.role == "flow" and bond.ramp is not None:  # the master's, not a connection
+                marks["ramp"] = bond.ramp.target.variable
+            _sub(note, "wf", "Bond", **marks)
 
 
 def _units(parent: etree._Element, prefix: str, used: set[str], models) -> None:

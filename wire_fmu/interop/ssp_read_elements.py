@@ -230,6 +230,8 @@ def _connections(
             problems.append(f"{where}: bond {name!r} has a second {role} connection")
             continue
         bond[role] = f"{link[0]} -> {link[1]}"
+        if role == "flow" and mark.get("ramp"):  # the flow's ramp input, set by the master
+            bond["ramp"] = f"{link[0]} -> {link[1].split('.', 1)[0]}.{mark.get('ramp')}"
     return plain, list(bonds.values())
 
 

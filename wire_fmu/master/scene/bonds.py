@@ -23,8 +23,9 @@ itself, ``interface = ["rope.mover_a.stiffness -> cylinder.rod.stiffness",
 
 Ramped flows: when the effort port of a short-form bond declares a ``flow_ramp``
 input, the bond offers a ramp link from the flow side's flow to it, wired by
-``ramped_flows = true`` in ``[run]`` (:class:`.data.Bond`); long-form bonds hold
-their flow over the step.
+``ramped_flows = true`` in ``[run]`` (:class:`.data.Bond`); a long-form bond
+offers one when it names it, ``ramp = "winch.rope.payout_rate ->
+rope.line_a.payout_acceleration"`` (from the flow's source).
 """
 
 from __future__ import annotations
@@ -58,6 +59,7 @@ _LONG_KEYS = {
     "extrapolation",
     "interface",
     "interface_model",
+    "ramp",
 }
 _SHORT_KEYS = {"name", "kind", "ports", "extrapolation", "interface_model"}
 
@@ -168,9 +170,9 @@ def _long_bond(
             "the bond as 'ports' whose FMUs declare the model)"
         )
     links = {}
-    for role in ("effort", "flow", "position"):
+    for role in ("effort", "flow", "position", RAMP_ROLE):
         if role not in spec:
-            if role != "position":
+            if role in ("effort", "flow"):
                 problems.append(f"{where}: '{role}' is required (or write the bond as 'ports')")
             continue
         link = _parse_link(spec[role], f"{where} {role}", problems)
@@ -189,6 +191,12 @@ def _long_bond(
             f"{f.source.unit} -> {f.target.unit})"
         )
     _crossed_interface(e, interface, where, problems)
+    ramp = links.get(RAMP_ROLE)
+    if ramp is not None and (ramp.source != f.source or ramp.target.unit != f.target.unit):
+        problems.append(
+            f"{where}: the ramp must go from the flow's source {f.source} to an input of "
+            f"unit {f.target.unit!r}, got {ramp.source} -> {ramp.target}"
+        )
     return Bond(
         name,
         str(kind),
@@ -198,6 +206,7 @@ def _long_bond(
         interface=interface,
         interface_model=choice,
         extrapolation=extrapolation,
+        ramp=ramp if ramp is not None and not problems else None,
     )
 
 
