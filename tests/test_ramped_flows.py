@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import math
 import zipfile
-from pathlib import Path
 from dataclasses import replace
+from pathlib import Path
 from types import SimpleNamespace
 from xml.etree import ElementTree as ET
 
@@ -274,8 +274,8 @@ def test_ssp_names_the_ramp_without_connecting_it_and_reads_it_back(tmp_path):
 
     from wire_fmu.interop.ssp import NS, export_ssp
     from wire_fmu.interop.ssp_read import read_ssp
-    from wire_fmu.master.scene import load_scene
     from wire_fmu.master.run import find_scene
+    from wire_fmu.master.scene import load_scene
 
     scene = load_scene(find_scene("drawworks"))
     assert scene.bonds[0].ramped
