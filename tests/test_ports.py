@@ -146,6 +146,7 @@ def test_a_port_that_does_not_match_its_variables_is_named_with_what_is_wrong():
 def test_a_bond_written_as_two_ports_is_the_long_form(name):
     data = scene_data(name)
     data["run"].pop("interface_models", None)  # the long forms below list no interface links
+    data["run"].pop("ramped_flows", None)  # nor ramps
     short, problems = read(data)
     assert problems == []
     long_form = copy.deepcopy(data)

@@ -18,7 +18,9 @@ second order (SPEC section 15).
     averaged over the step by Simpson's rule, exact for a parabola.
 
 With fewer past values than a scheme needs (at the start, after a reset)
-the order drops accordingly.
+the order drops accordingly; so it does where the past values are closer together
+than half the step (:data:`MIN_SPACING`: after a step shortened to a mode change),
+which a polynomial through them would turn into a wild extrapolation.
 
 A ramped flow (a bond wired with ``run.ramped_flows``, :func:`ramp`) is not held:
 the effort side takes its value at the step's start and its slope over the step,
@@ -44,6 +46,10 @@ from collections import deque
 __all__ = ["History", "held_value", "ramp", "SCHEME_POINTS"]
 
 SCHEME_POINTS = {"constant": 1, "linear": 2, "quadratic": 3}
+MIN_SPACING = 0.5
+"""Past values closer together than this many steps are not extrapolated from: a line
+through two values ``d`` apart carried over a step ``H`` multiplies their difference by
+``H / d`` (after a step shortened to a unit's mode change, ``d`` may be microseconds)."""
 
 
 class History:
@@ -127,13 +133,11 @@ def held_value(
         if len(points) == 1:
             return points[-1][1]
         (t0, y0), (t1, y1) = points[-2], points[-1]
-        return _line(t0, y0, t1, y1, t + 0.5 * step)
-    if fresh is not None:
-        if scheme == "constant":
-            return fresh
-        pts = list(points)[-(need - 1) :] + [(t + step, fresh)]
-    else:
-        pts = list(points)[-need:]
+        if t1 - t0 >= MIN_SPACING * step:
+            return _line(t0, y0, t1, y1, t + 0.5 * step)
+    if fresh is not None and scheme == "constant":
+        return fresh
+    pts = _polynomial(history, t, step, scheme, fresh)
     if len(pts) == 1:
         return pts[0][1]
     if len(pts) == 2:
@@ -146,11 +150,17 @@ def held_value(
 def _polynomial(
     history: History, t: float, step: float, scheme: str, fresh: float | None
 ) -> list[tuple[float, float]]:
-    """The points the scheme's polynomial over ``[t, t + step]`` goes through."""
+    """The points the scheme's polynomial over ``[t, t + step]`` goes through, oldest first:
+    the newest (``fresh`` at ``t + step`` when given), then going back each point at least
+    :data:`MIN_SPACING` steps before the one after it."""
     need = SCHEME_POINTS[scheme]
-    if fresh is None:
-        return list(history.points)[-need:]
-    return list(history.points)[-(need - 1) :] + [(t + step, fresh)] if need > 1 else []
+    chosen = [(t + step, fresh)] if fresh is not None else []
+    for point in reversed(history.points):
+        if len(chosen) == need:
+            break
+        if not chosen or chosen[-1][0] - point[0] >= MIN_SPACING * step:
+            chosen.append(point)
+    return chosen[::-1]
 
 
 def ramp(

@@ -247,6 +247,7 @@ class Simulation(UnitExchange, MacroStep):
         now_ns = _ns(self.time)
         h = self.run_settings.step
         resume_h = None  # the step to go on with after one shortened to a mode change
+        planned_ns = None  # where that shortened step was to end: the rest is stepped first
         while now_ns < stop_ns:
             next_ns = min(now_ns + max(1, _ns(h)), stop_ns)
             upcoming = self.events.next_time
@@ -262,6 +263,7 @@ class Simulation(UnitExchange, MacroStep):
             if attempt.event_end_ns is not None:  # step every unit to the mode change
                 result.synchronised += 1
                 resume_h = h if resume_h is None else resume_h
+                planned_ns = next_ns if planned_ns is None else planned_ns
                 h = (attempt.event_end_ns - now_ns) / 1e9
                 continue
             if not attempt.accepted:
@@ -287,7 +289,9 @@ class Simulation(UnitExchange, MacroStep):
             blow_up = self.energy.blow_up(self.time, h)
             if blow_up:
                 raise SimulationStoppedError(blow_up)
-            if resume_h is not None:  # after a step shortened to a mode change: the one asked
-                h, resume_h = resume_h, None
+            if planned_ns is not None and now_ns < planned_ns:  # the rest of a shortened step:
+                h = (planned_ns - now_ns) / 1e9  # back on the grid (and the output times)
+            elif resume_h is not None:  # then the step asked for
+                h, resume_h, planned_ns = resume_h, None, None
             else:
                 h = self._next_step(h, attempt.residuals)
