@@ -31,8 +31,8 @@ from .facade_checks import load_facade_class
 RING_SPEED = 0.5  # m/s, the riser's ring moving along its direction (down)
 
 
-def riser(interface_model: bool = True):
-    """The riser tensioner's rope at its 356 kN set tension, the ring moving; one short step."""
+def riser_rope(interface_model: bool = True):
+    """The riser tensioner's rope at its 356 kN set tension, the ring moving; not stepped."""
     unit = make_unit(
         riser_tensioner(),
         "rope_damping",
@@ -41,6 +41,12 @@ def riser(interface_model: bool = True):
         interface_model=interface_model,
     )
     unit.values["mover_b.velocity"] = RING_SPEED
+    return unit
+
+
+def riser(interface_model: bool = True):
+    """:func:`riser_rope` after one short step."""
+    unit = riser_rope(interface_model)
     assert unit.advance(0.0, 1e-4).success
     return unit
 

@@ -25,7 +25,6 @@ import pytest
 
 from wire_fmu.core.framework import compiled
 from wire_fmu.core.framework.compiled import KERNEL_ENV
-from wire_fmu.core.units.block_train.reevings import riser_tensioner
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 from wire_fmu.export.model_description import patch_model_description
 from wire_fmu.master import validate
@@ -37,9 +36,8 @@ from wire_fmu.study.accuracy import run_accuracy_study
 from wire_fmu.study.plan import load_study_scene, study_settings
 
 from . import test_interface_links as links_helpers
-from .block_train_helpers import make_unit
 from .facade_checks import load_facade_class
-from .test_block_train_interface import RING_SPEED
+from .test_block_train_interface import RING_SPEED, riser_rope
 from .test_kernels import assert_tables_agree
 
 STEP = 2e-3  # s
@@ -47,16 +45,8 @@ ROD = {"position": 0.01, "velocity": 0.2, "acceleration": 50.0}  # m, m/s, m/s2
 
 
 def ramped_riser(interface_model: bool = False, **rod: float):
-    """The riser's rope at 356 kN, the rod's inputs ``rod`` (position, velocity,
-    acceleration), the ring moving at :data:`RING_SPEED`."""
-    unit = make_unit(
-        riser_tensioner(),
-        "rope_damping",
-        initial_equilibrium=False,
-        pretension=356.0e3,
-        interface_model=interface_model,
-    )
-    unit.values["mover_b.velocity"] = RING_SPEED
+    """:func:`riser_rope` with the rod's inputs ``rod`` (position, velocity, acceleration)."""
+    unit = riser_rope(interface_model)
     for name, value in rod.items():
         unit.values[f"mover_a.{name}"] = value
     return unit

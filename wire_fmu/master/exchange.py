@@ -186,13 +186,16 @@ class UnitExchange:
         if plan.idle:
             return
         held, values = self.held, []
+        ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
         for link in plan.links:
             if link.position:
                 value = link.history.points[-1][1]  # the unit advances it with the held velocity
             elif link.ramp:
-                start, slope = ramp(
-                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
-                )
+                ramps = {} if ramps is None else ramps
+                if link.key not in ramps:
+                    source = None if fresh is None else fresh.get(link.key)
+                    ramps[link.key] = ramp(link.history, t, h, link.scheme, source)
+                start, slope = ramps[link.key]
                 value = slope if link.ramp == "slope" else start
                 values.append(value)
                 held[link.target] = slope if link.ramp == "slope" else start + 0.5 * slope * h

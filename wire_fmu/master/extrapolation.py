@@ -186,6 +186,15 @@ def ramp(
         Its rate of change over the step, in the source's unit per second.
     """
     average = held_value(history, t, step, scheme, fresh)
+    latest = history.points[-1] if history.points else None
+    if scheme == "linear" and latest is not None and latest[0] == t:  # the common case
+        if fresh is not None:
+            slope = (fresh - latest[1]) / step
+            return average - 0.5 * slope * step, slope
+        if len(history.points) > 1 and t - history.points[-2][0] >= MIN_SPACING * step:
+            t0, y0 = history.points[-2]
+            slope = (latest[1] - y0) / (t - t0)
+            return average - 0.5 * slope * step, slope
     points = _polynomial(history, t, step, scheme, fresh)
     if len(points) < 2 or step <= 0.0:
         return average, 0.0

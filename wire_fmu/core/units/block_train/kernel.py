@@ -176,40 +176,36 @@ def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
 
 
 @jit
-def held_motion(t: float, held: np.ndarray, nd: int) -> tuple:
-    """The held inputs' motion at ``t`` (:meth:`BlockTrainModel.held_motion`).
+def held_motion(held: np.ndarray, port: int, mover: bool, nd: int, dt: float) -> tuple:
+    """A held port input's position and rate ``dt`` into the step (one port of
+    :meth:`BlockTrainModel.held_motion`, without an array).
 
     Parameters
     ----------
-    t : float
-        Time, s.
     held : numpy.ndarray
         The held inputs (the module docstring's index 11).
+    port : int
+        The line (0, 1) or the driven body (0 .. ``nd`` - 1).
+    mover : bool
+        Whether ``port`` is a driven body.
     nd : int
         Number of driven bodies.
+    dt : float
+        Time since the inputs hold, s.
 
     Returns
     -------
-    tuple of numpy.ndarray
-        Line rope positions (m) and rates (m/s), driven bodies' positions (m) and
-        velocities (m/s): each rate ramps with its acceleration from the step's start,
-        each position advances with the rate.
+    tuple of float
+        Its position (m) and rate (m/s): the rate ramps with its acceleration from the
+        step's start, the position advances with the rate.
     """
-    dt = t - held[0]
-    ramps = 1 + 2 * N_LINES + 2 * nd
-    line_s = np.empty(N_LINES)
-    line_rate = np.empty(N_LINES)
-    for i in range(N_LINES):
-        rate, acc = held[1 + N_LINES + i], held[ramps + i]
-        line_rate[i] = rate + acc * dt
-        line_s[i] = held[1 + i] + (rate + 0.5 * acc * dt) * dt
-    mover_y = np.empty(nd)
-    mover_v = np.empty(nd)
-    for j in range(nd):
-        rate, acc = held[1 + 2 * N_LINES + nd + j], held[ramps + N_LINES + j]
-        mover_v[j] = rate + acc * dt
-        mover_y[j] = held[1 + 2 * N_LINES + j] + (rate + 0.5 * acc * dt) * dt
-    return line_s, line_rate, mover_y, mover_v
+    if mover:
+        at, rate_at = 1 + 2 * N_LINES + port, 1 + 2 * N_LINES + nd + port
+        ramp_at = 1 + 2 * N_LINES + 2 * nd + N_LINES + port
+    else:
+        at, rate_at, ramp_at = 1 + port, 1 + N_LINES + port, 1 + 2 * N_LINES + 2 * nd + port
+    rate, acceleration = held[rate_at], held[ramp_at]
+    return held[at] + (rate + 0.5 * acceleration * dt) * dt, rate + acceleration * dt
 
 
 @jit
@@ -242,23 +238,21 @@ def evaluate(t: float, x: np.ndarray, data):
     n, nb, nd = sizes[0], sizes[1], sizes[2]
     ea, damping = rope[0], rope[1]
     n_spans = len0.size
-    line_s, line_rate, mover_y, mover_v = held_motion(t, held, nd)
+    dt = t - held[0]
     y = np.empty(nb + nd)
     ydot = np.empty(nb + nd)
     for j in range(nb):
         y[j] = x[j]
         ydot[j] = x[n + j]
     for j in range(nd):
-        y[nb + j] = mover_y[j]
-        ydot[nb + j] = mover_v[j]
+        y[nb + j], ydot[nb + j] = held_motion(held, j, True, nd, dt)
     flow_q = np.empty(n + N_LINES)
     flow_v = np.empty(n + N_LINES)
     for i in range(n):
         flow_q[i] = x[i]
         flow_v[i] = x[n + i]
     for i in range(N_LINES):
-        flow_q[n + i] = line_s[i]
-        flow_v[n + i] = line_rate[i]
+        flow_q[n + i], flow_v[n + i] = held_motion(held, i, False, nd, dt)
     if sizes[3]:
         big_l, jac, ok = span_geometry(y, data)
     else:
@@ -323,7 +317,7 @@ def evaluate(t: float, x: np.ndarray, data):
                 potential += 0.5 * elastic_force * depth[j]
                 loss += stiffness * depth[j] * x[n + j]
     line_force = generalised[n:]
-    power = -(line_force[0] * line_rate[0] + line_force[1] * line_rate[1])
+    power = -(line_force[0] * flow_v[n] + line_force[1] * flow_v[n + 1])
     for j in range(nd):
         power -= body_force[nb + j] * ydot[nb + j]
     return (
@@ -387,7 +381,13 @@ def rhs_parts(t: float, x: np.ndarray, data):
     flow, held = data[5], data[11]
     result = evaluate(t, x, data)
     tension, jac, on_unstretched = result[1], result[14], result[16]
-    _, line_rate, _, mover_v = held_motion(t, held, nd)
+    dt = t - held[0]
+    line_rate = np.empty(N_LINES)
+    for line in range(N_LINES):
+        line_rate[line] = held_motion(held, line, False, nd, dt)[1]
+    mover_v = np.empty(nd)
+    for j in range(nd):
+        mover_v[j] = held_motion(held, j, True, nd, dt)[1]
     span_power = np.empty(tension.size)
     for i in range(tension.size):
         p = 0.0

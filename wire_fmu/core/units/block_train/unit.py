@@ -65,8 +65,12 @@ _KINEMATIC_INPUTS = tuple(
     + [f"{p}.position" for p in MOVER_PORTS]
     + [f"{p}.velocity" for p in MOVER_PORTS]
 )
-_LINE_INPUTS = tuple((p, f"{p}.payout", f"{p}.payout_rate") for p in LINE_PORTS)
-_MOVER_INPUTS = tuple((p, f"{p}.position", f"{p}.velocity") for p in MOVER_PORTS)
+_LINE_INPUTS = tuple(
+    (p, f"{p}.payout", f"{p}.payout_rate", f"{p}.payout_acceleration") for p in LINE_PORTS
+)
+_MOVER_INPUTS = tuple(
+    (p, f"{p}.position", f"{p}.velocity", f"{p}.acceleration") for p in MOVER_PORTS
+)
 
 
 def _variables():
@@ -438,12 +442,12 @@ class BlockTrainUnit(Unit):
     def _inputs(self) -> BlockTrainInputs:
         v = self.values
         return BlockTrainInputs(
-            payout={p: float(v[name]) for p, name, _ in _LINE_INPUTS},
-            payout_rate={p: float(v[rate]) for p, _, rate in _LINE_INPUTS},
-            mover_position={p: float(v[name]) for p, name, _ in _MOVER_INPUTS},
-            mover_velocity={p: float(v[rate]) for p, _, rate in _MOVER_INPUTS},
-            payout_acceleration={p: float(v[f"{p}.payout_acceleration"]) for p in LINE_PORTS},
-            mover_acceleration={p: float(v[f"{p}.acceleration"]) for p in MOVER_PORTS},
+            payout={p: float(v[name]) for p, name, _, _ in _LINE_INPUTS},
+            payout_rate={p: float(v[rate]) for p, _, rate, _ in _LINE_INPUTS},
+            mover_position={p: float(v[name]) for p, name, _, _ in _MOVER_INPUTS},
+            mover_velocity={p: float(v[rate]) for p, _, rate, _ in _MOVER_INPUTS},
+            payout_acceleration={p: float(v[ramp]) for p, _, _, ramp in _LINE_INPUTS},
+            mover_acceleration={p: float(v[ramp]) for p, _, _, ramp in _MOVER_INPUTS},
         )
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
