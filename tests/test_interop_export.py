@@ -67,13 +67,50 @@ def test_exported_ssp_validates_against_the_ssp_1_0_schemas(ssp):
             assert (
                 schema_errors(archive.read(name), "ssp/SystemStructureParameterValues.xsd") == []
             ), name
-    # one copy of each FMU, however many units use it
+    # each unit's own FMU, configured with its parameters (two units of one model: two files)
     assert sorted(n for n in names if n.endswith(".fmu")) == [
-        "resources/CoupledMass.fmu",
-        "resources/Oscillator.fmu",
-        "resources/Signals_two_mass.fmu",
-        "resources/SpringDamper.fmu",
+        f"resources/{u}.fmu" for u in ("a", "b", "c", "d", "e", "signals")
     ]
+    sources = {c.get("name"): c.get("source") for c in _ssd(ssp).iter(f"{{{NS['ssd']}}}Component")}
+    assert sources == {u: f"resources/{u}.fmu" for u in ("a", "b", "c", "d", "e", "signals")}
+
+
+def test_each_units_fmu_starts_with_the_units_parameter_values(ssp, tmp_path):
+    """What FMPy's runner needs (it applies no binding and sets no String): the FMU's
+    own start values, in its model description and set by its facade, are the SSV's."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    with zipfile.ZipFile(ssp) as archive:
+        ssv = etree.fromstring(archive.read("resources/a.ssv"))
+        archive.extract("resources/a.fmu", tmp_path)
+    bound = {}
+    for parameter in ssv.iter(f"{{{NS['ssv']}}}Parameter"):
+        typed = parameter[0]
+        bound[parameter.get("name")] = (etree.QName(typed).localname, typed.get("value"))
+    assert bound["label"][0] == "String" and bound["mass"][0] == "Real"
+    fmu = tmp_path / "resources" / "a.fmu"
+    model = read_model_description(str(fmu))
+    starts = {v.name: v for v in model.modelVariables}
+    for name, (_, text) in bound.items():
+        assert starts[name].start == text, name
+    fmu_unzipped = extract(str(fmu))
+    slave = FMU2Slave(
+        guid=model.guid,
+        unzipDirectory=fmu_unzipped,
+        modelIdentifier=model.coSimulation.modelIdentifier,
+        instanceName="a",
+    )
+    slave.instantiate()
+    try:
+        for name, (kind, text) in bound.items():
+            ref = [starts[name].valueReference]
+            if kind == "Real":
+                assert slave.getReal(ref)[0] == float(text), name
+            elif kind == "String":
+                assert slave.getString(ref)[0].decode() == text, name
+    finally:
+        slave.freeInstance()
 
 
 def test_the_signals_fmu_is_built_beside_the_export_never_into_the_shared_fmu_folder(

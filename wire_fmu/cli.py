@@ -88,6 +88,16 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _coupling_list(text: str) -> tuple[str, ...]:
+    """Couplings of the accuracy study from the command line (see ``parse_couplings``)."""
+    from wire_fmu.study.plan import parse_couplings
+
+    try:
+        return parse_couplings(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _positive_float_number(text: str) -> float:
     """A finite number > 0 from the command line (no unit)."""
     try:
@@ -151,6 +161,15 @@ def _study_parser(sub) -> None:
                 default=None,
                 help="slices (default): every coupling with the scene's solvers and "
                 "every solver with the scene's coupling; product: all of them",
+            )
+            q.add_argument(
+                "--couplings",
+                type=_coupling_list,
+                default=None,
+                metavar="LIST",
+                help="couplings to compare besides the scene's own, joined by commas, or "
+                "all (default: held, interface, ramped, interface+ramped, synchronised, "
+                "interface+synchronised); those the scene's bonds cannot take are left out",
             )
         q.set_defaults(func=cmd_study)
 

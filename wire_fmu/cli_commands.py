@@ -444,7 +444,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed command line: ``study`` (``accuracy`` or ``effects``),
-        ``scene``, ``output``, ``quick``, ``grid``, ``fmu_dir``, ``repeats`` and
+        ``scene``, ``output``, ``quick``, ``grid``, ``couplings``, ``fmu_dir``, ``repeats`` and
         ``stop_time`` (s).
 
     Returns
@@ -461,6 +461,7 @@ def cmd_study(args: argparse.Namespace) -> int:
             out,
             quick=args.quick,
             grid=args.grid,
+            couplings=args.couplings,
             fmu_dir=args.fmu_dir,
             repeats=args.repeats,
             stop_time=args.stop_time,

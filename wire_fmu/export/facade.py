@@ -12,7 +12,9 @@ What the facade does at each FMI call
 -------------------------------------
 ``fmi2Instantiate``
     Checks that the imported ``wire_fmu`` is the bundled one
-    (:mod:`wire_fmu.export.guard`), creates the unit, registers its variables.
+    (:mod:`wire_fmu.export.guard`), creates the unit, registers its variables,
+    and sets the start values of an FMU configured for one unit
+    (:mod:`wire_fmu.export.start_values`).
 ``fmi2SetupExperiment``
     Remembers the start time.
 ``fmi2EnterInitializationMode``
@@ -62,6 +64,12 @@ from wire_fmu.core.framework.unit import Causality, Unit, Variability, Variable
 from wire_fmu.export.facade_calls import FacadeError, Phase, fmi_access, fmi_entry
 from wire_fmu.export.facade_state import STATE_FORMAT, FacadeState
 from wire_fmu.export.guard import check_core
+from wire_fmu.export.start_values import (
+    START_VALUES_FILE,
+    StartValuesError,
+    fits,
+    read_start_values,
+)
 
 __all__ = ["CoreFacade", "FacadeError", "Phase", "STATE_FORMAT"]
 
@@ -129,6 +137,8 @@ class CoreFacade(FacadeState, Fmi2Slave):
         for var in unit_class.variables():
             self._register(var)
         self._register_timing()
+        if self.resources is not None:
+            self._apply_start_values(unit_class)
 
     # -- construction -----------------------------------------------------------
     @classmethod
@@ -150,6 +160,35 @@ class CoreFacade(FacadeState, Fmi2Slave):
             # the Python logger reaches the master's process.
             logger.error("%s", exc)
             raise
+
+    def _apply_start_values(self, unit_class: type[Unit]) -> None:
+        """Set the values of the FMU's ``resources/start_values.json``, if it has one.
+
+        An FMU configured by :func:`~wire_fmu.export.start_values.write_configured_fmu`
+        carries a unit's parameter values as its start values; they are set here as a
+        host would set them before initialisation (a host may still set others).
+        """
+        try:
+            values = read_start_values(self.resources)
+        except StartValuesError as exc:
+            logger.error("%s %r: %s", unit_class.NAME, self.instance_name, exc)
+            raise
+        declared = {var.name: var for var in unit_class.variables()}
+        problems = []
+        for name, value in values.items():
+            var = declared.get(name)
+            if var is None or var.causality is Causality.output:
+                problems.append(f"{name!r} is not a parameter or input of {unit_class.NAME}")
+            elif not fits(var.type, value):
+                problems.append(f"{name!r} = {value!r}: expected a {var.type.__name__}")
+            else:
+                self.unit.values[name] = var.type(value)
+        if problems:
+            exc = StartValuesError(
+                f"{unit_class.NAME} {self.instance_name!r} {START_VALUES_FILE}", problems
+            )
+            logger.error("%s", exc)
+            raise exc
 
     def _register(self, var: Variable) -> None:
         scalar = _SCALAR[var.type](

@@ -9,15 +9,15 @@ is read from its source:
 * **No parameter bindings.** It applies none of the package's
   ``ssd:ParameterBinding`` elements; the only values it sets before
   initialisation are those of its ``parameter_set`` argument, named
-  ``<component>.<variable>``. :func:`fmpy_parameter_set` makes that set from
-  the package's own bindings.
+  ``<component>.<variable>``. Our packages need none: each unit's FMU starts
+  with the unit's values (:mod:`wire_fmu.export.start_values`).
+  :func:`fmpy_parameter_set` makes that set from the package's own bindings,
+  for a package whose bindings were edited after export.
 * **No String values.** Its ``set_value`` raises ``Exception("Unsupported
-  type: String")`` for a String variable, so a package with a String
-  parameter cannot be configured in it. Every unit of ours has one (its
-  ``effects``; a block train its ``reeving`` too): none of the shipped
-  scenes runs in FMPy's runner with its parameters. :func:`fmpy_parameter_set`
-  leaves out a String equal to the FMU's own start value and refuses a package
-  with any other, naming each.
+  type: String")`` for a String variable. In our packages a String parameter
+  (a unit's ``effects``, a block train's ``reeving``) reaches the unit as its
+  FMU's start value; :func:`fmpy_parameter_set` leaves out a String equal to
+  the FMU's start value and refuses any other, naming each.
 * **Booleans from text.** It sets a Boolean to ``value != 0.0``, which is
   true for the SSV text ``"false"``; the set made here gives 0.0 or 1.0.
 * **Inputs start at zero.** Every connector starts at 0.0 and the loop steps

@@ -3,7 +3,7 @@
 Layout of the package (a zip)::
 
     SystemStructure.ssd           the system: components, connectors, connections
-    resources/<Model>.fmu         each distinct FMU once (two units may share one)
+    resources/<unit>.fmu          each unit's FMU, its start values the unit's parameters
     resources/<unit>.ssv          each unit's parameter values (SSV 1.0)
 
 Mapping
@@ -17,6 +17,10 @@ Mapping
   ``reeving`` and the ``effects`` list of our units, are bound through one
   ``ssd:ParameterBinding`` per component to ``resources/<unit>.ssv``; Reals
   are written with ``repr`` so they round-trip bit for bit.
+* Each unit's FMU is its own copy configured with the same values as its start
+  values (:func:`~wire_fmu.export.start_values.write_configured_fmu`), so a tool
+  that applies no parameter binding or cannot set a String (FMPy's
+  ``simulate_ssp``) still runs the unit as the scene configured it.
 * A power bond's effort, flow and position are ordinary
   ``ssd:Connection`` elements (any tool can run them), each marked with an
   annotation of type ``org.wire-fmu.bond`` naming the bond, its kind
@@ -46,6 +50,7 @@ from __future__ import annotations
 
 import json
 import logging
+import tempfile
 import zipfile
 from datetime import UTC, datetime
 from pathlib import Path
@@ -53,10 +58,11 @@ from pathlib import Path
 from lxml import etree
 
 import wire_fmu
+from wire_fmu.export.start_values import write_configured_fmu
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
 from wire_fmu.master.scene import Scene
 
-from .plan import ExportPlan, PlannedUnit, archive_names, plan_export
+from .plan import ExportPlan, PlannedUnit, plan_export
 
 __all__ = [
     "NS",
@@ -223,17 +229,26 @@ def _default_experiment(root: etree._Element, plan: ExportPlan) -> None:
     _sub(algorithm, "osp", "FixedStepAlgorithm", baseStepSize=repr(float(plan.scene.run.step)))
 
 
-def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etree._Element:
+def component_files(plan: ExportPlan) -> dict[str, str]:
+    """File name in the package's ``resources/`` of each unit's FMU, by unit name.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        What to write.
+    """
+    return {unit.name: f"{unit.name}.fmu" for unit in plan.units}
+
+
+def ssd_tree(plan: ExportPlan) -> etree._Element:
     """The ``SystemStructure.ssd`` document of ``plan``.
 
     Parameters
     ----------
     plan : ExportPlan
         What to write.
-    fmu_names : dict, optional
-        File name in ``resources/`` of each FMU (default :func:`archive_names`).
     """
-    names = fmu_names or archive_names(plan.units)
+    names = component_files(plan)
     scene = plan.scene
     root = etree.Element(
         _q("ssd", "SystemStructureDescription"),
@@ -252,7 +267,7 @@ def ssd_tree(plan: ExportPlan, fmu_names: dict[Path, str] | None = None) -> etre
     fed = {(c.target.unit, c.target.variable) for c in plan.all_connections}
     for unit in plan.units:
         connected = {variable for name, variable in fed if name == unit.name}
-        _component(elements, unit, names[unit.fmu.resolve()], connected)
+        _component(elements, unit, names[unit.name], connected)
     _connections(system, plan)
     note = _annotation(system, SCENE_ANNOTATION)
     meta = dict(plan.metadata, signals=plan.signals)
@@ -312,12 +327,16 @@ def write_ssp(plan: ExportPlan, path: Path) -> Path:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    names = archive_names(plan.units)
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-        archive.writestr(SSD_NAME, _xml(ssd_tree(plan, names)))
-        for source, name in names.items():
-            archive.write(source, f"resources/{name}")
+    names = component_files(plan)
+    with (
+        tempfile.TemporaryDirectory(prefix="wire_fmu_ssp_") as tmp,
+        zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive,
+    ):
+        archive.writestr(SSD_NAME, _xml(ssd_tree(plan)))
         for unit in plan.units:
+            configured = Path(tmp) / names[unit.name]
+            write_configured_fmu(unit.fmu, unit.start_values, configured)
+            archive.write(configured, f"resources/{names[unit.name]}")
             if unit.start_values:
                 archive.writestr(f"resources/{unit.name}.ssv", _xml(ssv_tree(unit)))
     logger.info(

@@ -128,6 +128,7 @@ from .plan import (
     StudySettings,
     build_grid,
     configured_scene,
+    parse_couplings,
     solver_choices,
     study_scene,
 )
@@ -320,7 +321,12 @@ def _monolithic_runs(scene: Scene, settings: StudySettings) -> int:
 
 
 def run_accuracy_study(
-    scene: Scene | str | Path, output_dir: Path, *, grid: str | None = None, **options: Any
+    scene: Scene | str | Path,
+    output_dir: Path,
+    *,
+    grid: str | None = None,
+    couplings: Sequence[str] | None = None,
+    **options: Any,
 ) -> AccuracyStudy:
     """Run the accuracy study of ``scene`` and write its files into ``output_dir``.
 
@@ -334,6 +340,10 @@ def run_accuracy_study(
     grid : str, optional
         ``"slices"`` or ``"product"`` (see :func:`~wire_fmu.study.plan.build_grid`),
         instead of the plan's.
+    couplings : sequence of str, optional
+        Keys of :data:`~wire_fmu.study.plan.COUPLINGS` to compare besides the scene's
+        own, instead of the plan's (:data:`~wire_fmu.study.plan.DEFAULT_COUPLINGS`);
+        those the scene's bonds cannot take are left out.
     **options
         How the study runs, the fields of
         :class:`~wire_fmu.study.plan.StudyOptions`: ``quick`` (the reduced
@@ -358,6 +368,8 @@ def run_accuracy_study(
     )
     if settings.grid not in GRIDS:
         raise ValueError(f"grid must be one of {GRIDS}, got {settings.grid!r}")
+    if couplings is not None:
+        settings = replace(settings, couplings=parse_couplings(",".join(couplings)))
     base = study_scene(scene, settings)
     with tempfile.TemporaryDirectory(prefix="wire_fmu_study_") as tmp:
         structure = pinned(validate_scene(base, opts.fmu_dir), Path(tmp))

@@ -48,6 +48,7 @@ __all__ = [
     "GRIDS",
     "COUPLINGS",
     "DEFAULT_COUPLINGS",
+    "parse_couplings",
     "StudySettings",
     "study_settings",
     "with_stop_time",
@@ -115,6 +116,37 @@ DEFAULT_COUPLINGS = (
 )
 """The couplings a study compares unless told otherwise (those of :data:`COUPLINGS` with
 both ramps and synchronisation are left to an explicit choice)."""
+
+
+def parse_couplings(text: str) -> tuple[str, ...]:
+    """Couplings named on a command line: keys of :data:`COUPLINGS`, comma-separated, or ``all``.
+
+    Parameters
+    ----------
+    text : str
+        For example ``"held,ramped,interface+ramped"``.
+
+    Returns
+    -------
+    tuple of str
+        The keys, in the order given, each once.
+
+    Raises
+    ------
+    ValueError
+        Naming every unknown key at once, and the known ones.
+    """
+    if text.strip() == "all":
+        return tuple(COUPLINGS)
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in COUPLINGS]
+    if unknown or not names:
+        said = f"unknown {', '.join(repr(n) for n in unknown)}" if unknown else "none given"
+        raise ValueError(
+            f"couplings: {said}; give keys of {', '.join(COUPLINGS)} joined by commas, or all"
+        )
+    return tuple(dict.fromkeys(names))
+
 
 GRIDS = ("slices", "product")
 """``slices``: every coupling with the scene's own solvers, and every solver with the
