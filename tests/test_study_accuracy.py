@@ -23,10 +23,12 @@ from wire_fmu.study.accuracy_report import accuracy_markdown
 from wire_fmu.study.measures import RunRow, output_error
 from wire_fmu.study.orders import equal_error, observed_orders, theoretical_order
 from wire_fmu.study.plan import (
+    COUPLINGS,
     StudyError,
     build_grid,
     configured_scene,
     coupling_choices,
+    parse_couplings,
     study_scene,
     study_settings,
     with_stop_time,
@@ -319,6 +321,45 @@ def test_the_grid_adds_couplings_a_scene_can_use():
     configured = configured_scene(bonded, synchronised)
     assert configured.run.synchronise_events and not configured.run.interface_models
     assert coupling_choices(bonded, replace(settings, couplings=())) == ["held"]
+
+
+def test_couplings_named_on_the_command_line():
+    assert parse_couplings("ramped, held,ramped") == ("ramped", "held")
+    assert parse_couplings("all") == tuple(COUPLINGS)
+    with pytest.raises(ValueError) as caught:
+        parse_couplings("held,ramp,interface+sync")
+    text = str(caught.value)
+    assert "'ramp'" in text and "'interface+sync'" in text and "interface+ramped" in text
+    with pytest.raises(ValueError, match="none given"):
+        parse_couplings(" , ")
+
+
+def test_the_cli_refuses_an_unknown_coupling_as_a_usage_error(capsys):
+    from wire_fmu.cli import main
+
+    with pytest.raises(SystemExit) as caught:
+        main(["study", "accuracy", "drawworks", "--couplings", "held,bogus"])
+    assert caught.value.code == 2
+    assert "--couplings" in capsys.readouterr().err
+
+
+@pytest.mark.integration
+def test_the_study_compares_the_couplings_it_is_given(tmp_path):
+    """``couplings`` replaces the plan's: the scene's own coupling and those named, no more."""
+    scene = load_scene(WINCH_HOIST)
+    settings = replace(
+        study_settings(scene, quick=True),
+        steps=(0.02, 0.01),
+        stop_time=0.4,
+        algorithms=("gauss_seidel",),
+        extrapolations=("linear",),
+    )
+    study = run_accuracy_study(
+        scene, tmp_path, settings=settings, couplings=["synchronised"], progress=False
+    )
+    assert study.settings.couplings == ("synchronised",)
+    cosim = {r.family for r in study.rows if r.algorithm != "monolithic"}
+    assert len(cosim) == 2 and sum(f.endswith(" / synchronised") for f in cosim) == 1
 
 
 @pytest.mark.integration
