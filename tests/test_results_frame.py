@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 
 from wire_fmu.master.column_units import DIMENSIONLESS, TEXT, UNDECLARED, variable_unit
+from wire_fmu.master.observers import LEDGER_TERMS
 from wire_fmu.master.plots import read_results
 from wire_fmu.master.run import (
     IncompleteResultsWarning,
@@ -153,6 +154,20 @@ def test_the_ledger_sum_is_in_the_unit_of_the_ledgers_it_sums(outcome, meta):
     assert (frame["energy.units_balance"] - total).abs().max() <= 1e-12 * max(
         1.0, total.abs().max()
     )
+
+
+def test_every_units_whole_ledger_is_recorded_though_the_scene_names_few_outputs(outcome):
+    """The drawworks names a handful of outputs; each unit's ledger terms come with its
+    residual (what the report's energy books show), and they close it."""
+    assert outcome.scene.outputs is not None
+    frame = outcome.frame()
+    for unit in ("rope", "winch"):
+        terms = [f"{unit}.{t}" for t in LEDGER_TERMS]
+        assert set(terms) <= set(frame.columns), unit
+        stored, dissipated, external, balance = (frame[t] for t in terms)
+        books = stored - stored.iloc[0] + dissipated - external
+        scale = max(1.0, external.abs().max(), stored.abs().max())
+        assert ((books - balance) - (books - balance).iloc[0]).abs().max() <= 1e-9 * scale
 
 
 # ========================================================== the frame: the file's numbers, units

@@ -52,6 +52,7 @@ __all__ = [
     "summary_rows",
     "BOND_CHANNELS",
     "LEDGER_CHANNEL",
+    "LEDGER_TERMS",
 ]
 
 logger = logging.getLogger(__name__)
@@ -59,6 +60,11 @@ logger = logging.getLogger(__name__)
 BOND_CHANNELS = ("energy_residual", "energy_carried", "power")
 """Per bond ``bond.<name>.<channel>``: energy its coupling created (J), energy it carried (J),
 power it transmitted (W)."""
+
+LEDGER_TERMS = ("stored_energy", "dissipated_energy", "external_work", "energy_balance")
+"""A unit's energy ledger, its outputs in J: recorded for every unit that keeps one
+(``energy_balance`` = change of ``stored_energy`` + ``dissipated_energy`` −
+``external_work``)."""
 
 LEDGER_CHANNEL = "energy.units_balance"
 """Sum of the units' ``energy_balance`` outputs, J (each unit's own ledger)."""
@@ -213,9 +219,11 @@ class CsvRecorder:
             for ref in plot.variables:
                 if ref.variable not in plan[ref.unit]:
                     plan[ref.unit].append(ref.variable)
-        for name, slave in sim.slaves.items():
-            if "energy_balance" in slave.variables and "energy_balance" not in plan[name]:
-                plan[name].append("energy_balance")
+        for name, slave in sim.slaves.items():  # every unit's whole energy ledger, if it keeps one
+            if "energy_balance" in slave.variables:
+                for term in LEDGER_TERMS:
+                    if term in slave.variables and term not in plan[name]:
+                        plan[name].append(term)
         return plan
 
     def _column_units(self, sim: Simulation) -> dict[str, str]:

@@ -1,8 +1,8 @@
 """What a monolithic run records, and how: a normal run's columns that one ODE can give honestly.
 
 A co-simulated run records the scene's outputs (every unit's outputs when it
-names none), its plotted variables, each unit's ``energy_balance``, three
-channels per bond and the sum of the units' ledgers
+names none), its plotted variables, each unit's energy ledger (``energy_balance``
+and its terms), three channels per bond and the sum of the units' ledgers
 (:class:`~wire_fmu.master.observers.CsvRecorder`). A monolithic run records
 the same columns, under the same names and in the same units (read from the
 units' model descriptions), except those that have no counterpart in one ODE;
@@ -52,7 +52,7 @@ from wire_fmu.master.column_units import (
     ledger_unit_problems,
     variable_unit,
 )
-from wire_fmu.master.observers import BOND_CHANNELS, FLUSH_EVERY, LEDGER_CHANNEL
+from wire_fmu.master.observers import BOND_CHANNELS, FLUSH_EVERY, LEDGER_CHANNEL, LEDGER_TERMS
 from wire_fmu.master.run_record import scene_record
 from wire_fmu.master.run_result import RunResult
 from wire_fmu.master.scene import Scene, VarRef
@@ -183,9 +183,12 @@ def _planned(scene: Scene, structure: Structure) -> dict[str, list[str]]:
         for ref in plot.variables:
             if ref.variable not in plan[ref.unit]:
                 plan[ref.unit].append(ref.variable)
-    for name in scene.units:
-        if structure.variable(VarRef(name, LEDGER)) is not None and LEDGER not in plan[name]:
-            plan[name].append(LEDGER)
+    for name in scene.units:  # every unit's whole energy ledger, if it keeps one
+        if structure.variable(VarRef(name, LEDGER)) is None:
+            continue
+        for term in LEDGER_TERMS:
+            if structure.variable(VarRef(name, term)) is not None and term not in plan[name]:
+                plan[name].append(term)
     return plan
 
 

@@ -21,6 +21,7 @@ from typing import Any
 
 import wire_fmu
 from wire_fmu.core.errors import WireFmuError
+from wire_fmu.master.observers import LEDGER_TERMS
 from wire_fmu.master.plot_units import display_unit
 from wire_fmu.master.plots import plot_requests, plot_results, read_metadata, read_results
 from wire_fmu.master.results_frame import CSV_NAME, METADATA_NAME, ResultsError
@@ -43,8 +44,6 @@ _RUN_UNITS = {
     "energy_tolerance": "J",
 }
 """Units of the run settings that have one (the others are pure numbers, names or flags)."""
-
-_LEDGER_TERMS = ("stored_energy", "dissipated_energy", "external_work", "energy_balance")
 
 
 def write_report(
@@ -286,7 +285,7 @@ def _energy(meta: dict[str, Any], result: dict[str, Any], data) -> str:
             "<h3>Units' ledgers at the end</h3>",
             "<p>Each unit's own books: stored change + dissipated − external work = "
             "residual (zero for exact bookkeeping).</p>",
-            table(("unit", *(t.replace("_", " ") for t in _LEDGER_TERMS)), rows, (1, 2, 3, 4)),
+            table(("unit", *(t.replace("_", " ") for t in LEDGER_TERMS)), rows, (1, 2, 3, 4)),
         ]
     return "".join(parts) or _none("no energy channels were recorded")
 
@@ -297,7 +296,7 @@ def _ledgers(meta: dict[str, Any], data) -> list[tuple]:
     rows = []
     for unit in meta.get("units") or {}:
         cells = []
-        for term in _LEDGER_TERMS:
+        for term in LEDGER_TERMS:
             column = data.get(f"{unit}.{term}")
             cells.append(_joules(float(column[-1])) if column is not None else "-")
         if any(c != "-" for c in cells):
