@@ -157,8 +157,12 @@ def _command_seconds(scene: str, env: dict[str, str], out: Path) -> float:
     return time.perf_counter() - start
 
 
-def start_times(scene: str, work: Path) -> dict[str, float]:
+def start_times(scene: str, work: Path, repeats: int = 3) -> dict[str, float]:
     """Start of ``wire-fmu run``: Python kernel, compiled cold and warm (s).
+
+    The Python kernel's and the warm start are the median of ``repeats`` commands, taken
+    in alternation (so that a busy moment of the machine does not fall on one of them);
+    the cold start is one command on a fresh compiled-code cache.
 
     Parameters
     ----------
@@ -166,13 +170,18 @@ def start_times(scene: str, work: Path) -> dict[str, float]:
         A shipped scene.
     work : Path
         Folder for results and the fresh compiled-code cache.
+    repeats : int
+        Commands per warm figure.
     """
     cache = work / "cold-cache"
-    return {
-        "python": _command_seconds(scene, _environment("python"), work / "start-python"),
-        "cold": _command_seconds(scene, _environment("compiled", cache), work / "start-cold"),
-        "warm": _command_seconds(scene, _environment("compiled", cache), work / "start-warm"),
-    }
+    cold = _command_seconds(scene, _environment("compiled", cache), work / "start-cold")
+    python, warm = [], []
+    for i in range(max(1, repeats)):
+        python.append(_command_seconds(scene, _environment("python"), work / f"start-python{i}"))
+        warm.append(
+            _command_seconds(scene, _environment("compiled", cache), work / f"start-warm{i}")
+        )
+    return {"python": statistics.median(python), "cold": cold, "warm": statistics.median(warm)}
 
 
 def table(figures: list[SceneFigures], starts: dict[str, float], scene: str) -> str:
@@ -198,9 +207,12 @@ def table(figures: list[SceneFigures], starts: dict[str, float], scene: str) -> 
             f"| {f.ratio:.1f} | {f.real_time_factor(f.python_s):.1f} "
             f"| {f.real_time_factor(f.compiled_s):.1f} |"
         )
+    if not figures:  # --start-only
+        lines = []
     lines += [
         "",
-        f"Start of `wire-fmu run {scene}` (one macro step, whole command): Python kernel "
+        f"Start of `wire-fmu run {scene}` (one macro step, whole command; median of the "
+        "warm runs): Python kernel "
         f"{starts['python']:.2f} s, compiled cold {starts['cold']:.2f} s, "
         f"compiled warm {starts['warm']:.2f} s.",
     ]
@@ -220,6 +232,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=3, help="runs per kernel (median)")
     parser.add_argument("--scenes", nargs="*", default=list(SCENES), help="scenes to run")
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
+    parser.add_argument(
+        "--start-only", action="store_true", help="only the start of the first scene's command"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     stop = "own" if args.stop_time is None else str(args.stop_time)
@@ -227,10 +242,10 @@ def main(argv: list[str] | None = None) -> int:
         work = Path(tmp)
         _run_once(args.scenes[0], "compiled", "0.01", work / "build")  # builds the FMUs
         figures = []
-        for scene in args.scenes:
+        for scene in args.scenes if not args.start_only else ():
             figures.append(measure_scene(scene, stop, args.repeats, work))
             logger.info("%s: %.1fx", scene, figures[-1].ratio)
-        starts = start_times(args.scenes[0], work)
+        starts = start_times(args.scenes[0], work, args.repeats)
     text = table(figures, starts, args.scenes[0])
     logger.info("\n%s", text)
     if args.out:

@@ -329,7 +329,12 @@ def _fit_limits(fig, ax, lower: np.ndarray, upper: np.ndarray) -> None:
     """Limits that show the drawing and every label, with equal aspect filling the axes."""
     ax.update_datalim([tuple(lower), tuple(upper)])
     ax.autoscale_view()
-    for _ in range(4):  # text sizes in data units change with the limits
+    limits = None
+    for _ in range(4):  # text sizes in data units change with the limits: until they settle
+        now = (*ax.get_xlim(), *ax.get_ylim())
+        if limits is not None and np.allclose(now, limits, rtol=1e-6, atol=0.0):
+            break
+        limits = now
         fig.draw_without_rendering()
         to_data = ax.transData.inverted()
         renderer = fig.canvas.get_renderer()
