@@ -127,13 +127,14 @@ def test_the_facade_sets_the_values_as_a_host_would_before_initialisation(tmp_pa
 
 
 def test_the_facade_refuses_a_start_values_file_naming_every_problem(tmp_path, caplog):
-    values = {"nope": 1.0, "velocity": 0.0, "label": 2}
+    values = {"nope": 1.0, "velocity": 0.0, "label": 2, "x0": float("nan")}
     with caplog.at_level(logging.ERROR), pytest.raises(StartValuesError) as caught:
         Oscillator(instance_name="osc", resources=str(_resources(tmp_path, values)))
     text = str(caught.value)
     assert "Oscillator 'osc'" in text and START_VALUES_FILE in text
-    assert len(caught.value.problems) == 3
+    assert len(caught.value.problems) == 4
     assert "'nope'" in text and "'velocity'" in text and "expected a str" in text
+    assert "'x0' = nan: must be finite" in text
     assert any("'nope'" in r.getMessage() for r in caplog.records)
 
 

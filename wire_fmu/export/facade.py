@@ -182,7 +182,10 @@ class CoreFacade(FacadeState, Fmi2Slave):
             elif not fits(var.type, value):
                 problems.append(f"{name!r} = {value!r}: expected a {var.type.__name__}")
             else:
-                self.unit.values[name] = var.type(value)
+                try:  # as a host's set: the same checks
+                    self._set_value(var, value)
+                except FacadeError as exc:
+                    problems.append(str(exc))
         if problems:
             exc = StartValuesError(
                 f"{unit_class.NAME} {self.instance_name!r} {START_VALUES_FILE}", problems
