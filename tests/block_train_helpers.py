@@ -85,3 +85,30 @@ def fall_scene(**extra):
     }
     data.update(extra)
     return parse_scene(data, base_dir=Path("."))
+
+
+def long_form_rope_data(bond: dict | None = None, **extra) -> dict:
+    """A winch ``w`` and a block train ``r`` on one rope bond written out long-hand (no
+    interface model offered), as plain scene data.
+
+    Parameters
+    ----------
+    bond : dict, optional
+        More keys of the bond (e.g. ``ramp``).
+    **extra
+        More top-level keys of the scene (``run``, ``study``, ...).
+    """
+    return {
+        "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
+        "bonds": [
+            {
+                "name": "rope",
+                "kind": "rope",
+                "effort": "r.line_a.tension -> w.rope.tension",
+                "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
+                "position": "w.rope.payout -> r.line_a.payout",
+                **(bond or {}),
+            }
+        ],
+        **extra,
+    }

@@ -16,10 +16,9 @@ from xml.etree import ElementTree as ET
 
 import pytest
 
+from wire_fmu.export.fmu_archive import FACADE_FILE, MODEL_DESCRIPTION
 from wire_fmu.export.guard import imported_core
 from wire_fmu.export.start_values import (
-    FACADE_FILE,
-    MODEL_DESCRIPTION,
     START_VALUES_FILE,
     StartValuesError,
     read_start_values,

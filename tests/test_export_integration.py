@@ -26,7 +26,8 @@ from fmpy.validation import validate_fmu  # noqa: E402
 from wire_fmu_test_units import OscillatorUnit, oscillator_position  # noqa: E402
 
 from wire_fmu.export.binary import platform_folder  # noqa: E402
-from wire_fmu.export.builder import FACADE_FILE, build_fmu  # noqa: E402
+from wire_fmu.export.builder import build_fmu  # noqa: E402
+from wire_fmu.export.fmu_archive import FACADE_FILE  # noqa: E402
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo, imported_core  # noqa: E402
 
 pytestmark = pytest.mark.integration

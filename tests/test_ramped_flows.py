@@ -36,6 +36,7 @@ from wire_fmu.study.accuracy import run_accuracy_study
 from wire_fmu.study.plan import load_study_scene, study_settings
 
 from . import test_interface_links as links_helpers
+from .block_train_helpers import long_form_rope_data
 from .facade_checks import load_facade_class
 from .test_block_train_interface import RING_SPEED, riser_rope
 from .test_kernels import assert_tables_agree
@@ -303,20 +304,7 @@ def test_ssp_names_the_ramp_without_connecting_it_and_reads_it_back(tmp_path):
 
 
 def _long_form(ramp: str, **run) -> dict:
-    return {
-        "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
-        "run": run,
-        "bonds": [
-            {
-                "name": "rope",
-                "kind": "rope",
-                "effort": "r.line_a.tension -> w.rope.tension",
-                "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
-                "position": "w.rope.payout -> r.line_a.payout",
-                "ramp": ramp,
-            }
-        ],
-    }
+    return long_form_rope_data({"ramp": ramp}, run=run)
 
 
 def test_a_long_form_bond_names_its_ramp_from_the_flows_source():

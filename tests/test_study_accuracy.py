@@ -40,6 +40,7 @@ from .block_train_helpers import (
     FALL_LENGTH,
     FALL_MASS,
     FALL_PRETENSION,
+    long_form_rope_data,
 )
 from .block_train_helpers import fall_scene as released_fall
 
@@ -184,21 +185,7 @@ def test_theory_of_held_efforts_signals_and_bonded_flows():
     scene = load_scene(COUPLED_FALLS)
     assert [theoretical_order(scene, e) for e in ("constant", "linear", "quadratic")] == [1, 2, 2]
     assert theoretical_order(fall_scene(), "constant") is None  # nothing held
-    bonded = parse_scene(
-        {
-            "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
-            "bonds": [
-                {
-                    "name": "rope",
-                    "kind": "rope",
-                    "effort": "r.line_a.tension -> w.rope.tension",
-                    "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
-                    "position": "w.rope.payout -> r.line_a.payout",
-                }
-            ],
-        },
-        base_dir=Path("."),
-    )
+    bonded = parse_scene(long_form_rope_data(), base_dir=Path("."))
     assert theoretical_order(bonded, "constant") == 1  # the held tension
     # the same bond with its effort not held (marked as exact like a position): only the flow
     only_flow = replace(
@@ -292,20 +279,7 @@ def test_the_grid_adds_couplings_a_scene_can_use():
     """Event synchronisation for any scene; interface models only across a bond that offers
     them (a bond written out long-hand offers none)."""
     bonded = parse_scene(
-        {
-            "units": {"w": {"fmu": "Winch"}, "r": {"fmu": "BlockTrain"}},
-            "bonds": [
-                {
-                    "name": "rope",
-                    "kind": "rope",
-                    "effort": "r.line_a.tension -> w.rope.tension",
-                    "flow": "w.rope.payout_rate -> r.line_a.payout_rate",
-                    "position": "w.rope.payout -> r.line_a.payout",
-                }
-            ],
-            "study": {"key_outputs": ["r.line_a.tension"]},
-        },
-        base_dir=Path("."),
+        long_form_rope_data(study={"key_outputs": ["r.line_a.tension"]}), base_dir=Path(".")
     )
     settings = replace(
         study_settings(bonded), steps=(0.02, 0.01), solvers=(), extrapolations=("linear",)

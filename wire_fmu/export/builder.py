@@ -21,7 +21,7 @@ import shutil
 import sys
 import tempfile
 import zipfile
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,17 +37,13 @@ from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.unit import Unit
 from wire_fmu.export.binary import compiled_binary, platform_folder
 from wire_fmu.export.facade import CoreFacade
+from wire_fmu.export.fmu_archive import FACADE_FILE, MODEL_DESCRIPTION, rewrite_zip
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo, imported_core
 from wire_fmu.export.model_description import check_units, patch_model_description
 
 __all__ = ["BuildError", "build_fmu", "find_facade_class", "unique_module_name"]
 
 logger = logging.getLogger(__name__)
-
-MODEL_DESCRIPTION = "modelDescription.xml"
-
-FACADE_FILE = "resources/wire_fmu_facade.txt"
-"""What the FMU binary instantiates: module, class and GUID, one per line."""
 
 
 class BuildError(ConfigurationError):
@@ -199,18 +195,6 @@ def _write_build_info(staging: _Staging, facade: type[CoreFacade]) -> Path:
     return path
 
 
-def _rewrite_zip(archive: Path, drop: Callable[[str], bool], add: dict[str, bytes]) -> None:
-    """Rewrite ``archive`` without the entries ``drop`` selects, with ``add`` added."""
-    rewritten = archive.with_suffix(".tmp")
-    with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
-        for item in src.infolist():
-            if not drop(item.filename) and item.filename not in add:
-                dst.writestr(item, src.read(item.filename), zipfile.ZIP_DEFLATED)
-        for name, data in add.items():
-            dst.writestr(name, data, zipfile.ZIP_DEFLATED)
-    rewritten.replace(archive)
-
-
 def _finish(fmu: Path, facade: type[CoreFacade], module: str) -> None:
     """Our model description, our binary in place of pythonfmu's, the facade file."""
     with zipfile.ZipFile(fmu) as archive:
@@ -222,7 +206,7 @@ def _finish(fmu: Path, facade: type[CoreFacade], module: str) -> None:
     folder, suffix = platform_folder()
     binary = compiled_binary(native_cache()).read_bytes()
     facade_file = f"{module}\n{facade.__name__}\n{root.get('guid')}\n"
-    _rewrite_zip(
+    rewrite_zip(
         fmu,
         drop=lambda name: name.startswith("binaries/") or name == "resources/slavemodule.txt",
         add={

@@ -29,9 +29,9 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
+from wire_fmu.export.fmu_archive import FACADE_FILE, MODEL_DESCRIPTION, rewrite_zip
+
 __all__ = [
-    "FACADE_FILE",
-    "MODEL_DESCRIPTION",
     "START_VALUES_FILE",
     "StartValuesError",
     "fits",
@@ -41,9 +41,6 @@ __all__ = [
 
 START_VALUES_FILE = "start_values.json"
 """File in an FMU's ``resources/`` whose values the facade applies at instantiation."""
-MODEL_DESCRIPTION = "modelDescription.xml"
-FACADE_FILE = "resources/wire_fmu_facade.txt"
-"""``module``, ``class`` and ``guid`` lines the FMU binary reads (see the builder)."""
 
 _TYPES = {"Real": float, "Integer": int, "Boolean": bool, "String": str}
 
@@ -191,17 +188,15 @@ def write_configured_fmu(fmu: str | Path, values: Mapping[str, Any], out: str | 
     with zipfile.ZipFile(fmu) as src:
         xml, guid = _patched_description(src.read(MODEL_DESCRIPTION), plain, f"FMU {fmu.name}")
         module, cls, _ = src.read(FACADE_FILE).decode().splitlines()[:3]
-        replaced = {
+    shutil.copyfile(fmu, out)
+    rewrite_zip(
+        out,
+        {
             MODEL_DESCRIPTION: xml,
             FACADE_FILE: f"{module}\n{cls}\n{guid}\n".encode(),
             f"resources/{START_VALUES_FILE}": json.dumps(plain, indent=1).encode(),
-        }
-        with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
-            for item in src.infolist():
-                if item.filename not in replaced:
-                    dst.writestr(item, src.read(item.filename))
-            for name, data in replaced.items():
-                dst.writestr(name, data)
+        },
+    )
     return out
 
 
