@@ -65,7 +65,9 @@ class UnitExchange:
             if reals:
                 refs += [v.valueReference for v in variables]
             evented = name in self.events.units
-            self._inputs[name] = InputPlan(links, driven, refs, reals, evented)
+            self._inputs[name] = InputPlan(
+                links, driven, refs, reals, evented, write=slave.writer(refs)
+            )
             sources = self.source_vrs.get(name, [])
             mode = MODE_OUTPUT if name in self.mode_counts else None
             self._reads[name] = (
@@ -217,13 +219,14 @@ class UnitExchange:
             else:  # checked as a set by name would, then sent as floats
                 slave.typed_values(dict(zip(plan.driven, driven, strict=True)))
                 values += [float(v) for v in driven]
-        refs, others = plan.refs, None
-        if by_name is not None:  # as the events' values override the drivers'
-            by_name.update(self.events.values(unit))
-        elif plan.evented:
+        others = None
+        if by_name is None and plan.evented:  # the Reals the events set join the batch
             refs, event_values, others = plan.event_inputs(slave, self.events)
-            values += event_values
-        slave.set_reals(refs, values)
+            slave.set_reals(refs, values + event_values)
+        else:
+            plan.write(values)
+            if by_name is not None:  # as the events' values override the drivers'
+                by_name.update(self.events.values(unit))
         if by_name:
             slave.set_many(by_name)
         if others:

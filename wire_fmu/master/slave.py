@@ -25,7 +25,7 @@ import logging
 import os
 import time
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,6 +57,8 @@ _GETTERS = {kind: f"get{kind}" for kind in ("Real", "Integer", "Boolean", "Strin
 _C_TYPES = {"Real": fmi2Real, "Integer": fmi2Integer}
 """FMI types read every step into C arrays made once per list of value references."""
 _clock = time.perf_counter
+_HOT_FUNCTIONS = ("fmi2SetReal", "fmi2GetReal", "fmi2GetInteger", "fmi2DoStep")
+"""The C functions every macro step calls, taken from fmpy once per instantiation."""
 _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
 
@@ -115,8 +117,8 @@ class Slave(NamedValues):
         self.seconds: dict[str, float] = defaultdict(float)
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
-        self._c_arrays: dict[tuple[str, tuple[int, ...]], tuple[Any, Any, int]] = {}
-        self._natives: dict[str, Any] = {}
+        self._readers: dict[tuple[str, tuple[int, ...]], Callable[..., Any]] = {}
+        self._hot: _HotCalls | None = None
         self._fatal = False
         self._unzipdir: str | None = None
 
@@ -177,7 +179,7 @@ class Slave(NamedValues):
             unzipdir = self._unzipdir
         cwd = os.getcwd()
         try:
-            self._natives.clear()
+            self._hot = None
             self._fmu = FMU2Slave(
                 guid=md.guid,
                 unzipDirectory=unzipdir,
@@ -185,6 +187,7 @@ class Slave(NamedValues):
                 instanceName=self.name,
             )
             self._call("instantiate", callbacks=_callbacks(self.messages), loggingOn=True)
+            self._hot = _HotCalls.of(self._fmu)
         except BaseException:
             try:  # fmpy leaves the working directory in the binary's folder if loading fails
                 os.chdir(cwd)
@@ -232,8 +235,7 @@ class Slave(NamedValues):
         fmu = self._fmu
         if self._fatal:  # FMI 2.0: after fmi2Fatal no further call is allowed
             _KEEP_ALIVE.append(fmu)
-            self._fmu = None
-            self._natives.clear()
+            self._fmu, self._hot = None, None
             self._remove_unzipdir()
             return
         for name, call in (
@@ -245,11 +247,92 @@ class Slave(NamedValues):
             except Exception as exc:  # noqa: BLE001 - cleaning up, report and go on
                 logger.debug("%s: %s failed during cleanup: %s", self.name, name, exc)
         _KEEP_ALIVE.append(fmu)  # keep the library (and its handle) alive
-        self._fmu = None
-        self._natives.clear()
+        self._fmu, self._hot = None, None
         self._remove_unzipdir()  # the loaded library stays mapped; its files can go
 
     # -- values ------------------------------------------------------------------
+    def reader(self, kind: str, refs: Sequence[int]) -> Callable[[], list[Any]]:
+        """A get of ``refs`` made ready once, for a read the master makes every macro step.
+
+        The value references and the answer's C array are made here; each call
+        is then the FMU's C function, its status checked, counted and timed as
+        ``get{kind}`` (see :meth:`get_typed`, which keeps one per list of references).
+
+        Parameters
+        ----------
+        kind : str
+            The variables' FMI type: ``"Real"``, ``"Integer"``, ``"Boolean"`` or
+            ``"String"`` (the last two through fmpy's own getters).
+        refs : sequence of int
+            Value references (see :meth:`vr`).
+
+        Returns
+        -------
+        callable
+            ``read()``: a value for each reference, in the variable's unit (a String
+            as bytes), as a new list.
+        """
+        refs = tuple(refs)
+        fn, ctype = _GETTERS.get(kind) or f"get{kind}", _C_TYPES.get(kind)
+        if not refs:
+            return list
+        if ctype is None:
+            return lambda: self._call(fn, list(refs))
+        n, native = len(refs), f"fmi2Get{kind}"
+        vrs, values = (fmi2ValueReference * n)(*refs), (ctype * n)()
+        seconds, calls = self.seconds, self.calls
+
+        def read() -> list[Any]:
+            hot = self._hot
+            if hot is None:  # not instantiated (raises), or an fmpy without C functions
+                return self._call(fn, list(refs))
+            start = _clock()
+            status = hot.functions[native](hot.component, vrs, n, values)
+            seconds[fn] += _clock() - start
+            calls[fn] += 1
+            if status > 1:  # worse than fmi2Warning
+                raise self._failure(fn, status)
+            return list(values)
+
+        return read
+
+    def writer(self, refs: Sequence[int]) -> Callable[[Sequence[float]], None]:
+        """A set of the Reals ``refs`` made ready once, for the master's set every macro step.
+
+        Parameters
+        ----------
+        refs : sequence of int
+            Value references of Real variables (see :meth:`vr`).
+
+        Returns
+        -------
+        callable
+            ``write(values)``: sets a value (in the variable's unit) for each
+            reference; a list of another length raises ValueError. Counted and
+            timed as ``setReal``.
+        """
+        refs = tuple(refs)
+        n = len(refs)
+        if not n:
+            return lambda values: None
+        vrs, array = (fmi2ValueReference * n)(*refs), (fmi2Real * n)()
+        seconds, calls = self.seconds, self.calls
+
+        def write(values: Sequence[float]) -> None:
+            hot = self._hot
+            if hot is None:  # not instantiated (raises), or an fmpy without C functions
+                self._call("setReal", list(refs), _listed(values))
+                return
+            array[:] = values  # the FMU copies them during the call
+            start = _clock()
+            status = hot.functions["fmi2SetReal"](hot.component, vrs, n, array)
+            seconds["setReal"] += _clock() - start
+            calls["setReal"] += 1
+            if status > 1:
+                raise self._failure("setReal", status)
+
+        return write
+
     def get_typed(self, kind: str, refs: Sequence[int]) -> list[Any]:
         """Values of variables of one FMI type by value reference, in one call.
 
@@ -266,22 +349,14 @@ class Slave(NamedValues):
         list of object
             A value for each, in the variable's unit (a String as bytes).
         """
-        if not refs:
-            return []
-        fmu, ctype = self._fmu, _C_TYPES.get(kind)
-        if fmu is None or ctype is None:
-            return self._call(_GETTERS.get(kind) or f"get{kind}", _listed(refs))
         key = (kind, refs if type(refs) is tuple else tuple(refs))
-        arrays = self._c_arrays.get(key)
-        if arrays is None:  # the references and the answer's place, made once
-            n = len(refs)
-            arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), (ctype * n)(), n)
-        vrs, values, n = arrays
-        self._invoke(_GETTERS[kind], self._native(f"fmi2Get{kind}"), fmu.component, vrs, n, values)
-        return list(values)
+        read = self._readers.get(key)
+        if read is None:
+            read = self._readers[key] = self.reader(kind, key[1])
+        return read()
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
-        """Fast path: set Reals by value reference.
+        """Set Reals by value reference, in one call.
 
         Parameters
         ----------
@@ -290,20 +365,11 @@ class Slave(NamedValues):
         values : sequence of float
             A value for each, in the variable's unit.
         """
-        fmu = self._fmu
-        if not refs or fmu is None:
-            if refs:
-                self._call("setReal", _listed(refs), _listed(values))
-            return
-        key = ("Real", refs if type(refs) is tuple else tuple(refs))
-        arrays = self._c_arrays.get(key)
-        if arrays is None:
-            n = len(refs)
-            arrays = self._c_arrays[key] = ((fmi2ValueReference * n)(*refs), None, n)
-        vrs, _, n = arrays
-        self._invoke(
-            "setReal", self._native("fmi2SetReal"), fmu.component, vrs, n, (fmi2Real * n)(*values)
-        )
+        key = ("setReal", refs if type(refs) is tuple else tuple(refs))
+        write = self._readers.get(key)
+        if write is None:
+            write = self._readers[key] = self.writer(key[1])
+        write(values)
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:
         """Fast path: get Reals by value reference.
@@ -339,24 +405,38 @@ class Slave(NamedValues):
             On fmi2Error or fmi2Fatal.
         """
         self.messages.kept.clear()
-        fmu = self._fmu
-        if fmu is None:
-            raise UnitFailedError(f"unit {self.name!r} is not instantiated", self.name)
-        try:  # currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint
-            self._invoke("doStep", self._native("fmi2DoStep"), fmu.component, t, h, 1)
+        hot = self._hot
+        if hot is None:
+            self._step_through_fmpy(t, h)
+            return
+        start = _clock()  # currentCommunicationPoint, communicationStepSize, noSetFMUState...
+        status = hot.functions["fmi2DoStep"](hot.component, t, h, 1)
+        self.seconds["doStep"] += _clock() - start
+        self.calls["doStep"] += 1
+        if status > 1:
+            raise self._step_failure(t, h, status)
+
+    def _step_through_fmpy(self, t: float, h: float) -> None:
+        """:meth:`do_step` by fmpy's wrapper (not instantiated: raises; or no C functions)."""
+        try:
+            self._call("doStep", t, h, 1)
         except FMICallException as exc:
-            self._fatal = self._fatal or exc.status == 4
-            said = "; ".join(self.messages.kept[-3:]) or "no message"
-            if exc.status == 2:
-                raise StepRefusedError(
-                    f"unit {self.name!r} refused the step at t = {t:.6g} s (h = {h:.3g} s): {said}",
-                    self.name,
-                ) from None
-            raise UnitFailedError(
-                f"unit {self.name!r} failed at t = {t:.6g} s with "
-                f"{FMI_STATUS.get(exc.status, exc.status)}: {said}",
+            raise self._step_failure(t, h, exc.status) from None
+
+    def _step_failure(self, t: float, h: float, status: int) -> Exception:
+        """What a step answered with ``status`` (Discard, Error, Fatal) raises."""
+        self._fatal = self._fatal or status == 4
+        said = "; ".join(self.messages.kept[-3:]) or "no message"
+        if status == 2:
+            return StepRefusedError(
+                f"unit {self.name!r} refused the step at t = {t:.6g} s (h = {h:.3g} s): {said}",
                 self.name,
-            ) from None
+            )
+        return UnitFailedError(
+            f"unit {self.name!r} failed at t = {t:.6g} s with "
+            f"{FMI_STATUS.get(status, status)}: {said}",
+            self.name,
+        )
 
     def get_state(self) -> object:
         """Save the FMU state (for rollback)."""
@@ -382,37 +462,6 @@ class Slave(NamedValues):
         """
         self._call("freeFMUstate", state)
 
-    def _native(self, function: str) -> Any:
-        """The FMU's C function ``function``, called without fmpy's wrapper (status checked).
-
-        fmpy's wrapper around each call (a method, its ``_call`` and the optional call
-        logger, which the master does not use) costs about as much as the call
-        itself for the three calls every macro step makes per unit: ``fmi2DoStep``,
-        ``fmi2SetReal`` and ``fmi2Get{Real,Integer}``. The C function with fmpy's
-        argument and result types, and a check that raises
-        :class:`~fmpy.fmi1.FMICallException` as fmpy's wrapper does, is kept here.
-
-        Parameters
-        ----------
-        function : str
-            An FMI 2.0 function name the FMU exports (``"fmi2DoStep"``).
-        """
-        checked = self._natives.get(function)
-        if checked is None:
-            c_functions = getattr(self._fmu, "_functions", None)  # typed by fmpy at load
-            if not isinstance(c_functions, dict) or function not in c_functions:
-                return getattr(self._fmu, function)  # an fmpy without them: its wrapper
-            c_function = c_functions[function]
-
-            def checked(*args, _f=c_function, _name=function):
-                status = _f(*args)
-                if status > 1:  # worse than fmi2Warning
-                    raise FMICallException(function=_name, status=status)
-                return status
-
-            self._natives[function] = checked
-        return checked
-
     def _call(self, fn: str, *args, **kwargs):
         fmu = self._fmu
         if fmu is None:
@@ -425,20 +474,47 @@ class Slave(NamedValues):
         try:
             return method(*args, **kwargs)
         except FMICallException as exc:
-            self._fatal = self._fatal or exc.status == 4
             if fn == "doStep":
                 raise
-            said = "; ".join(dict.fromkeys(self.messages.kept[-5:]))
-            status = FMI_STATUS.get(exc.status, exc.status)
-            raise UnitFailedError(  # the unit's own words name the call, else we do
-                f"unit {self.name!r}: {said}"
-                if said
-                else f"unit {self.name!r}: {fn} failed with {status} and no message",
-                self.name,
-            ) from None
+            raise self._failure(fn, exc.status) from None
         finally:
             self.seconds[fn] += _clock() - start
             self.calls[fn] += 1
+
+    def _failure(self, fn: str, status: int) -> UnitFailedError:
+        """What an FMI call ``fn`` other than a step that answered ``status`` raises."""
+        self._fatal = self._fatal or status == 4
+        said = "; ".join(dict.fromkeys(self.messages.kept[-5:]))
+        return UnitFailedError(  # the unit's own words name the call, else we do
+            f"unit {self.name!r}: {said}"
+            if said
+            else f"unit {self.name!r}: {fn} failed with {FMI_STATUS.get(status, status)} "
+            "and no message",
+            self.name,
+        )
+
+
+@dataclass(frozen=True)
+class _HotCalls:
+    """An instance's component and the C functions every macro step calls.
+
+    fmpy's wrapper around each call (a method, its ``_call`` and the optional call
+    logger, which the master does not use) costs about as much as the call itself
+    for the calls every macro step makes per unit: ``fmi2SetReal``, ``fmi2DoStep``
+    and ``fmi2Get{Real,Integer}``. The C functions, with the argument and result
+    types fmpy gave them when it loaded the binary, are called directly.
+    """
+
+    component: Any
+    functions: dict[str, Any]
+
+    @classmethod
+    def of(cls, fmu: FMU2Slave) -> _HotCalls | None:
+        """The hot calls of an instantiated ``fmu``; None if fmpy keeps no typed C functions."""
+        c_functions = getattr(fmu, "_functions", None)
+        if not isinstance(c_functions, dict) or not all(f in c_functions for f in _HOT_FUNCTIONS):
+            return None
+        return cls(fmu.component, {f: c_functions[f] for f in _HOT_FUNCTIONS})
 
 
 def _listed(items: Sequence[Any]) -> list[Any]:

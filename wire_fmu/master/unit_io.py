@@ -89,6 +89,9 @@ class InputPlan:
         Whether every driven input is a Real (else they are set by name, checked).
     evented : bool
         Whether some scheduled event sets an input of the unit.
+    write : callable
+        The set of :attr:`refs` made ready (:meth:`Slave.writer
+        <wire_fmu.master.slave.Slave.writer>`).
 
     Attributes
     ----------
@@ -101,6 +104,7 @@ class InputPlan:
     refs: list[int]
     driven_reals: bool
     evented: bool
+    write: Callable[[Sequence[float]], None]
     _fired: int = field(default=-1, repr=False)
     _event_refs: list[int] = field(default_factory=list, repr=False)
     _event_values: list[float] = field(default_factory=list, repr=False)
@@ -236,11 +240,16 @@ class ReadPlan:
         Type and position of the ``mode_changes`` output, if the unit has one.
     watched : bool
         Whether the read includes the watched variables.
+    readers : tuple of (str, callable)
+        For each group, its type and its get made ready (:meth:`Slave.reader
+        <wire_fmu.master.slave.Slave.reader>`); empty: read through
+        :meth:`Slave.get_typed <wire_fmu.master.slave.Slave.get_typed>`.
     """
 
     groups: tuple[tuple[str, list[int]], ...]
     mode: _Place | None
     watched: bool
+    readers: tuple[tuple[str, Callable[[], list[Any]]], ...] = ()
 
     def read(self, slave: Slave, source_keys: Sequence[str]) -> EndValues:
         """Read the plan's values from ``slave``, one call per FMI type.
@@ -256,9 +265,10 @@ class ReadPlan:
         -------
         EndValues
         """
-        by_kind = {}
-        for kind, refs in self.groups:
-            by_kind[kind] = slave.get_typed(kind, refs)
+        if self.readers:
+            by_kind = {kind: read() for kind, read in self.readers}
+        else:
+            by_kind = {kind: slave.get_typed(kind, refs) for kind, refs in self.groups}
         sources = {}
         if source_keys:  # the sources come first among the Reals, the watched variables after
             sources = dict(zip(source_keys, by_kind["Real"][: len(source_keys)], strict=True))
@@ -340,4 +350,5 @@ def read_plan(
     for watch in watches:
         watch.places[unit] = [place(name) for name in watch.names.get(unit, ())]
     kept = tuple((kind, refs) for kind, refs in groups.items() if refs)
-    return ReadPlan(kept, mode, bool(watches))
+    readers = tuple((kind, slave.reader(kind, refs)) for kind, refs in kept)
+    return ReadPlan(kept, mode, bool(watches), readers)
