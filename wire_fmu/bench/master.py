@@ -8,6 +8,10 @@ call and its time), so
 
 * master overhead per unit per macro step = (wall time of the stepping loop
   − time in FMI calls made by it) / (units × macro steps),
+* of which recording: the time the results recorder spent putting rows together
+  and writing them as text during the loop, per unit per macro step (it grows
+  with the number of recorded values and how often a row is due, about half a
+  microsecond per value: the shortest text that reads back to the same float),
 * set-up and clean-up = the rest of the run's wall time beyond its FMI calls
   (extracting and loading the FMUs, initialisation, the results' metadata,
   freeing the units): paid once per run, not per step, and
@@ -22,6 +26,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.run import run_scene, shipped_scenes
 
 from .tables import markdown_table
@@ -41,6 +46,8 @@ class SceneFigures:
     fmi_seconds: float
     stepping_wall: float
     stepping_fmi_seconds: float
+    recording_seconds: float = 0.0
+    recorded_values: int = 0
 
     @property
     def real_time_factor(self) -> float:
@@ -52,6 +59,16 @@ class SceneFigures:
         """Master time per unit per macro step beyond the FMI calls, microseconds."""
         stepping = self.stepping_wall - self.stepping_fmi_seconds
         return 1e6 * stepping / max(1, self.units * self.steps)
+
+    @property
+    def recording_us(self) -> float:
+        """Of :attr:`overhead_us`, the recorder's share, microseconds per unit per step."""
+        return 1e6 * self.recording_seconds / max(1, self.units * self.steps)
+
+    @property
+    def coupling_us(self) -> float:
+        """:attr:`overhead_us` without the recorder's share, microseconds."""
+        return self.overhead_us - self.recording_us
 
     @property
     def setup_ms(self) -> float:
@@ -81,6 +98,7 @@ def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
     if result.status != "finished":
         raise RuntimeError(f"{name}: {result.status}: {result.message}")
     fmi = sum(sum(s.seconds.values()) for s in sim.slaves.values())
+    recorder = next(o for o in sim.observers if isinstance(o, CsvRecorder))
     return SceneFigures(
         name,
         len(sim.slaves),
@@ -90,6 +108,8 @@ def measure(name: str, stop_time: float | None, out: Path) -> SceneFigures:
         fmi,
         result.stepping_wall_time,
         result.stepping_fmi_time,
+        recorder.stepping_seconds,
+        len(recorder.columns),
     )
 
 
@@ -103,13 +123,15 @@ def table(rows: list[SceneFigures]) -> str:
     """
     header = (
         "scene | units | macro steps | simulated s | wall s | real-time factor | "
-        "master overhead per unit per step | set-up and clean-up"
+        "master overhead per unit per step | of which recording | recorded columns | "
+        "without recording | set-up and clean-up"
     )
     return markdown_table(
         header,
         (
             f"{r.scene} | {r.units} | {r.steps} | {r.simulated:g} | {r.wall:.2f} | "
-            f"{r.real_time_factor:.3g} | {r.overhead_us:.1f} µs | {r.setup_ms:.0f} ms"
+            f"{r.real_time_factor:.3g} | {r.overhead_us:.1f} µs | {r.recording_us:.1f} µs | "
+            f"{r.recorded_values} | {r.coupling_us:.1f} µs | {r.setup_ms:.0f} ms"
             for r in rows
         ),
     )
@@ -133,10 +155,12 @@ def main(argv: list[str] | None = None) -> None:
         for name in shipped_scenes():
             rows.append(measure(name, args.stop_time, Path(tmp)))
             logger.info(
-                "%s: RTF %.3g, overhead %.1f µs per unit per step, set-up and clean-up %.0f ms",
+                "%s: RTF %.3g, overhead %.1f µs per unit per step (recording %.1f), "
+                "set-up and clean-up %.0f ms",
                 name,
                 rows[-1].real_time_factor,
                 rows[-1].overhead_us,
+                rows[-1].recording_us,
                 rows[-1].setup_ms,
             )
     text = table(rows)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 
-from .extrapolation import History, held_value, ramp
+from .extrapolation import History, held_value, push_all, ramp
 from .scene.data import RAMP_ROLE
 from .unit_io import EndValues, InputPlan, Link, Watch, read_plan
 
@@ -145,8 +145,7 @@ class UnitExchange:
         self.slaves[unit].set_reals(refs, values)
 
     def _push(self, unit: str, t: float) -> None:
-        for key, value in self.read_sources(unit).items():
-            self.histories[key].push(t, value)
+        push_all(self.histories, self.read_sources(unit), t)
 
     # -- what algorithms call ------------------------------------------------------
     def read_sources(self, unit: str) -> dict[str, float]:

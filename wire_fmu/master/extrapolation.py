@@ -42,8 +42,9 @@ instant; a trend extrapolated on top would count the model's own rate twice.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Mapping
 
-__all__ = ["History", "held_value", "ramp", "SCHEME_POINTS"]
+__all__ = ["History", "held_value", "push_all", "ramp", "SCHEME_POINTS"]
 
 SCHEME_POINTS = {"constant": 1, "linear": 2, "quadratic": 3}
 MIN_SPACING = 0.5
@@ -68,10 +69,7 @@ class History:
         value : float
             The output's value there, in its unit.
         """
-        if self.points and t <= self.points[-1][0]:
-            self.points[-1] = (t, value)
-        else:
-            self.points.append((t, value))
+        push_all({"": self}, {"": value}, t)
 
     def reset(self) -> None:
         """Forget all but the latest value (after a mode change or an event)."""
@@ -82,6 +80,29 @@ class History:
     def latest(self) -> float:
         """The newest value."""
         return self.points[-1][1]
+
+
+def push_all(histories: Mapping[str, History], values: Mapping[str, float], t: float) -> None:
+    """:meth:`History.push` of each value into the history of its key, all at ``t``.
+
+    The master calls this for every source at every accepted step, so the loop is
+    written out here once rather than as a method call per source.
+
+    Parameters
+    ----------
+    histories : mapping of str to History
+        Histories by source key (``"unit.variable"``).
+    values : mapping of str to float
+        The new value of each source to push, by key, in its unit.
+    t : float
+        Time of the step end, s; a time not after a history's newest replaces it.
+    """
+    for key, value in values.items():
+        points = histories[key].points
+        if points and t <= points[-1][0]:
+            points[-1] = (t, value)
+        else:
+            points.append((t, value))
 
 
 def _lagrange(points: list[tuple[float, float]], t: float) -> float:

@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass, field
 
 from .bond_energy import step_energy
+from .extrapolation import push_all
 from .run_result import SimulationStoppedError
 from .step_size import _PI, _ns, new_h
 from .unit_errors import StepRefusedError
@@ -202,8 +203,7 @@ class MacroStep:
 
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
         histories, end = self.histories, t + h
-        for key, value in new.items():
-            histories[key].push(end, value)
+        push_all(histories, new, end)
         switched = set()
         for name, before in self.mode_counts.items():
             now = self._mode_count(name)

@@ -145,6 +145,8 @@ class CsvRecorder:
         self.columns: list[str] = []
         self.units: dict[str, str] = {}
         """Unit of each column, by column (see :mod:`~wire_fmu.master.column_units`)."""
+        self.stepping_seconds = 0.0
+        """Wall-clock time spent recording rows (and writing them) between steps, s."""
 
     # -- observer protocol -----------------------------------------------------
     def on_start(self, sim: Simulation) -> None:
@@ -180,7 +182,9 @@ class CsvRecorder:
         Parameters as in :meth:`Observer.on_step`.
         """
         if self._due(sim.time):
+            started = time.perf_counter()
             self._row(sim)
+            self.stepping_seconds += time.perf_counter() - started
 
     def _due(self, t: float) -> bool:
         """Whether a row is recorded after a step ending at ``t`` (s)."""

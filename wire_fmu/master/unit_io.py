@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from typing import Any
 
 from .extrapolation import History
@@ -164,6 +165,7 @@ class Watch:
     names: Mapping[str, Sequence[str]]
     due: Callable[[float], bool]
     places: dict[str, list[_Place]] = field(default_factory=dict, repr=False)
+    _pickers: dict[str, tuple[str, Callable | None, bool]] = field(default_factory=dict, repr=False)
 
     def values(self, unit: str, slave: Slave, end: EndValues | None) -> list[Any]:
         """The watched variables of ``unit`` now, in the order of :attr:`names`.
@@ -223,8 +225,31 @@ class Watch:
         """
         if isinstance(taken, list):
             return taken
-        by_kind = taken.by_kind
-        return [by_kind[kind][position] for kind, position in self.places[unit]]
+        kind, pick, single = self._pickers[unit]
+        if pick is None:  # of several FMI types, or none
+            by_kind = taken.by_kind
+            return [by_kind[kind][position] for kind, position in self.places[unit]]
+        got = pick(taken.by_kind[kind])
+        return [got] if single else list(got)
+
+    def place(self, unit: str, places: list[_Place]) -> None:
+        """Say where ``unit``'s watched variables sit in its end-of-step read.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        places : list of (str, int)
+            For each watched variable of the unit, in order, its FMI type and its
+            position in that type's answer.
+        """
+        self.places[unit] = places
+        kinds = {kind for kind, _ in places}
+        if len(kinds) == 1:  # all of one type (the usual case): one C call picks them
+            positions = [position for _, position in places]
+            self._pickers[unit] = (kinds.pop(), itemgetter(*positions), len(positions) == 1)
+        else:
+            self._pickers[unit] = ("", None, False)
 
 
 @dataclass(frozen=True)
@@ -348,7 +373,7 @@ def read_plan(
 
     mode = None if mode_output is None else place(mode_output)
     for watch in watches:
-        watch.places[unit] = [place(name) for name in watch.names.get(unit, ())]
+        watch.place(unit, [place(name) for name in watch.names.get(unit, ())])
     kept = tuple((kind, refs) for kind, refs in groups.items() if refs)
     readers = tuple((kind, slave.reader(kind, refs)) for kind, refs in kept)
     return ReadPlan(kept, mode, bool(watches), readers)
