@@ -53,7 +53,10 @@ def _mode_changes_inside_steps(out, synchronise: bool) -> tuple[int, int]:
 
     class Watch:
         def on_start(self, sim):
-            self.counts = dict(sim.mode_counts)
+            self.counts = {
+                name: int(sim.slaves[name].get(["mode_changes"])["mode_changes"])
+                for name in sim.event_time_units
+            }
             self.t = sim.time
 
         def on_step(self, sim):
@@ -109,3 +112,59 @@ def test_mode_change_time_is_declared_on_every_unit_that_changes_mode(unit_class
     assert MODE_CHANGE_TIME == CORE_MODE_CHANGE_TIME
     assert variable.unit == "s" and variable.type is float
     assert variable.causality is Causality.output
+
+
+class _MarkerLedger:
+    """For every unit with both outputs, whether ``mode_change_time`` moved in each step in
+    which ``mode_changes`` did, and only then (read directly, not from the master's plan)."""
+
+    def __init__(self) -> None:
+        self.steps = self.changes = 0
+        self.mismatches: list[tuple[str, float]] = []
+
+    def _read(self, sim) -> dict[str, tuple[int, float]]:
+        out = {}
+        for name in sim.event_time_units:
+            got = sim.slaves[name].get(["mode_changes", MODE_CHANGE_TIME])
+            out[name] = (int(got["mode_changes"]), float(got[MODE_CHANGE_TIME]))
+        return out
+
+    def on_start(self, sim):
+        self.before, self.t = self._read(sim), sim.time
+
+    def on_step(self, sim):
+        now = self._read(sim)
+        for name, (count, when) in now.items():
+            counted, told = count != self.before[name][0], when != self.before[name][1]
+            self.changes += counted
+            if counted != told or (told and not self.t < when <= sim.time):
+                self.mismatches.append((name, sim.time))
+        self.before, self.t = now, sim.time
+        self.steps += 1
+
+    def on_end(self, sim, result):
+        pass
+
+
+@pytest.mark.integration
+@pytest.mark.parametrize(("scene", "stop"), [("riser_tensioner", STOP_TIME), ("drawworks", 3.0)])
+def test_mode_change_time_moves_exactly_when_mode_changes_does(tmp_path, scene, stop):
+    """The master watches a unit's mode through ``mode_change_time`` alone (one get of
+    Reals per step); that is right only if it moves in exactly the steps where the
+    ``mode_changes`` counter does, to an instant inside the step, located or not."""
+    ledger = _MarkerLedger()
+    outcome = run_scene(
+        scene,
+        tmp_path,
+        plots=False,
+        stop_time=stop,
+        step=0.002,
+        output_interval=1.0,  # a recorded Integer output is read with its rows
+        observers=[ledger],
+    )
+    assert outcome.result.status == "finished", outcome.result.message
+    assert outcome.simulation.event_time_units  # the scene's units tell when
+    assert ledger.changes > 0 and ledger.mismatches == []
+    for name in outcome.simulation.event_time_units:  # the master reads no Integer per step
+        own = ledger.steps + 1  # the ledger's reads, one per step and at the start
+        assert outcome.simulation.slaves[name].calls["getInteger"] - own <= 2 + stop

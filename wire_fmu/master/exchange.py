@@ -27,7 +27,7 @@ class UnitExchange:
     """The units' inputs and outputs across the FMI boundary (a mixin of the simulation).
 
     The simulation provides ``scene``, ``run_settings``, ``slaves``, ``drivers``,
-    ``events``, ``held``, ``mode_counts``, ``_watches``, ``_watching``, ``_inputs``,
+    ``events``, ``held``, ``mode_markers``, ``_watches``, ``_watching``, ``_inputs``,
     ``_reads`` and ``_ends``.
     """
 
@@ -69,7 +69,7 @@ class UnitExchange:
                 links, driven, refs, reals, evented, write=slave.writer(refs)
             )
             sources = self.source_vrs.get(name, [])
-            mode = MODE_OUTPUT if name in self.mode_counts else None
+            mode = self.mode_markers.get(name)
             self._reads[name] = (
                 read_plan(name, slave, sources, mode),
                 read_plan(name, slave, sources, mode, self._watches),
@@ -255,9 +255,10 @@ class UnitExchange:
             new.update(end.sources if end is not None else self.read_sources(unit))
         return new
 
-    def _mode_count(self, unit: str) -> int:
-        """The unit's ``mode_changes`` output now (from its end-of-step read if valid)."""
+    def _mode_mark(self, unit: str) -> float | int:
+        """The unit's mode marker now (see ``mode_markers``; from its end-of-step read if valid)."""
         end = self._ends.get(unit)
         if end is not None and end.mode is not None:
             return end.mode
-        return int(self.slaves[unit].get([MODE_OUTPUT])[MODE_OUTPUT])
+        marker = self.mode_markers[unit]
+        return self.slaves[unit].get([marker])[marker]

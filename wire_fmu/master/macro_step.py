@@ -45,9 +45,9 @@ class MacroStep:
     """Taking, judging, accepting and rolling back a macro step (a mixin of the simulation).
 
     The simulation provides ``scene``, ``run_settings``, ``slaves``, ``algorithm``,
-    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_counts``,
+    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_marks``,
     ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``, ``_reads``, ``_ends``,
-    ``_build_plans``, ``_read_all`` and ``_mode_count``.
+    ``_build_plans``, ``_read_all`` and ``_mode_mark``.
     """
 
     def _save(self):
@@ -182,18 +182,19 @@ class MacroStep:
     def _first_mode_change_ns(self, t: float, h: float) -> int | None:
         """End (ns) of the step that places the earliest mode change inside ``(t, t + h)``.
 
-        Units whose ``mode_changes`` moved in the step and that tell when
-        (:data:`~wire_fmu.core.framework.unit.MODE_CHANGE_TIME`) are asked; None when no
+        Units that tell when their mode changes
+        (:data:`~wire_fmu.core.framework.unit.MODE_CHANGE_TIME`, which moves in exactly
+        the steps where their ``mode_changes`` does) are asked; None when no
         such change lies more than :data:`SYNC_RESOLUTION_NS` inside the step. The end
         is rounded up to the nanosecond, so that stepping to it takes the change in.
         """
         start_ns, end_ns = _ns(t), _ns(t + h)
         earliest = None
-        for name, before in self.mode_counts.items():
-            if name not in self.event_time_units or self._mode_count(name) == before:
+        for name, before in self.mode_marks.items():
+            if name not in self.event_time_units:
                 continue
-            when = float(self.slaves[name].get([MODE_CHANGE_TIME])[MODE_CHANGE_TIME])
-            if not math.isfinite(when):
+            when = float(self._mode_mark(name))  # the unit's mode_change_time
+            if when == before or not math.isfinite(when):
                 continue
             candidate = math.ceil(when * 1e9 - 1e-3)  # a change at the step's start is older
             inside = start_ns + SYNC_RESOLUTION_NS <= candidate <= end_ns - SYNC_RESOLUTION_NS
@@ -205,11 +206,11 @@ class MacroStep:
         histories, end = self.histories, t + h
         push_all(histories, new, end)
         switched = set()
-        for name, before in self.mode_counts.items():
-            now = self._mode_count(name)
+        for name, before in self.mode_marks.items():
+            now = self._mode_mark(name)
             if now != before:
                 switched.add(name)
-                self.mode_counts[name] = now
+                self.mode_marks[name] = now
                 for key in self.source_keys.get(name, ()):
                     histories[key].reset()
         across = (

@@ -30,9 +30,10 @@ side still steps first and takes the model about the step's start.
 Across the FMI boundary each unit gets, per macro step, one batched set of
 its Real inputs (connected, driven, set by events) and, after its step, one
 batched read per FMI type of what the master needs: the outputs that feed
-connections, the ``mode_changes`` counter and, at the steps an observer
-records, the variables it watches (:meth:`Simulation.watch`). The value
-references are resolved once (:mod:`~wire_fmu.master.unit_io`).
+connections, the unit's mode marker (``mode_change_time``, a Real, on our units:
+one read in all; the ``mode_changes`` counter on a unit without it) and, at the
+steps an observer records, the variables it watches (:meth:`Simulation.watch`).
+The value references are resolved once (:mod:`~wire_fmu.master.unit_io`).
 
 The exchange with the units (the links, the batched sets and reads, the
 calls the coupling algorithms make) is in :mod:`~wire_fmu.master.exchange`;
@@ -100,8 +101,9 @@ class Simulation(UnitExchange, MacroStep):
         )
         self.bond_power = {b.name: 0.0 for b in scene.bonds}
         self.held: dict[str, float] = {}
-        self.mode_counts: dict[str, int] = {}
-        self.event_time_units: set[str] = set()  # of mode_counts, those that tell when
+        self.mode_marks: dict[str, float | int] = {}  # see _watch_modes
+        self.mode_markers: dict[str, str] = {}
+        self.event_time_units: set[str] = set()  # of mode_marks, those that tell when
         self.result = RunResult("not started")
         self._error_prev = 1.0
         self._interrupts = Interrupts()
@@ -148,13 +150,26 @@ class Simulation(UnitExchange, MacroStep):
             self._set_connected_from_latest(name)
             self.slaves[name].exit_initialization()
             self._push(name, start)
-        for name, slave in self.slaves.items():
-            # a mode event resets the unit's outgoing histories: watched where there are any
-            if MODE_OUTPUT in slave.variables and self.source_keys.get(name):
-                self.mode_counts[name] = int(slave.get([MODE_OUTPUT])[MODE_OUTPUT])
-                if MODE_CHANGE_TIME in slave.variables:
-                    self.event_time_units.add(name)
+        self._watch_modes()
         self.time = start
+
+    def _watch_modes(self) -> None:
+        """Note each unit's mode marker: a mode event resets the unit's outgoing histories.
+
+        Watched where the unit has outgoing connections and a ``mode_changes`` counter:
+        through its Real ``mode_change_time`` where it declares one (it moves exactly
+        when the counter does, and is read with the unit's other Reals), else
+        through the Integer counter itself.
+        """
+        for name, slave in self.slaves.items():
+            if MODE_OUTPUT not in slave.variables or not self.source_keys.get(name):
+                continue
+            told = slave.variables.get(MODE_CHANGE_TIME)
+            marker = MODE_CHANGE_TIME if told is not None and told.type == "Real" else MODE_OUTPUT
+            self.mode_markers[name] = marker
+            self.mode_marks[name] = slave.get([marker])[marker]
+            if marker == MODE_CHANGE_TIME:
+                self.event_time_units.add(name)
 
     def _fire_events(self, t: float) -> list[str]:
         fired = self.events.fire_due(t)

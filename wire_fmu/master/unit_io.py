@@ -2,8 +2,10 @@
 
 Per unit and macro step the master makes one batched set of its Real inputs
 (connected, driven and set by events) before the step and one batched get per
-FMI type after it: the outputs that feed connections, the ``mode_changes``
-counter and, at the steps an observer records, the variables it records. The
+FMI type after it: the outputs that feed connections, the unit's mode marker
+(its Real ``mode_change_time`` where it has one, so that our units are read in
+one get of Reals; else its Integer ``mode_changes`` counter) and, at the steps
+an observer records, the variables it records. The
 value references of all of these are resolved here, once, into plans:
 
 :class:`ReadPlan`
@@ -262,7 +264,8 @@ class ReadPlan:
         For each FMI type with something to read, its value references, Real
         first; the Reals start with the unit's source outputs, in order.
     mode : (str, int) or None
-        Type and position of the ``mode_changes`` output, if the unit has one.
+        Type and position of the unit's mode marker (its ``mode_change_time``, else
+        its ``mode_changes`` counter), if the master watches one.
     watched : bool
         Whether the read includes the watched variables.
     readers : tuple of (str, callable)
@@ -297,7 +300,7 @@ class ReadPlan:
         sources = {}
         if source_keys:  # the sources come first among the Reals, the watched variables after
             sources = dict(zip(source_keys, by_kind["Real"][: len(source_keys)], strict=True))
-        mode = None if self.mode is None else int(by_kind[self.mode[0]][self.mode[1]])
+        mode = None if self.mode is None else by_kind[self.mode[0]][self.mode[1]]
         return EndValues(by_kind, sources, mode, self.watched)
 
 
@@ -310,8 +313,8 @@ class EndValues:
         The values by FMI type, in the order of the plan's value references.
     sources : dict of str to float
         The source outputs by ``"unit.variable"`` name, in their units.
-    mode : int or None
-        The ``mode_changes`` counter, if the unit has one.
+    mode : float, int or None
+        The unit's mode marker (``mode_change_time`` or ``mode_changes``), if read.
     watched : bool
         Whether the watched variables were read too.
     """
@@ -322,7 +325,7 @@ class EndValues:
         self,
         by_kind: dict[str, list[Any]],
         sources: dict[str, float],
-        mode: int | None,
+        mode: float | int | None,
         watched: bool,
     ) -> None:
         self.by_kind = by_kind

@@ -58,11 +58,15 @@ __all__ = [
     "STEP_ERRORS",
     "HeldInputsUnit",
     "MODE_CHANGE_TIME",
+    "MODE_CHANGES",
     "mode_change_time_output",
 ]
 
 MODE_CHANGE_TIME = "mode_change_time"
 """The output that tells when a unit's mode first changed inside its last step."""
+
+MODE_CHANGES = "mode_changes"
+"""The Integer output that counts a unit's mode changes (stick/slip, slack, a break)."""
 
 
 def mode_change_time_output(what: str) -> Variable:
@@ -76,15 +80,19 @@ def mode_change_time_output(what: str) -> Variable:
     Returns
     -------
     Variable
-        An output in s: the time of the first mode change located inside the
-        latest step that had one (a step without one leaves it as it was). A
-        master that sees ``mode_changes`` move in a step and this time inside
-        it can step every unit to that instant.
+        An output in s: the time of the first mode change inside the latest step
+        that had one (:data:`MODE_CHANGES` moved), where the model located it,
+        else that step's end; a step without one leaves it as it was. It
+        therefore changes exactly at the steps where :data:`MODE_CHANGES` does,
+        so a master can watch it in its batched read of Reals instead of reading
+        the Integer counter too; one that sees it move to an instant inside the
+        step can step every unit to that instant.
     """
     return output(
         MODE_CHANGE_TIME,
         "s",
-        f"Time of the first mode change ({what}) inside the latest step that had one",
+        f"Time of the first mode change ({what}) inside the latest step that had one "
+        "(that step's end where not located)",
     )
 
 
@@ -232,11 +240,12 @@ class Unit(ABC):
             refused = f"{self.who} at t = {time:.6g} s: step refused: "
             return StepResult(False, refused + "; ".join(bad))
         saved = self._snapshot()
+        changes = self.values.get(MODE_CHANGES)
         try:
             events = self._advance(time, step)
             self.time = time + step
             self._update_outputs()
-            if MODE_CHANGE_TIME in self.values:
+            if MODE_CHANGE_TIME in self.values and self.values.get(MODE_CHANGES) != changes:
                 self._note_mode_change_time(time, step)
         except STEP_ERRORS as err:
             self._restore_snapshot(saved)
@@ -246,10 +255,10 @@ class Unit(ABC):
         return StepResult(True, events=tuple(events))
 
     def _note_mode_change_time(self, time: float, step: float) -> None:
-        """Write the model's first located event inside ``(time, time + step)``, if any, s."""
+        """Write when the mode changed in the step just taken from ``time`` (s): the model's
+        first located event inside ``(time, time + step)``, else the step's end, s."""
         first = getattr(self.model, "first_event_time", math.inf)
-        if time < first < time + step:
-            self.values[MODE_CHANGE_TIME] = first
+        self.values[MODE_CHANGE_TIME] = first if time < first < time + step else time + step
 
     def timed_advance(self, time: float, step: float) -> StepResult:
         """:meth:`advance`, its wall-clock time added to :attr:`physics_seconds` (timing hook).
