@@ -254,7 +254,12 @@ def test_fmpy_runner_runs_shipped_scenes_like_our_master(name, tmp_path):
     names, ours = run_ours(scene)
     n = len(ours)
     assert len(result) >= n
-    named = [(u, v) for u, v in names if f"{u}.{v}" in result.dtype.names]
+    # mode_change_time remembers when a mode last changed: in FMPy's first step (every
+    # connected input at 0.0: the drawworks' brake lever let go for one step) the winch's
+    # brake slips and holds again, two switches our run never has
+    named = [
+        (u, v) for u, v in names if f"{u}.{v}" in result.dtype.names and v != "mode_change_time"
+    ]
     # FMPy adds up its time: the same instants to a few ulps
     np.testing.assert_allclose(result["time"][:n] + step, ours[:, 0], rtol=0, atol=1e-12)
     theirs = np.column_stack([ours[:, 0]] + [result[f"{u}.{v}"][:n] for u, v in named])
@@ -271,7 +276,7 @@ def test_fmpy_runner_runs_shipped_scenes_like_our_master(name, tmp_path):
     # torque); in these scenes that changes that step's outputs and no state
     worst, where = _worst(named, ours[1:], theirs[1:])
     assert worst < 1e-8, f"{name}: {where} differs by {worst:.3g} (relative)"
-    moving = [np.ptp(ours[:, i]) for i in keep[1:]]
+    moving = [np.ptp(ours[:, i]) for i in range(1, ours.shape[1])]  # the compared columns
     assert max(moving) > 1.0, name  # something happens in the window
 
 
