@@ -45,7 +45,7 @@ class MacroStep:
     """Taking, judging, accepting and rolling back a macro step (a mixin of the simulation).
 
     The simulation provides ``scene``, ``run_settings``, ``slaves``, ``algorithm``,
-    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_marks``,
+    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_marks``, ``mode_markers``,
     ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``, ``_reads``, ``_ends``,
     ``_build_plans``, ``_read_all`` and ``_mode_mark``.
     """
@@ -191,7 +191,7 @@ class MacroStep:
         start_ns, end_ns = _ns(t), _ns(t + h)
         earliest = None
         for name, before in self.mode_marks.items():
-            if name not in self.event_time_units:
+            if self.mode_markers[name] != MODE_CHANGE_TIME:  # a counter tells no time
                 continue
             when = float(self._mode_mark(name))  # the unit's mode_change_time
             if when == before or not math.isfinite(when):

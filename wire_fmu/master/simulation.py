@@ -103,7 +103,6 @@ class Simulation(UnitExchange, MacroStep):
         self.held: dict[str, float] = {}
         self.mode_marks: dict[str, float | int] = {}  # see _watch_modes
         self.mode_markers: dict[str, str] = {}
-        self.event_time_units: set[str] = set()  # of mode_marks, those that tell when
         self.result = RunResult("not started")
         self._error_prev = 1.0
         self._interrupts = Interrupts()
@@ -168,8 +167,11 @@ class Simulation(UnitExchange, MacroStep):
             marker = MODE_CHANGE_TIME if told is not None and told.type == "Real" else MODE_OUTPUT
             self.mode_markers[name] = marker
             self.mode_marks[name] = slave.get([marker])[marker]
-            if marker == MODE_CHANGE_TIME:
-                self.event_time_units.add(name)
+
+    @property
+    def event_time_units(self) -> set[str]:
+        """Units whose mode the master watches through ``mode_change_time``: they tell when."""
+        return {name for name, m in self.mode_markers.items() if m == MODE_CHANGE_TIME}
 
     def _fire_events(self, t: float) -> list[str]:
         fired = self.events.fire_due(t)

@@ -117,7 +117,8 @@ class Slave(NamedValues):
         self.seconds: dict[str, float] = defaultdict(float)
         self.messages = _Messages(name)
         self._fmu: FMU2Slave | None = None
-        self._readers: dict[tuple[str, tuple[int, ...]], Callable[..., Any]] = {}
+        # the prepared gets and sets of get_typed and set_reals, by type and references
+        self._prepared: dict[tuple[str, tuple[int, ...]], Callable[..., Any]] = {}
         self._hot: _HotCalls | None = None
         self._fatal = False
         self._unzipdir: str | None = None
@@ -350,9 +351,9 @@ class Slave(NamedValues):
             A value for each, in the variable's unit (a String as bytes).
         """
         key = (kind, refs if type(refs) is tuple else tuple(refs))
-        read = self._readers.get(key)
+        read = self._prepared.get(key)
         if read is None:
-            read = self._readers[key] = self.reader(kind, key[1])
+            read = self._prepared[key] = self.reader(kind, key[1])
         return read()
 
     def set_reals(self, refs: Sequence[int], values: Sequence[float]) -> None:
@@ -366,9 +367,9 @@ class Slave(NamedValues):
             A value for each, in the variable's unit.
         """
         key = ("setReal", refs if type(refs) is tuple else tuple(refs))
-        write = self._readers.get(key)
+        write = self._prepared.get(key)
         if write is None:
-            write = self._readers[key] = self.writer(key[1])
+            write = self._prepared[key] = self.writer(key[1])
         write(values)
 
     def get_reals(self, refs: Sequence[int]) -> list[float]:

@@ -270,14 +270,13 @@ class ReadPlan:
         Whether the read includes the watched variables.
     readers : tuple of (str, callable)
         For each group, its type and its get made ready (:meth:`Slave.reader
-        <wire_fmu.master.slave.Slave.reader>`); empty: read through
-        :meth:`Slave.get_typed <wire_fmu.master.slave.Slave.get_typed>`.
+        <wire_fmu.master.slave.Slave.reader>`).
     """
 
     groups: tuple[tuple[str, list[int]], ...]
     mode: _Place | None
     watched: bool
-    readers: tuple[tuple[str, Callable[[], list[Any]]], ...] = ()
+    readers: tuple[tuple[str, Callable[[], list[Any]]], ...]
 
     def read(self, slave: Slave, source_keys: Sequence[str]) -> EndValues:
         """Read the plan's values from ``slave``, one call per FMI type.
@@ -293,10 +292,7 @@ class ReadPlan:
         -------
         EndValues
         """
-        if self.readers:
-            by_kind = {kind: read() for kind, read in self.readers}
-        else:
-            by_kind = {kind: slave.get_typed(kind, refs) for kind, refs in self.groups}
+        by_kind = {kind: read() for kind, read in self.readers}
         sources = {}
         if source_keys:  # the sources come first among the Reals, the watched variables after
             sources = dict(zip(source_keys, by_kind["Real"][: len(source_keys)], strict=True))
