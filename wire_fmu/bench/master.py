@@ -11,8 +11,9 @@ call and its time), so
   − time in FMI calls made by it) / (units × macro steps),
 * of which recording: the time the results recorder spent putting rows together
   and writing them as text during the loop, per unit per macro step (it grows
-  with the number of recorded values and how often a row is due, about half a
-  microsecond per value: the shortest text that reads back to the same float),
+  with the number of recorded values and how often a row is due: about a tenth
+  of a microsecond per value for its text, the shortest that reads back to the
+  same float, and as much again to put the row together),
 * set-up and clean-up = the rest of the run's wall time beyond its FMI calls
   (extracting and loading the FMUs, initialisation, the results' metadata,
   freeing the units): paid once per run, not per step, and

@@ -39,6 +39,7 @@ from .column_units import (
     ledger_unit_problems,
     variable_unit,
 )
+from .results_text import number_lines
 from .run_record import scene_record
 
 if TYPE_CHECKING:
@@ -290,16 +291,15 @@ class CsvRecorder:
     def _write_rows(self) -> None:
         """Write the rows recorded since the last write and flush the file.
 
-        A float is written as its ``repr``, the shortest text that reads back to the
-        same number, as the csv module writes it; rows of numbers only are joined
-        directly (no cell of theirs needs quoting), the same text at half the cost.
+        Rows of numbers only (no cell of theirs needs quoting) are written by
+        :func:`number_lines`; rows with text or booleans go through the csv module.
         """
         rows = [self._values(row) for row in self._rows]
         self._rows.clear()
         if self._converted:
             self._writer.writerows(rows)
-        else:
-            self._file.write("".join([",".join(map(repr, row)) + "\r\n" for row in rows]))
+        elif rows:
+            self._file.write(number_lines(rows))
         self._file.flush()
         self._written = time.perf_counter()
 

@@ -53,6 +53,7 @@ from wire_fmu.master.column_units import (
     variable_unit,
 )
 from wire_fmu.master.observers import BOND_CHANNELS, FLUSH_EVERY, LEDGER_CHANNEL, LEDGER_TERMS
+from wire_fmu.master.results_text import number_lines
 from wire_fmu.master.run_record import scene_record
 from wire_fmu.master.run_result import RunResult
 from wire_fmu.master.scene import Scene, VarRef
@@ -137,6 +138,11 @@ class ColumnPlan:
     bonds: list[tuple[str, VarRef, VarRef]] = field(default_factory=list)
     ledgers: list[VarRef] = field(default_factory=list)
     omitted: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def texts(self) -> bool:
+        """Whether a recorded variable is text (its rows go through the csv module)."""
+        return str in self.kinds
 
     def row(self, model: MonolithicModel, t: float, x: np.ndarray) -> list[Any]:
         """The cells of one row at state ``x``.
@@ -288,7 +294,10 @@ class Recorder:
 
     def _flush(self) -> None:
         if self._file is not None:
-            self._writer.writerows(self._rows)
+            if self.plan.texts:
+                self._writer.writerows(self._rows)
+            elif self._rows:  # numbers only: as the co-simulation's recorder writes them
+                self._file.write(number_lines(self._rows))
             self._file.flush()
         self._rows.clear()
         self._written = time.perf_counter()

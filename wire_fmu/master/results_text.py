@@ -1,0 +1,47 @@
+"""The results' numbers as text.
+
+:func:`number_lines` writes rows of numbers as CSV lines: each float as the
+shortest text that reads back to the same bits, at about a fifth of the cost of
+``repr`` (see ``docs/architecture.md``, *Results as CSV*).
+"""
+
+from __future__ import annotations
+
+import orjson
+
+__all__ = ["number_lines"]
+
+_OPTIONS = orjson.OPT_SERIALIZE_NUMPY
+
+
+def number_lines(rows: list[list[float | int]]) -> str:
+    """CSV lines of rows of numbers, each line ended by CRLF as the csv module ends it.
+
+    A float is written as the shortest text that reads back to the same number
+    (``0.1``, ``2.5e-7``, ``1e+20``), an integer as its digits. orjson writes the
+    numbers (the Ryu algorithm, about 0.1 µs a float against 0.46 µs for ``repr``,
+    which runs the bignum dtoa); JSON has no text for nan and infinity, so a row
+    holding one is written with ``repr`` (``nan``, ``inf``, ``-inf``).
+
+    Parameters
+    ----------
+    rows : list of list of float or int
+        The rows, each a list of numbers (Python or numpy scalars).
+
+    Returns
+    -------
+    str
+        One line per row (none for no rows).
+    """
+    if not rows:
+        return ""
+    text = orjson.dumps(rows, option=_OPTIONS)  # b"[[1.0,2],[...]]"
+    if b"null" not in text:
+        return text[2:-2].replace(b"],[", b"\r\n").decode("ascii") + "\r\n"
+    lines = []
+    for row in rows:
+        line = orjson.dumps(row, option=_OPTIONS)[1:-1].decode("ascii")
+        if "null" in line:  # a non-finite number: repr spells it as float() reads it
+            line = ",".join(repr(float(v)) if isinstance(v, float) else str(v) for v in row)
+        lines.append(line + "\r\n")
+    return "".join(lines)
