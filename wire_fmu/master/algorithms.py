@@ -37,7 +37,9 @@ class CouplingAlgorithm(ABC):
         self.order = list(order)
 
     @abstractmethod
-    def sweep(self, sim: Simulation, t: float, h: float, fresh: dict | None = None) -> None:
+    def sweep(
+        self, sim: Simulation, t: float, h: float, fresh: dict | None = None
+    ) -> dict[str, float]:
         """Set every unit's inputs and step it once over ``[t, t + h]``.
 
         ``fresh`` (iteration) maps source outputs to their values at ``t + h``
@@ -47,7 +49,7 @@ class CouplingAlgorithm(ABC):
         ----------
         sim : Simulation
             The simulation whose units are stepped (through its
-            ``set_inputs``, ``step_unit`` and ``read_sources``).
+            ``set_inputs``, ``step_unit`` and ``add_sources``).
         t : float
             Start of the macro step, s.
         h : float
@@ -55,6 +57,12 @@ class CouplingAlgorithm(ABC):
         fresh : dict of str to float, optional
             Source outputs (``"unit.variable"``) at ``t + h`` from the previous
             sweep, in their units.
+
+        Returns
+        -------
+        dict of str to float
+            Every unit's source outputs at ``t + h``, by ``"unit.variable"``, in
+            their units (each unit's read after its step).
         """
 
 
@@ -67,8 +75,11 @@ class Jacobi(CouplingAlgorithm):
         """Parameters and contract as in :meth:`CouplingAlgorithm.sweep`."""
         for unit in self.order:
             sim.set_inputs(unit, t, h, fresh)
+        new: dict[str, float] = {}
         for unit in self.order:
             sim.step_unit(unit, t, h)
+            sim.add_sources(unit, new)
+        return new
 
 
 class GaussSeidel(CouplingAlgorithm):
@@ -82,7 +93,8 @@ class GaussSeidel(CouplingAlgorithm):
         for unit in self.order:
             sim.set_inputs(unit, t, h, new)
             sim.step_unit(unit, t, h)
-            new.update(sim.read_sources(unit))
+            sim.add_sources(unit, new)  # every unit steps: all of new is now of t + h
+        return new
 
 
 def step_order(

@@ -12,6 +12,7 @@ variables are read with the end-of-step reads (:meth:`UnitExchange.watch`).
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Sequence
 
 from .extrapolation import History, held_value, push_all, ramp
 from .scene.data import RAMP_ROLE
@@ -117,23 +118,25 @@ class UnitExchange:
         """
         return watch.values(unit, self.slaves[unit], self._ends.get(unit))
 
-    def watched_snapshot(self, watch: Watch, unit: str) -> EndValues | list:
-        """:meth:`watched_values`, kept for later (:meth:`Watch.unpack <.unit_io.Watch.unpack>`).
+    def watched_snapshots(self, watch: Watch, units: Sequence[str]) -> list[EndValues | list]:
+        """:meth:`watched_values` of each of ``units``, kept for later.
 
         Parameters
         ----------
         watch : Watch
             From :meth:`watch`.
-        unit : str
-            Instance name of the unit in the scene.
+        units : sequence of str
+            Instance names of units in the scene.
 
         Returns
         -------
-        EndValues or list
-            The unit's end-of-step read when it holds the watched values, else
-            the values read now.
+        list of EndValues or list
+            For each unit, in order, its end-of-step read when that holds the
+            watched values, else the values read now; :meth:`Watch.unpack
+            <.unit_io.Watch.unpack>` gives the values.
         """
-        return watch.take(unit, self.slaves[unit], self._ends.get(unit))
+        take, slaves, ends = watch.take, self.slaves, self._ends
+        return [take(unit, slaves[unit], ends.get(unit)) for unit in units]
 
     def _set_connected_from_latest(self, unit: str) -> None:
         self._ends.pop(unit, None)
@@ -161,13 +164,27 @@ class UnitExchange:
         dict of str to float
             Each output's value by its ``"unit.variable"`` name, in its unit.
         """
+        sources: dict[str, float] = {}
+        self.add_sources(unit, sources)
+        return sources
+
+    def add_sources(self, unit: str, into: dict[str, float]) -> None:
+        """Put :meth:`read_sources` of ``unit`` into ``into`` (one update, no new dict).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        into : dict of str to float
+            Source outputs by ``"unit.variable"`` name, updated in place.
+        """
         end = self._ends.get(unit)
         if end is not None:  # read once, just after the unit's step
-            return dict(end.sources)
+            end.add_sources(into)
+            return
         keys = self.source_keys.get(unit, [])
-        return dict(
-            zip(keys, self.slaves[unit].get_reals(self.source_vrs.get(unit, [])), strict=True)
-        )
+        got = self.slaves[unit].get_reals(self.source_vrs.get(unit, []))
+        into.update(zip(keys, got, strict=True))
 
     def set_inputs(self, unit: str, t: float, h: float, fresh: dict | None) -> None:
         """Held values of every connected, driven or overridden input of ``unit``.
@@ -247,13 +264,6 @@ class UnitExchange:
         plain, watched = self._reads[unit]
         plan = watched if self._watching else plain
         self._ends[unit] = plan.read(slave, self.source_keys.get(unit, ()))
-
-    def _read_all(self) -> dict[str, float]:
-        new = {}
-        for unit in self.slaves:
-            end = self._ends.get(unit)
-            new.update(end.sources if end is not None else self.read_sources(unit))
-        return new
 
     def _mode_mark(self, unit: str) -> float | int:
         """The unit's mode marker now (see ``mode_markers``; from its end-of-step read if valid)."""

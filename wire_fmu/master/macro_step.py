@@ -47,7 +47,7 @@ class MacroStep:
     The simulation provides ``scene``, ``run_settings``, ``slaves``, ``algorithm``,
     ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_marks``, ``mode_markers``,
     ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``, ``_reads``, ``_ends``,
-    ``_build_plans``, ``_read_all`` and ``_mode_mark``.
+    ``_build_plans`` and ``_mode_mark``.
     """
 
     def _save(self):
@@ -63,16 +63,14 @@ class MacroStep:
             self.slaves[name].free_state(state)
 
     def _sweep_iterated(self, t: float, h: float, states) -> tuple[dict[str, float], int]:
-        self.algorithm.sweep(self, t, h)
-        new = self._read_all()
+        new = self.algorithm.sweep(self, t, h)
         sweeps, changes = 1, []
         for _ in range(self.run_settings.iterations - 1):
             if not all(map(math.isfinite, new.values())):
                 return new, sweeps  # never handed on: the caller rejects the step
             before = dict(self.held)
             self._restore(states)
-            self.algorithm.sweep(self, t, h, fresh=new)
-            new = self._read_all()
+            new = self.algorithm.sweep(self, t, h, fresh=new)
             sweeps += 1
             changes.append(
                 max(
@@ -126,8 +124,7 @@ class MacroStep:
             if states is not None:
                 new, sweeps = self._sweep_iterated(t, h, states)
             else:
-                self.algorithm.sweep(self, t, h)
-                new, sweeps = self._read_all(), 1
+                new, sweeps = self.algorithm.sweep(self, t, h), 1
         except StepRefusedError as exc:
             if states is None:
                 raise SimulationStoppedError(str(exc)) from None

@@ -140,7 +140,8 @@ class CsvRecorder:
         self.meta_path = self.directory / "metadata.json"
         self._file = None
         self._writer = None
-        self._next = 0.0
+        self._next = 0.0  # the next output time, s
+        self._due_from = -math.inf  # a step ending at or after this time is recorded, s
         self._rows: list[tuple] = []  # recorded, not yet written (see _row)
         self._written = -math.inf  # wall-clock time of the last write, s
         self.columns: list[str] = []
@@ -189,7 +190,7 @@ class CsvRecorder:
 
     def _due(self, t: float) -> bool:
         """Whether a row is recorded after a step ending at ``t`` (s)."""
-        return self.interval is None or t >= self._next - 1e-9 * max(1.0, self._next)
+        return t >= self._due_from
 
     def on_end(self, sim: Simulation, result: RunResult) -> None:
         """Close the file and write the summary into the metadata (also after a failure).
@@ -254,7 +255,7 @@ class CsvRecorder:
         What a row needs is kept as it is now: the units' end-of-step reads (never
         changed once made) and the bonds' energies (which change with every step).
         """
-        taken = [sim.watched_snapshot(self._watch, unit) for unit in self._read_units]
+        taken = sim.watched_snapshots(self._watch, self._read_units)
         bonds = sim.energy.bonds
         created = [bond.created for bond in bonds.values()]
         carried = [bond.carried for bond in bonds.values()]
@@ -267,6 +268,7 @@ class CsvRecorder:
             # interval: a loop adding it could run for ever once it is below the round-off)
             reached = math.floor((sim.time + 1e-9 * max(1.0, sim.time)) / self.interval)
             self._next = max(self._next, (reached + 1) * self.interval)
+            self._due_from = self._next - 1e-9 * max(1.0, self._next)
 
     def _values(self, row: tuple) -> list[Any]:
         """The cells of a recorded row: time, recorded variables, bond channels, ledger."""

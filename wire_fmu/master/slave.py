@@ -293,7 +293,7 @@ class Slave(NamedValues):
             calls[fn] += 1
             if status > 1:  # worse than fmi2Warning
                 raise self._failure(fn, status)
-            return list(values)
+            return values[:]  # a new list, made in C (list() would iterate in Python)
 
         return read
 

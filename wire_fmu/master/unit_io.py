@@ -293,11 +293,8 @@ class ReadPlan:
         EndValues
         """
         by_kind = {kind: read() for kind, read in self.readers}
-        sources = {}
-        if source_keys:  # the sources come first among the Reals, the watched variables after
-            sources = dict(zip(source_keys, by_kind["Real"][: len(source_keys)], strict=True))
         mode = None if self.mode is None else by_kind[self.mode[0]][self.mode[1]]
-        return EndValues(by_kind, sources, mode, self.watched)
+        return EndValues(by_kind, source_keys, mode, self.watched)
 
 
 class EndValues:
@@ -307,27 +304,32 @@ class EndValues:
     ----------
     by_kind : dict of str to list
         The values by FMI type, in the order of the plan's value references.
-    sources : dict of str to float
-        The source outputs by ``"unit.variable"`` name, in their units.
+    source_keys : sequence of str
+        ``"unit.variable"`` names of the unit's source outputs: the first Reals.
     mode : float, int or None
         The unit's mode marker (``mode_change_time`` or ``mode_changes``), if read.
     watched : bool
         Whether the watched variables were read too.
     """
 
-    __slots__ = ("by_kind", "sources", "mode", "watched")
+    __slots__ = ("by_kind", "source_keys", "mode", "watched")
 
     def __init__(
         self,
         by_kind: dict[str, list[Any]],
-        sources: dict[str, float],
+        source_keys: Sequence[str],
         mode: float | int | None,
         watched: bool,
     ) -> None:
         self.by_kind = by_kind
-        self.sources = sources
+        self.source_keys = source_keys
         self.mode = mode
         self.watched = watched
+
+    def add_sources(self, into: dict[str, float]) -> None:
+        """Put the source outputs into ``into``, by ``"unit.variable"`` name, in their units."""
+        if self.source_keys:  # the sources come first among the Reals, the watched after
+            into.update(zip(self.source_keys, self.by_kind["Real"], strict=False))
 
 
 def read_plan(

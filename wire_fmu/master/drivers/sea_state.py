@@ -141,8 +141,8 @@ class SeaStateDriver:
         if isinstance(t, float):  # one time, every macro step: the sum as one dot product
             tau = float(t) - self.start_time
             weight, _ = _fade_scalar(tau, self.ramp_time)
-            wave = float(np.cos(self.angular_frequencies * tau + self.phases) @ self.amplitudes)
-            return float(self.heave_rao * weight * wave)
+            waves = np.cos(self.angular_frequencies * tau + self.phases) * self.amplitudes
+            return float(self.heave_rao * weight * float(np.add.reduce(waves)))
         weight, _ = _fade(t, self.start_time, self.ramp_time)
         wave = self._sum(t, np.cos, self.amplitudes)
         return _out(self.heave_rao * weight * wave, t)
@@ -150,9 +150,9 @@ class SeaStateDriver:
     def values_at(self, times: Sequence[float]) -> list[float]:
         """:meth:`value` at each of ``times`` (s), m: the same numbers, computed together.
 
-        The cosines of all times and components are evaluated in one call; each
-        time's sum is then the dot product :meth:`value` takes, so every value
-        is identical to it to the last bit.
+        The cosines of all times and components are evaluated in one call and
+        each time's row summed by numpy's pairwise sum, as :meth:`value` sums its
+        one row, so every value is identical to it to the last bit.
 
         Parameters
         ----------
@@ -164,13 +164,14 @@ class SeaStateDriver:
         list of float
             The heave at each time, m.
         """
-        taus = [float(t) - self.start_time for t in times]
-        waves = np.cos(np.multiply.outer(np.array(taus), self.angular_frequencies) + self.phases)
-        out = []
-        for tau, row in zip(taus, waves, strict=True):
-            weight, _ = _fade_scalar(tau, self.ramp_time)
-            out.append(float(self.heave_rao * weight * float(row @ self.amplitudes)))
-        return out
+        taus = np.array(times, dtype=float) - self.start_time
+        waves = np.cos(np.multiply.outer(taus, self.angular_frequencies) + self.phases)
+        sums = np.add.reduce(waves * self.amplitudes, axis=1).tolist()
+        rao, ramp_time = self.heave_rao, self.ramp_time
+        return [
+            rao * _fade_scalar(tau, ramp_time)[0] * wave
+            for tau, wave in zip(taus.tolist(), sums, strict=True)
+        ]
 
     def rate(self, t: float) -> float:
         """Heave velocity at ``t`` (s), m/s.
