@@ -202,9 +202,10 @@ class MacroStep:
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
         histories, end = self.histories, t + h
         push_all(histories, new, end)
-        switched = set()
+        switched, ends = set(), self._ends
         for name, before in self.mode_marks.items():
-            now = self._mode_mark(name)
+            end = ends.get(name)  # the marker as the unit's end-of-step read holds it, if valid
+            now = end.mode if end is not None and end.mode is not None else self._mode_mark(name)
             if now != before:
                 switched.add(name)
                 self.mode_marks[name] = now

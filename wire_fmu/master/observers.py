@@ -172,6 +172,9 @@ class CsvRecorder:
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
         self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
+        self._unpackers = [self._watch.unpacker(u) for u in self._read_units]
+        self._bond_names = list(sim.energy.bonds)
+        self._bonds = list(sim.energy.bonds.values())
         self._file = self.csv_path.open("w", newline="")
         self._writer = csv.writer(self._file)
         self._writer.writerow(self.columns)
@@ -256,11 +259,10 @@ class CsvRecorder:
         changed once made) and the bonds' energies (which change with every step).
         """
         taken = sim.watched_snapshots(self._watch, self._read_units)
-        bonds = sim.energy.bonds
-        created = [bond.created for bond in bonds.values()]
-        carried = [bond.carried for bond in bonds.values()]
-        power = [sim.bond_power[b] for b in bonds]
-        self._rows.append((sim.time, taken, created, carried, power))
+        bonds, power = self._bonds, sim.bond_power
+        created = [bond.created for bond in bonds]
+        carried = [bond.carried for bond in bonds]
+        self._rows.append((sim.time, taken, created, carried, [power[b] for b in self._bond_names]))
         if time.perf_counter() - self._written >= self.flush_every:
             self._write_rows()
         if self.interval is not None:
@@ -275,9 +277,8 @@ class CsvRecorder:
         t, taken, created, carried, power = row
         values: list[Any] = [t]
         ledger = 0.0
-        unpack = self._watch.unpack
-        for unit, at, kept in zip(self._read_units, self._ledger_of, taken, strict=True):
-            got = unpack(unit, kept)
+        for unpack, at, kept in zip(self._unpackers, self._ledger_of, taken, strict=True):
+            got = unpack(kept)
             values += got
             if at is not None:
                 ledger += float(got[at])

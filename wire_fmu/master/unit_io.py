@@ -234,6 +234,32 @@ class Watch:
         got = pick(taken.by_kind[kind])
         return [got] if single else list(got)
 
+    def unpacker(self, unit: str) -> Callable[[EndValues | list[Any]], list[Any]]:
+        """:meth:`unpack` for ``unit`` as one function (the recorder's, for every row).
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+
+        Returns
+        -------
+        callable
+            ``unpack(taken)``: the values of what :meth:`take` kept for ``unit``.
+        """
+        pickers = self._pickers  # placed when the reads are planned, maybe after this call
+
+        def unpack(taken: EndValues | list[Any]) -> list[Any]:
+            if type(taken) is list:
+                return taken
+            kind, pick, single = pickers[unit]
+            if pick is None:  # of several FMI types, or none: the general case
+                return self.unpack(unit, taken)
+            got = pick(taken.by_kind[kind])
+            return [got] if single else list(got)
+
+        return unpack
+
     def place(self, unit: str, places: list[_Place]) -> None:
         """Say where ``unit``'s watched variables sit in its end-of-step read.
 
