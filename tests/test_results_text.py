@@ -7,6 +7,7 @@ import io
 import math
 import random
 import struct
+from fractions import Fraction
 
 import numpy as np
 
@@ -66,3 +67,8 @@ def test_non_finite_numbers_are_spelt_as_float_reads_them():
 def test_numpy_scalars_are_written_as_their_values():
     rows = [[np.float64(0.1), np.float32(0.25), np.int64(7), np.float64(np.nan)]]
     assert _cells(number_lines(rows)) == [["0.1", "0.25", "7", "nan"]]
+
+
+def test_other_numbers_are_written_as_their_floats():
+    rows = [[Fraction(1, 4), np.array(2.5)], [Fraction(1, 2), np.array(math.inf)]]
+    assert _cells(number_lines(rows)) == [["0.25", "2.5"], ["0.5", "inf"]]

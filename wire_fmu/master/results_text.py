@@ -7,6 +7,9 @@ shortest text that reads back to the same bits, at about a fifth of the cost of
 
 from __future__ import annotations
 
+from numbers import Integral
+from typing import Any
+
 import orjson
 
 __all__ = ["number_lines"]
@@ -26,7 +29,8 @@ def number_lines(rows: list[list[float | int]]) -> str:
     Parameters
     ----------
     rows : list of list of float or int
-        The rows, each a list of numbers (Python or numpy scalars).
+        The rows, each a list of numbers (Python or numpy scalars; any other
+        number, such as a Fraction or a 0-d array, is written as its ``float``).
 
     Returns
     -------
@@ -35,13 +39,18 @@ def number_lines(rows: list[list[float | int]]) -> str:
     """
     if not rows:
         return ""
-    text = orjson.dumps(rows, option=_OPTIONS)  # b"[[1.0,2],[...]]"
+    text = orjson.dumps(rows, default=float, option=_OPTIONS)  # b"[[1.0,2],[...]]"
     if b"null" not in text:
         return text[2:-2].replace(b"],[", b"\r\n").decode("ascii") + "\r\n"
     lines = []
     for row in rows:
-        line = orjson.dumps(row, option=_OPTIONS)[1:-1].decode("ascii")
+        line = orjson.dumps(row, default=float, option=_OPTIONS)[1:-1].decode("ascii")
         if "null" in line:  # a non-finite number: repr spells it as float() reads it
-            line = ",".join(repr(float(v)) if isinstance(v, float) else str(v) for v in row)
+            line = ",".join(map(_repr, row))
         lines.append(line + "\r\n")
     return "".join(lines)
+
+
+def _repr(value: Any) -> str:
+    """A number's text as ``repr`` writes it: an integer's digits, else its float's."""
+    return str(int(value)) if isinstance(value, Integral) else repr(float(value))
