@@ -202,10 +202,9 @@ class MacroStep:
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
         histories, end = self.histories, t + h
         push_all(histories, new, end)
-        switched, ends = set(), self._ends
+        switched = set()
         for name, before in self.mode_marks.items():
-            end = ends.get(name)  # the marker as the unit's end-of-step read holds it, if valid
-            now = end.mode if end is not None and end.mode is not None else self._mode_mark(name)
+            now = self._mode_mark(name)
             if now != before:
                 switched.add(name)
                 self.mode_marks[name] = now

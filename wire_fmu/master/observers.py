@@ -172,7 +172,6 @@ class CsvRecorder:
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
         self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
-        self._unpackers = [self._watch.unpacker(u) for u in self._read_units]
         self._bond_names = list(sim.energy.bonds)
         self._bonds = list(sim.energy.bonds.values())
         self._file = self.csv_path.open("w", newline="")
@@ -277,8 +276,9 @@ class CsvRecorder:
         t, taken, created, carried, power = row
         values: list[Any] = [t]
         ledger = 0.0
-        for unpack, at, kept in zip(self._unpackers, self._ledger_of, taken, strict=True):
-            got = unpack(kept)
+        unpack = self._watch.unpack
+        for unit, at, kept in zip(self._read_units, self._ledger_of, taken, strict=True):
+            got = unpack(unit, kept)
             values += got
             if at is not None:
                 ledger += float(got[at])

@@ -300,8 +300,7 @@ class Simulation(UnitExchange, MacroStep):
             now_ns = next_ns
             self.time = now_ns / 1e9
             result.steps += 1
-            if upcoming is not None:  # none pending: none to fire
-                self._fire_events(self.time)
+            self._fire_events(self.time)
             for obs in self.observers:
                 obs.on_step(self)
             blow_up = self.energy.blow_up(self.time, h)

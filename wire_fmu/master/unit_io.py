@@ -225,7 +225,7 @@ class Watch:
         list of object
             Each variable's value, in its unit, in the order of :attr:`names`.
         """
-        if isinstance(taken, list):
+        if type(taken) is list:  # read now, not from the end-of-step read
             return taken
         kind, pick, single = self._pickers[unit]
         if pick is None:  # of several FMI types, or none
@@ -233,32 +233,6 @@ class Watch:
             return [by_kind[kind][position] for kind, position in self.places[unit]]
         got = pick(taken.by_kind[kind])
         return [got] if single else list(got)
-
-    def unpacker(self, unit: str) -> Callable[[EndValues | list[Any]], list[Any]]:
-        """:meth:`unpack` for ``unit`` as one function (the recorder's, for every row).
-
-        Parameters
-        ----------
-        unit : str
-            Instance name of the unit in the scene.
-
-        Returns
-        -------
-        callable
-            ``unpack(taken)``: the values of what :meth:`take` kept for ``unit``.
-        """
-        pickers = self._pickers  # placed when the reads are planned, maybe after this call
-
-        def unpack(taken: EndValues | list[Any]) -> list[Any]:
-            if type(taken) is list:
-                return taken
-            kind, pick, single = pickers[unit]
-            if pick is None:  # of several FMI types, or none: the general case
-                return self.unpack(unit, taken)
-            got = pick(taken.by_kind[kind])
-            return [got] if single else list(got)
-
-        return unpack
 
     def place(self, unit: str, places: list[_Place]) -> None:
         """Say where ``unit``'s watched variables sit in its end-of-step read.

@@ -138,7 +138,7 @@ class SeaStateDriver:
 
         Parameters and return as in :meth:`~wire_fmu.master.drivers.Driver.value`.
         """
-        if isinstance(t, float):  # one time, every macro step: the sum as one dot product
+        if isinstance(t, float):  # one time: the row summed as values_at sums each
             tau = float(t) - self.start_time
             weight, _ = _fade_scalar(tau, self.ramp_time)
             waves = np.cos(self.angular_frequencies * tau + self.phases) * self.amplitudes
