@@ -72,3 +72,18 @@ def test_numpy_scalars_are_written_as_their_values():
 def test_other_numbers_are_written_as_their_floats():
     rows = [[Fraction(1, 4), np.array(2.5)], [Fraction(1, 2), np.array(math.inf)]]
     assert _cells(number_lines(rows)) == [["0.25", "2.5"], ["0.5", "inf"]]
+
+
+def test_an_array_is_written_as_its_rows_as_lists_are():
+    values = _random_doubles(5_000, seed=17)
+    block = np.array(values).reshape(200, 25)
+    assert number_lines(block) == number_lines(block.tolist())
+    every_other_column = block[:, ::2]  # not C-ordered: orjson reads only C-ordered arrays
+    assert number_lines(every_other_column) == number_lines(every_other_column.tolist())
+    assert number_lines(np.empty((0, 3))) == ""
+
+
+def test_an_array_with_non_finite_numbers_is_written_as_its_rows_as_lists_are():
+    block = np.array([[0.0, 1.5], [1.0, math.nan], [2.0, math.inf], [3.0, -math.inf]])
+    assert number_lines(block) == number_lines(block.tolist())
+    assert [line[1] for line in _cells(number_lines(block))] == ["1.5", "nan", "inf", "-inf"]

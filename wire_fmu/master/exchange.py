@@ -69,11 +69,11 @@ class UnitExchange:
             self._inputs[name] = InputPlan(
                 links, driven, refs, reals, evented, write=slave.writer(refs)
             )
-            sources = self.source_vrs.get(name, [])
+            keys, refs = self.source_keys.get(name, []), self.source_vrs.get(name, [])
             mode = self.mode_markers.get(name)
             self._reads[name] = (
-                read_plan(name, slave, sources, mode),
-                read_plan(name, slave, sources, mode, self._watches),
+                read_plan(name, slave, keys, refs, mode),
+                read_plan(name, slave, keys, refs, mode, self._watches),
             )
 
     def watch(self, names: dict[str, list[str]], due) -> Watch:
@@ -263,7 +263,7 @@ class UnitExchange:
         slave.do_step(t, h)
         plain, watched = self._reads[unit]
         plan = watched if self._watching else plain
-        self._ends[unit] = plan.read(slave, self.source_keys.get(unit, ()))
+        self._ends[unit] = plan.read()
 
     def _mode_mark(self, unit: str) -> float | int:
         """The unit's mode marker now (see ``mode_markers``; from its end-of-step read if valid)."""

@@ -32,6 +32,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+import numpy as np
+
 from .column_units import (
     BOND_CHANNEL_UNITS,
     LEDGER_UNIT,
@@ -170,6 +172,7 @@ class CsvRecorder:
         self._ledger_of = [self._ledger_at.get(u) for u in self._read_units]
         kinds = [sim.slaves[u].variables[n].type for u, names in self._plan.items() for n in names]
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
+        self._all_reals = all(kind == "Real" for kind in kinds)
         self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
         self._bond_names = list(sim.energy.bonds)
@@ -259,9 +262,10 @@ class CsvRecorder:
         """
         taken = sim.watched_snapshots(self._watch, self._read_units)
         bonds, power = self._bonds, sim.bond_power
-        created = [bond.created for bond in bonds]
-        carried = [bond.carried for bond in bonds]
-        self._rows.append((sim.time, taken, created, carried, [power[b] for b in self._bond_names]))
+        cells = [bond.created for bond in bonds]  # the bonds' channels, in BOND_CHANNELS order
+        cells += [bond.carried for bond in bonds]
+        cells += [power[b] for b in self._bond_names]
+        self._rows.append((sim.time, taken, cells))
         if time.perf_counter() - self._written >= self.flush_every:
             self._write_rows()
         if self.interval is not None:
@@ -273,7 +277,7 @@ class CsvRecorder:
 
     def _values(self, row: tuple) -> list[Any]:
         """The cells of a recorded row: time, recorded variables, bond channels, ledger."""
-        t, taken, created, carried, power = row
+        t, taken, bond_cells = row
         values: list[Any] = [t]
         ledger = 0.0
         unpack = self._watch.unpack
@@ -282,27 +286,45 @@ class CsvRecorder:
             values += got
             if at is not None:
                 ledger += float(got[at])
-        values += created
-        values += carried
-        values += power
+        values += bond_cells
         if self._ledger_units:
             values.append(ledger)
         for i in self._converted:  # text and booleans as the file shows them
             values[i] = _cell(values[i])
         return values
 
+    def _block(self, rows: list[tuple]) -> np.ndarray:
+        """The cells of recorded rows as one array, a row each (every recorded variable a Real).
+
+        Column by column, as :meth:`_values` gives them row by row: the same
+        numbers, the units' ledgers summed in the same order.
+        """
+        unpack_rows = self._watch.unpack_rows
+        columns = [np.array([row[0] for row in rows])[:, None]]
+        ledger = np.zeros(len(rows))
+        for i, (unit, at) in enumerate(zip(self._read_units, self._ledger_of, strict=True)):
+            values = unpack_rows(unit, [row[1][i] for row in rows])
+            columns.append(values)
+            if at is not None:
+                ledger += values[:, at]
+        columns.append(np.array([row[2] for row in rows], dtype=float).reshape(len(rows), -1))
+        if self._ledger_units:
+            columns.append(ledger[:, None])
+        return np.hstack(columns)
+
     def _write_rows(self) -> None:
         """Write the rows recorded since the last write and flush the file.
 
         Rows of numbers only (no cell of theirs needs quoting) are written by
-        :func:`number_lines`; rows with text or booleans go through the csv module.
+        :func:`number_lines`, as one array when every recorded variable is a Real;
+        rows with text or booleans go through the csv module.
         """
-        rows = [self._values(row) for row in self._rows]
-        self._rows.clear()
-        if self._converted:
-            self._writer.writerows(rows)
+        rows, self._rows = self._rows, []
+        if rows and self._converted:
+            self._writer.writerows([self._values(row) for row in rows])
         elif rows:
-            self._file.write(number_lines(rows))
+            cells = self._block(rows) if self._all_reals else [self._values(r) for r in rows]
+            self._file.write(number_lines(cells))
         self._file.flush()
         self._written = time.perf_counter()
 

@@ -24,9 +24,11 @@ import ctypes
 import logging
 import os
 import time
+from array import array
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
 from typing import Any
 
@@ -53,14 +55,21 @@ __all__ = ["Slave", "StepRefusedError", "UnitFailedError", "FMI_STATUS", "value_
 logger = logging.getLogger(__name__)
 
 FMI_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
-_GETTERS = {kind: f"get{kind}" for kind in ("Real", "Integer", "Boolean", "String")}
 _C_TYPES = {"Real": fmi2Real, "Integer": fmi2Integer}
 """FMI types read every step into C arrays made once per list of value references."""
+_COPY_LIST = itemgetter(slice(None))
+"""A C array's values as a new list, made in C (``list()`` would iterate in Python)."""
 _clock = time.perf_counter
+
 _HOT_FUNCTIONS = ("fmi2SetReal", "fmi2GetReal", "fmi2GetInteger", "fmi2DoStep")
 """The C functions every macro step calls, taken from fmpy once per instantiation."""
 _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
+
+
+def _packed(values: Sequence[float]) -> bytes:
+    """Floats as native doubles, as a C double array holds them."""
+    return array("d", values).tobytes()
 
 
 @dataclass
@@ -274,26 +283,57 @@ class Slave(NamedValues):
             as bytes), as a new list.
         """
         refs = tuple(refs)
-        fn, ctype = _GETTERS.get(kind) or f"get{kind}", _C_TYPES.get(kind)
         if not refs:
             return list
-        if ctype is None:
-            return lambda: self._call(fn, list(refs))
-        n, native = len(refs), f"fmi2Get{kind}"
-        vrs, values = (fmi2ValueReference * n)(*refs), (ctype * n)()
+        if kind not in _C_TYPES:
+            return lambda: self._call(f"get{kind}", list(refs))
+        return self._prepared_get(kind, refs, _COPY_LIST, list)
+
+    def packed_reader(self, refs: Sequence[int]) -> Callable[[], bytes]:
+        """A get of the Reals ``refs`` made ready once, answering the values packed.
+
+        As :meth:`reader`, but the answer is the C array's bytes (``8 * len(refs)``,
+        native doubles): one copy and no float objects, for reads that are mostly
+        kept (the recorder turns many of them into one array without a loop).
+
+        Parameters
+        ----------
+        refs : sequence of int
+            Value references of Real variables (see :meth:`vr`).
+
+        Returns
+        -------
+        callable
+            ``read()``: the values, in the variables' units, as native doubles.
+        """
+        refs = tuple(refs)
+        if not refs:
+            return bytes
+        return self._prepared_get("Real", refs, bytes, _packed)
+
+    def _prepared_get(
+        self, kind: str, refs: tuple[int, ...], answer: Callable, through_fmpy: Callable
+    ) -> Callable[[], Any]:
+        """A get of ``refs`` (Reals or Integers) into a C array made once.
+
+        ``answer(array)`` makes the result from the C array; ``through_fmpy(values)``
+        from the list fmpy's wrapper gives when the C function is not at hand.
+        """
+        fn, native, n = f"get{kind}", f"fmi2Get{kind}", len(refs)
+        vrs, values = (fmi2ValueReference * n)(*refs), (_C_TYPES[kind] * n)()
         seconds, calls = self.seconds, self.calls
 
-        def read() -> list[Any]:
+        def read() -> Any:
             hot = self._hot
             if hot is None:  # not instantiated (raises), or an fmpy without C functions
-                return self._call(fn, list(refs))
+                return through_fmpy(self._call(fn, list(refs)))
             start = _clock()
             status = hot.functions[native](hot.component, vrs, n, values)
             seconds[fn] += _clock() - start
             calls[fn] += 1
             if status > 1:  # worse than fmi2Warning
                 raise self._failure(fn, status)
-            return values[:]  # a new list, made in C (list() would iterate in Python)
+            return answer(values)
 
         return read
 

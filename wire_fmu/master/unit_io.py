@@ -24,7 +24,11 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from operator import itemgetter
+from struct import Struct
+from types import MappingProxyType
 from typing import Any
+
+import numpy as np
 
 from .extrapolation import History
 from .manipulators import ScheduledEvents
@@ -168,6 +172,7 @@ class Watch:
     due: Callable[[float], bool]
     places: dict[str, list[_Place]] = field(default_factory=dict, repr=False)
     _pickers: dict[str, tuple[str, Callable | None, bool]] = field(default_factory=dict, repr=False)
+    _positions: dict[str, list[int]] = field(default_factory=dict, repr=False)
 
     def values(self, unit: str, slave: Slave, end: EndValues | None) -> list[Any]:
         """The watched variables of ``unit`` now, in the order of :attr:`names`.
@@ -229,10 +234,38 @@ class Watch:
             return taken
         kind, pick, single = self._pickers[unit]
         if pick is None:  # of several FMI types, or none
-            by_kind = taken.by_kind
-            return [by_kind[kind][position] for kind, position in self.places[unit]]
-        got = pick(taken.by_kind[kind])
+            return [taken.of_kind(kind)[position] for kind, position in self.places[unit]]
+        got = pick(taken.of_kind(kind))
         return [got] if single else list(got)
+
+    def unpack_rows(self, unit: str, taken: Sequence[EndValues | list[Any]]) -> np.ndarray:
+        """:meth:`unpack` of each of ``taken``, as the rows of one float array.
+
+        When every one is an end-of-step read and the watched variables are Reals,
+        their packed Reals are joined and read as one array: no float object is made.
+
+        Parameters
+        ----------
+        unit : str
+            Instance name of the unit in the scene.
+        taken : sequence of EndValues or list
+            What :meth:`take` returned for ``unit`` at several steps; every watched
+            variable a Real or an Integer.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(len(taken), len(names[unit]))``: the same numbers as
+            :meth:`unpack`, as floats.
+        """
+        kind = self._pickers[unit][0] if unit in self._pickers else ""
+        if kind == "Real" and taken and all(type(t) is EndValues for t in taken):
+            widths = {len(t.reals) for t in taken}  # one plan's reads, unless planned again
+            if len(widths) == 1:
+                reads = np.frombuffer(b"".join([t.reals for t in taken]), dtype=np.float64)
+                reads = reads.reshape(len(taken), -1)
+                return reads.take(self._positions[unit], axis=1)
+        return np.array([self.unpack(unit, t) for t in taken], dtype=float)
 
     def place(self, unit: str, places: list[_Place]) -> None:
         """Say where ``unit``'s watched variables sit in its end-of-step read.
@@ -247,11 +280,18 @@ class Watch:
         """
         self.places[unit] = places
         kinds = {kind for kind, _ in places}
+        positions = [position for _, position in places]
+        self._positions[unit] = positions
         if len(kinds) == 1:  # all of one type (the usual case): one C call picks them
-            positions = [position for _, position in places]
             self._pickers[unit] = (kinds.pop(), itemgetter(*positions), len(positions) == 1)
         else:
             self._pickers[unit] = ("", None, False)
+
+
+_NO_OTHERS: Mapping[str, list[Any]] = MappingProxyType({})
+"""The values of FMI types other than Real of a read that has only Reals (shared, read-only)."""
+_DOUBLE = Struct("d")
+"""One native double, as a C double array holds it."""
 
 
 @dataclass(frozen=True)
@@ -263,38 +303,53 @@ class ReadPlan:
     groups : tuple of (str, list of int)
         For each FMI type with something to read, its value references, Real
         first; the Reals start with the unit's source outputs, in order.
+    source_keys : tuple of str
+        ``"unit.variable"`` names of the unit's source outputs, the first Reals.
     mode : (str, int) or None
         Type and position of the unit's mode marker (its ``mode_change_time``, else
         its ``mode_changes`` counter), if the master watches one.
     watched : bool
         Whether the read includes the watched variables.
-    readers : tuple of (str, callable)
-        For each group, its type and its get made ready (:meth:`Slave.reader
-        <wire_fmu.master.slave.Slave.reader>`).
+    read_reals : callable
+        The get of the Reals made ready, answering them packed
+        (:meth:`Slave.packed_reader <wire_fmu.master.slave.Slave.packed_reader>`).
+    other_readers : tuple of (str, callable)
+        For each other FMI type read, the type and its get made ready
+        (:meth:`Slave.reader <wire_fmu.master.slave.Slave.reader>`).
     """
 
     groups: tuple[tuple[str, list[int]], ...]
+    source_keys: tuple[str, ...]
     mode: _Place | None
     watched: bool
-    readers: tuple[tuple[str, Callable[[], list[Any]]], ...]
+    read_reals: Callable[[], bytes]
+    other_readers: tuple[tuple[str, Callable[[], list[Any]]], ...]
+    unpack_sources: Callable[[bytes], tuple[float, ...]] = field(init=False, repr=False)
+    """The source outputs from the packed Reals."""
 
-    def read(self, slave: Slave, source_keys: Sequence[str]) -> EndValues:
-        """Read the plan's values from ``slave``, one call per FMI type.
+    def __post_init__(self) -> None:
+        unpack = Struct(f"{len(self.source_keys)}d").unpack_from
+        object.__setattr__(self, "unpack_sources", unpack)
 
-        Parameters
-        ----------
-        slave : Slave
-            The unit, just stepped.
-        source_keys : sequence of str
-            ``"unit.variable"`` names of its source outputs, in plan order.
+    def read(self) -> EndValues:
+        """Read the plan's values from the unit, just stepped: one call per FMI type.
 
         Returns
         -------
         EndValues
         """
-        by_kind = {kind: read() for kind, read in self.readers}
-        mode = None if self.mode is None else by_kind[self.mode[0]][self.mode[1]]
-        return EndValues(by_kind, source_keys, mode, self.watched)
+        reals = self.read_reals()
+        others = _NO_OTHERS
+        if self.other_readers:
+            others = {kind: read() for kind, read in self.other_readers}
+        mode = None
+        if self.mode is not None:
+            kind, position = self.mode
+            if kind == "Real":
+                mode = _DOUBLE.unpack_from(reals, 8 * position)[0]
+            else:
+                mode = others[kind][position]
+        return EndValues(self, reals, others, mode)
 
 
 class EndValues:
@@ -302,39 +357,52 @@ class EndValues:
 
     Parameters
     ----------
-    by_kind : dict of str to list
-        The values by FMI type, in the order of the plan's value references.
-    source_keys : sequence of str
-        ``"unit.variable"`` names of the unit's source outputs: the first Reals.
+    plan : ReadPlan
+        The read's plan.
+    reals : bytes
+        The Reals, packed as native doubles in the order of the plan's value
+        references: the source outputs first, the watched variables after.
+    others : mapping of str to list
+        The values of each other FMI type read, by type, in the plan's order.
     mode : float, int or None
         The unit's mode marker (``mode_change_time`` or ``mode_changes``), if read.
+
+    Attributes
+    ----------
     watched : bool
         Whether the watched variables were read too.
     """
 
-    __slots__ = ("by_kind", "source_keys", "mode", "watched")
+    __slots__ = ("plan", "reals", "others", "mode", "watched")
 
     def __init__(
         self,
-        by_kind: dict[str, list[Any]],
-        source_keys: Sequence[str],
+        plan: ReadPlan,
+        reals: bytes,
+        others: Mapping[str, list[Any]],
         mode: float | int | None,
-        watched: bool,
     ) -> None:
-        self.by_kind = by_kind
-        self.source_keys = source_keys
+        self.plan = plan
+        self.reals = reals
+        self.others = others
         self.mode = mode
-        self.watched = watched
+        self.watched = plan.watched
+
+    def of_kind(self, kind: str) -> Sequence[Any]:
+        """The values read of FMI type ``kind``, in the plan's order (Reals as floats)."""
+        return memoryview(self.reals).cast("d") if kind == "Real" else self.others[kind]
 
     def add_sources(self, into: dict[str, float]) -> None:
         """Put the source outputs into ``into``, by ``"unit.variable"`` name, in their units."""
-        if self.source_keys:  # the sources come first among the Reals, the watched after
-            into.update(zip(self.source_keys, self.by_kind["Real"], strict=False))
+        plan = self.plan
+        if plan.source_keys:  # as many values as keys by construction; strict= costs a dict
+            into.update(zip(plan.source_keys, plan.unpack_sources(self.reals)))  # noqa: B905
 
 
 def read_plan(
     unit: str,
     slave: Slave,
+    source_keys: Sequence[str],
     source_refs: Sequence[int],
     mode_output: str | None,
     watches: Sequence[Watch] = (),
@@ -347,8 +415,10 @@ def read_plan(
         Instance name of the unit in the scene.
     slave : Slave
         The unit.
+    source_keys : sequence of str
+        ``"unit.variable"`` names of its outputs that feed connections, in order.
     source_refs : sequence of int
-        Value references of its outputs that feed connections (Reals), in order.
+        Their value references (Reals), in the same order.
     mode_output : str or None
         Name of the unit's mode-change counter output, if it is read.
     watches : sequence of Watch
@@ -376,5 +446,6 @@ def read_plan(
     for watch in watches:
         watch.place(unit, [place(name) for name in watch.names.get(unit, ())])
     kept = tuple((kind, refs) for kind, refs in groups.items() if refs)
-    readers = tuple((kind, slave.reader(kind, refs)) for kind, refs in kept)
-    return ReadPlan(kept, mode, bool(watches), readers)
+    others = tuple((kind, slave.reader(kind, refs)) for kind, refs in kept if kind != "Real")
+    read_reals = slave.packed_reader(groups["Real"])
+    return ReadPlan(kept, tuple(source_keys), mode, bool(watches), read_reals, others)
