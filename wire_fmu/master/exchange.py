@@ -205,8 +205,12 @@ class UnitExchange:
             return
         held, values = self.held, []
         ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
-        for link in plan.links:
-            if link.position:
+        for link in plan.links:  # every history holds its latest value from initialisation on
+            if link.constant:  # held_value's first case, without the call: most links
+                value = fresh.get(link.key) if fresh else None
+                if value is None:
+                    value = link.history.points[-1][1]
+            elif link.position:
                 value = link.history.points[-1][1]  # the unit advances it with the held velocity
             elif link.ramp:
                 ramps = {} if ramps is None else ramps

@@ -172,7 +172,7 @@ class CsvRecorder:
         self._ledger_of = [self._ledger_at.get(u) for u in self._read_units]
         kinds = [sim.slaves[u].variables[n].type for u, names in self._plan.items() for n in names]
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
-        self._all_reals = all(kind == "Real" for kind in kinds)
+        self._integers = [i + 1 for i, kind in enumerate(kinds) if kind == "Integer"]
         self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
         self._bond_names = list(sim.energy.bonds)
@@ -294,10 +294,10 @@ class CsvRecorder:
         return values
 
     def _block(self, rows: list[tuple]) -> np.ndarray:
-        """The cells of recorded rows as one array, a row each (every recorded variable a Real).
+        """The cells of recorded rows as one float array, a row each (no text or booleans).
 
         Column by column, as :meth:`_values` gives them row by row: the same
-        numbers, the units' ledgers summed in the same order.
+        numbers (an Integer's as a float), the units' ledgers summed in the same order.
         """
         unpack_rows = self._watch.unpack_rows
         columns = [np.array([row[0] for row in rows])[:, None]]
@@ -312,19 +312,29 @@ class CsvRecorder:
             columns.append(ledger[:, None])
         return np.hstack(columns)
 
+    def _number_cells(self, rows: list[tuple]) -> np.ndarray | list[list[float | int]]:
+        """The cells of rows of numbers: an array, or lists when an Integer is written as one."""
+        block = self._block(rows)
+        if not self._integers:
+            return block
+        cells = block.tolist()
+        for i in self._integers:
+            for row in cells:
+                row[i] = int(row[i])
+        return cells
+
     def _write_rows(self) -> None:
         """Write the rows recorded since the last write and flush the file.
 
         Rows of numbers only (no cell of theirs needs quoting) are written by
-        :func:`number_lines`, as one array when every recorded variable is a Real;
-        rows with text or booleans go through the csv module.
+        :func:`number_lines`, put together as one array; rows with text or booleans
+        go through the csv module.
         """
         rows, self._rows = self._rows, []
         if rows and self._converted:
             self._writer.writerows([self._values(row) for row in rows])
         elif rows:
-            cells = self._block(rows) if self._all_reals else [self._values(r) for r in rows]
-            self._file.write(number_lines(cells))
+            self._file.write(number_lines(self._number_cells(rows)))
         self._file.flush()
         self._written = time.perf_counter()
 

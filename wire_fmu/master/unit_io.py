@@ -40,7 +40,7 @@ __all__ = ["EndValues", "InputPlan", "Link", "ReadPlan", "Watch", "read_plan"]
 _Place = tuple[str, int]  # (FMI type, position in that type's answer)
 
 
-@dataclass
+@dataclass(slots=True)
 class Link:
     """A connection as the master holds it over a step.
 
@@ -72,10 +72,14 @@ class Link:
     """The input it sets, ``"unit.variable"``."""
     position: bool = field(init=False)
     """Whether it is a bond's position link (held at the source's latest value)."""
+    constant: bool = field(init=False)
+    """Whether it is held ``constant`` (at its source's latest value, or its new one when
+    the source has stepped), and is neither a position nor a ramped link."""
 
     def __post_init__(self) -> None:
         self.target = str(self.connection.target)
         self.position = self.connection.role == "position"
+        self.constant = self.scheme == "constant" and not (self.position or self.ramp)
 
 
 @dataclass
@@ -172,7 +176,9 @@ class Watch:
     due: Callable[[float], bool]
     places: dict[str, list[_Place]] = field(default_factory=dict, repr=False)
     _pickers: dict[str, tuple[str, Callable | None, bool]] = field(default_factory=dict, repr=False)
-    _positions: dict[str, list[int]] = field(default_factory=dict, repr=False)
+    _columns: dict[str, dict[str, tuple[list[int], list[int]]]] = field(
+        default_factory=dict, repr=False
+    )  # by unit and FMI type: the watched variables' columns and their positions in the read
 
     def values(self, unit: str, slave: Slave, end: EndValues | None) -> list[Any]:
         """The watched variables of ``unit`` now, in the order of :attr:`names`.
@@ -234,15 +240,17 @@ class Watch:
             return taken
         kind, pick, single = self._pickers[unit]
         if pick is None:  # of several FMI types, or none
-            return [taken.of_kind(kind)[position] for kind, position in self.places[unit]]
+            read = {kind: taken.of_kind(kind) for kind in self._columns[unit]}
+            return [read[kind][position] for kind, position in self.places[unit]]
         got = pick(taken.of_kind(kind))
         return [got] if single else list(got)
 
     def unpack_rows(self, unit: str, taken: Sequence[EndValues | list[Any]]) -> np.ndarray:
         """:meth:`unpack` of each of ``taken``, as the rows of one float array.
 
-        When every one is an end-of-step read and the watched variables are Reals,
-        their packed Reals are joined and read as one array: no float object is made.
+        When every one is an end-of-step read of one plan, their packed Reals are
+        joined and read as one array (no float object is made), their Integers
+        stacked as one.
 
         Parameters
         ----------
@@ -258,13 +266,16 @@ class Watch:
             Shape ``(len(taken), len(names[unit]))``: the same numbers as
             :meth:`unpack`, as floats.
         """
-        kind = self._pickers[unit][0] if unit in self._pickers else ""
-        if kind == "Real" and taken and all(type(t) is EndValues for t in taken):
-            widths = {len(t.reals) for t in taken}  # one plan's reads, unless planned again
-            if len(widths) == 1:
-                reads = np.frombuffer(b"".join([t.reals for t in taken]), dtype=np.float64)
-                reads = reads.reshape(len(taken), -1)
-                return reads.take(self._positions[unit], axis=1)
+        columns = self._columns.get(unit, {})
+        if taken and columns and all(type(t) is EndValues for t in taken):
+            rows = np.empty((len(taken), len(self.places[unit])))
+            for kind, (at, positions) in columns.items():
+                read = _stacked(kind, taken)
+                if read is None:  # reads of different plans
+                    break
+                rows[:, at] = read[:, positions]
+            else:
+                return rows
         return np.array([self.unpack(unit, t) for t in taken], dtype=float)
 
     def place(self, unit: str, places: list[_Place]) -> None:
@@ -281,7 +292,13 @@ class Watch:
         self.places[unit] = places
         kinds = {kind for kind, _ in places}
         positions = [position for _, position in places]
-        self._positions[unit] = positions
+        self._columns[unit] = {
+            kind: (
+                [i for i, (k, _) in enumerate(places) if k == kind],
+                [position for k, position in places if k == kind],
+            )
+            for kind in kinds
+        }
         if len(kinds) == 1:  # all of one type (the usual case): one C call picks them
             self._pickers[unit] = (kinds.pop(), itemgetter(*positions), len(positions) == 1)
         else:
@@ -292,6 +309,22 @@ _NO_OTHERS: Mapping[str, list[Any]] = MappingProxyType({})
 """The values of FMI types other than Real of a read that has only Reals (shared, read-only)."""
 _DOUBLE = Struct("d")
 """One native double, as a C double array holds it."""
+
+
+def _stacked(kind: str, taken: Sequence[EndValues]) -> np.ndarray | None:
+    """The values of FMI type ``kind`` of several reads as the rows of one float array.
+
+    None when the reads are not all of the same length (of different plans).
+    """
+    if kind == "Real":
+        if len({len(t.reals) for t in taken}) != 1:
+            return None
+        joined = np.frombuffer(b"".join([t.reals for t in taken]), dtype=np.float64)
+        return joined.reshape(len(taken), -1)
+    lists = [t.others[kind] for t in taken]
+    if len({len(values) for values in lists}) != 1:
+        return None
+    return np.array(lists, dtype=float)
 
 
 @dataclass(frozen=True)
