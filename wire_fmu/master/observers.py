@@ -72,6 +72,9 @@ LEDGER_TERMS = ("stored_energy", "dissipated_energy", "external_work", "energy_b
 LEDGER_CHANNEL = "energy.units_balance"
 """Sum of the units' ``energy_balance`` outputs, J (each unit's own ledger)."""
 
+_WHOLE_NUMBERS = ("Integer", "Enumeration")
+"""FMI types whose values the file writes as their digits."""
+
 FLUSH_EVERY = 0.1
 """Longest wall-clock time recorded rows wait before they are written to the file, s.
 
@@ -172,7 +175,7 @@ class CsvRecorder:
         self._ledger_of = [self._ledger_at.get(u) for u in self._read_units]
         kinds = [sim.slaves[u].variables[n].type for u, names in self._plan.items() for n in names]
         self._converted = [i + 1 for i, kind in enumerate(kinds) if kind in ("String", "Boolean")]
-        self._integers = [i + 1 for i, kind in enumerate(kinds) if kind == "Integer"]
+        self._integers = [i + 1 for i, kind in enumerate(kinds) if kind in _WHOLE_NUMBERS]
         self.units = self._column_units(sim)
         self._watch = sim.watch(self._plan, self._due)
         self._bond_names = list(sim.energy.bonds)
