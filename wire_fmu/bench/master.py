@@ -1,8 +1,8 @@
 """What the master costs beyond the FMUs, and each shipped scene's real-time factor.
 
-Run ``python -m wire_fmu.bench.master [--stop-time S] [--repeats N] [--out FILE]``. Each
-shipped scene is run ``N`` times (default 3; the run of median overhead counts;
-shortened to ``--stop-time`` if given) with the
+Run ``python -m wire_fmu.bench.master [--stop-time S] [--repeats N] [--scenes NAME ...]
+[--out FILE]``. Each shipped scene (or each one named) is run ``N`` times (default 3;
+the run of median overhead counts; shortened to ``--stop-time`` if given) with the
 master; the time spent inside fmpy's calls to the FMUs is measured per call
 by the master itself (:class:`~wire_fmu.master.slave.Slave` counts every FMI
 call and its time), so
@@ -153,11 +153,22 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--repeats", type=int, default=3, help="runs per scene; the one of median overhead counts"
     )
+    shipped = list(shipped_scenes())
+    parser.add_argument(
+        "--scenes",
+        nargs="+",
+        choices=shipped,
+        default=shipped,
+        metavar="NAME",
+        help=f"scenes to run (default: all of {', '.join(shipped)})",
+    )
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be at least 1, got {args.repeats}")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name in shipped_scenes():
+        for name in args.scenes:
             runs = [measure(name, args.stop_time, Path(tmp) / str(i)) for i in range(args.repeats)]
             rows.append(sorted(runs, key=lambda r: r.overhead_us)[len(runs) // 2])
             logger.info(

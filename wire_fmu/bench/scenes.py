@@ -1,6 +1,7 @@
 """Every shipped scene with the compiled and the Python kernel, side by side, and start times.
 
-Run ``python -m wire_fmu.bench.scenes [--stop-time T] [--repeats N] [--out FILE]``.
+Run ``python -m wire_fmu.bench.scenes [--stop-time T] [--repeats N] [--scenes NAME ...]
+[--out FILE]``.
 
 For each shipped scene and each kernel (``WIRE_FMU_KERNEL``), the scene runs at
 its own settings (or up to ``--stop-time``) in a fresh interpreter, without
@@ -230,12 +231,21 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop-time", type=float, help="shorten every scene to this, s")
     parser.add_argument("--repeats", type=int, default=3, help="runs per kernel (median)")
-    parser.add_argument("--scenes", nargs="*", default=list(SCENES), help="scenes to run")
+    parser.add_argument(
+        "--scenes",
+        nargs="+",
+        choices=SCENES,
+        default=list(SCENES),
+        metavar="NAME",
+        help=f"scenes to run (default: all of {', '.join(SCENES)})",
+    )
     parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
     parser.add_argument(
         "--start-only", action="store_true", help="only the start of the first scene's command"
     )
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be at least 1, got {args.repeats}")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     stop = "own" if args.stop_time is None else str(args.stop_time)
     with tempfile.TemporaryDirectory() as tmp:
