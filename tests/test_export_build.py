@@ -203,3 +203,42 @@ def test_instantiation_fails_on_core_mismatch(tmp_path, caplog):
     with caplog.at_level(logging.ERROR), pytest.raises(CoreVersionError):
         Oscillator(instance_name="osc", resources=str(tmp_path))
     assert any("was built with wire_fmu" in r.getMessage() for r in caplog.records)
+
+
+# -- an FMU replaced whole ------------------------------------------------------------
+def test_a_build_that_fails_leaves_the_fmu_before_it_and_nothing_else(tmp_path, monkeypatch):
+    import wire_fmu.export.builder as builder
+
+    fmu = build_fmu(SUPPORT / "facades" / "oscillator.py", tmp_path)
+    before = fmu.read_bytes()
+
+    def broken(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(builder, "_finish", broken)
+    with pytest.raises(OSError, match="disk full"):
+        build_fmu(SUPPORT / "facades" / "oscillator.py", tmp_path)
+    assert fmu.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == [fmu.name]
+
+
+@pytest.mark.integration
+def test_two_builds_into_one_folder_at_once_leave_one_whole_fmu(tmp_path):
+    import subprocess
+    import sys
+    import zipfile
+
+    code = (
+        "import sys; from pathlib import Path; sys.path.insert(0, sys.argv[3]); "
+        "from wire_fmu.export.builder import build_fmu; "
+        "build_fmu(Path(sys.argv[1]), Path(sys.argv[2]), extra_modules=[Path(sys.argv[4])])"
+    )
+    script, out = SUPPORT / "facades" / "oscillator.py", tmp_path / "out"
+    units = SUPPORT / "wire_fmu_test_units.py"
+    arguments = [str(script), str(out), str(SUPPORT), str(units)]
+    builds = [subprocess.Popen([sys.executable, "-c", code, *arguments]) for _ in range(2)]
+    assert [b.wait(timeout=300) for b in builds] == [0, 0]
+    (fmu,) = out.iterdir()  # no partial file left beside it
+    with zipfile.ZipFile(fmu) as archive:
+        assert archive.testzip() is None
+        assert "modelDescription.xml" in archive.namelist()
