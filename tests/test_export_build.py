@@ -242,3 +242,22 @@ def test_two_builds_into_one_folder_at_once_leave_one_whole_fmu(tmp_path):
     with zipfile.ZipFile(fmu) as archive:
         assert archive.testzip() is None
         assert "modelDescription.xml" in archive.namelist()
+
+
+def test_a_rewrite_of_an_archive_that_fails_leaves_it_as_it_was(tmp_path):
+    import zipfile
+
+    from wire_fmu.export.fmu_archive import rewrite_zip
+
+    archive = tmp_path / "unit.fmu"
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.writestr("modelDescription.xml", b"<fmiModelDescription/>")
+    before = archive.read_bytes()
+    with pytest.raises(TypeError):
+        rewrite_zip(archive, {"resources/a.txt": b"a", "resources/b.txt": object()})
+    assert archive.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["unit.fmu"]
+    rewrite_zip(archive, {"resources/a.txt": b"a"})
+    with zipfile.ZipFile(archive) as zf:
+        assert zf.read("resources/a.txt") == b"a" and zf.testzip() is None
+    assert [p.name for p in tmp_path.iterdir()] == ["unit.fmu"]

@@ -6,6 +6,8 @@ configures a copy of a finished one.
 
 from __future__ import annotations
 
+import os
+import secrets
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -32,11 +34,16 @@ def rewrite_zip(
     drop : callable
         Whether to leave out an existing entry, by name.
     """
-    rewritten = archive.with_suffix(".tmp")
-    with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
-        for item in src.infolist():
-            if not drop(item.filename) and item.filename not in add:
-                dst.writestr(item, src.read(item.filename), zipfile.ZIP_DEFLATED)
-        for name, data in add.items():
-            dst.writestr(name, data, zipfile.ZIP_DEFLATED)
-    rewritten.replace(archive)
+    # a name of this rewrite's own (another process may rewrite a copy beside it), replaced
+    # in one step: a reader sees the archive before or after, never half of it
+    rewritten = archive.with_name(f".{archive.name}-{os.getpid()}-{secrets.token_hex(4)}.tmp")
+    try:
+        with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
+            for item in src.infolist():
+                if not drop(item.filename) and item.filename not in add:
+                    dst.writestr(item, src.read(item.filename), zipfile.ZIP_DEFLATED)
+            for name, data in add.items():
+                dst.writestr(name, data, zipfile.ZIP_DEFLATED)
+        os.replace(rewritten, archive)
+    finally:
+        rewritten.unlink(missing_ok=True)
