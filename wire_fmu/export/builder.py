@@ -17,7 +17,6 @@ import inspect
 import logging
 import os
 import re
-import secrets
 import shutil
 import sys
 import tempfile
@@ -287,13 +286,13 @@ def build_fmu(facade_script: Path, out_dir: Path, *, extra_modules: Iterable[Pat
             facade = _load_facade(script, staging.script)
             files = staging.project_files(_write_build_info(staging, facade))
             target = out_dir / f"{facade.unit_class.NAME}.fmu"
-            partial = _partial_path(target)
-            try:
+            # built and finished beside the FMU, then moved into place (as the binary is):
+            # a process loading it while another builds it reads the old one or the new one
+            with tempfile.TemporaryDirectory(prefix=".wire_fmu_build_", dir=out_dir) as own:
+                partial = Path(own) / target.name
                 FmuBuilder.build_FMU(staging.script, dest=partial, project_files=files)
                 _finish(partial, facade, staging.script.stem)
-                os.replace(partial, target)  # atomic: a concurrent reader sees all of it or none
-            finally:
-                partial.unlink(missing_ok=True)
+                os.replace(partial, target)
         finally:
             module_dir = str(staging.script.parent)
             sys.modules.pop(staging.script.stem, None)
@@ -301,13 +300,3 @@ def build_fmu(facade_script: Path, out_dir: Path, *, extra_modules: Iterable[Pat
                 sys.path.remove(module_dir)
     logger.debug("built %s from %s (module %s)", target, script, staging.script.stem)
     return target
-
-
-def _partial_path(target: Path) -> Path:
-    """A file name beside ``target``, this build's own, to build into before it replaces it.
-
-    Beside it, so that the final :func:`os.replace` stays on one file system and is atomic:
-    a process loading the FMU while another builds it (two runs started together on a
-    fresh checkout) reads the old archive or the new one, never half of one.
-    """
-    return target.with_name(f".{target.stem}-{os.getpid()}-{secrets.token_hex(4)}.fmu")

@@ -7,7 +7,7 @@ configures a copy of a finished one.
 from __future__ import annotations
 
 import os
-import secrets
+import tempfile
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -34,10 +34,10 @@ def rewrite_zip(
     drop : callable
         Whether to leave out an existing entry, by name.
     """
-    # a name of this rewrite's own (another process may rewrite a copy beside it), replaced
-    # in one step: a reader sees the archive before or after, never half of it
-    rewritten = archive.with_name(f".{archive.name}-{os.getpid()}-{secrets.token_hex(4)}.tmp")
-    try:
+    # written beside it under a name of its own, then moved into place in one step: a
+    # reader sees the archive before or after, never half of it
+    with tempfile.TemporaryDirectory(prefix=".wire_fmu_zip_", dir=archive.parent) as own:
+        rewritten = Path(own) / archive.name
         with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
             for item in src.infolist():
                 if not drop(item.filename) and item.filename not in add:
@@ -45,5 +45,3 @@ def rewrite_zip(
             for name, data in add.items():
                 dst.writestr(name, data, zipfile.ZIP_DEFLATED)
         os.replace(rewritten, archive)
-    finally:
-        rewritten.unlink(missing_ok=True)
