@@ -196,6 +196,18 @@ def test_a_results_folder_that_is_a_file_is_said_before_anything_runs(tmp_path, 
     assert code == 1 and "cannot be the results folder" in out and "Traceback" not in out
 
 
+def test_a_misspelt_kernel_choice_names_the_variable_through_the_units(
+    tmp_path, fmu_dir, capsys, monkeypatch
+):
+    """The units read ``WIRE_FMU_KERNEL`` inside the FMUs; the run's error still names it."""
+    monkeypatch.setenv("WIRE_FMU_KERNEL", "numba")
+    args = ["run", "-q", "--stop-time", "0.004", "-o", str(tmp_path / "out"), "riser_tensioner"]
+    code = cli(["--fmu-dir", str(fmu_dir), *args])
+    out = capsys.readouterr().out
+    assert code == 1 and "Traceback" not in out
+    assert "WIRE_FMU_KERNEL='numba' is not a kernel: expected one of compiled, python" in out
+
+
 def test_plot_files_never_overwrite_each_other_or_the_energy_plot():
     from wire_fmu.master.plots import _file_names
 

@@ -82,7 +82,10 @@ def kernel_choice() -> str:
     if value not in _CHOICES:
         raise KernelChoiceError(
             f"environment variable {KERNEL_ENV}",
-            [f"{os.environ[KERNEL_ENV]!r} is not a kernel: expected one of {', '.join(_CHOICES)}"],
+            [
+                f"{KERNEL_ENV}={os.environ[KERNEL_ENV]!r} is not a kernel: expected one of "
+                f"{', '.join(_CHOICES)}"
+            ],
         )
     return value
 
