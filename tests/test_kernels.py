@@ -206,6 +206,30 @@ def test_without_numba_units_fall_back_with_one_log_line(monkeypatch, caplog):
     assert lines == ["block train: numba is not installed; running the Python kernel"]
 
 
+def test_a_cache_folder_that_cannot_be_written_is_said_once_per_unit(
+    tmp_path, monkeypatch, caplog
+):
+    """numba would go on silently caching elsewhere (for an extracted FMU: anew every run);
+    the unit's log names the variable, the folder and why."""
+    (tmp_path / "a_file").write_text("")
+    monkeypatch.setenv(KERNEL_ENV, "compiled")
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "a_file" / "cache"))
+    problem = compiled.cache_problem()
+    assert problem is not None and compiled.CACHE_ENV in problem and "a_file" in problem
+    with caplog.at_level(logging.WARNING, logger=compiled.__name__):
+        assert use_compiled("block train") is compiled.numba_available()
+    lines = [r.getMessage() for r in caplog.records if r.name == compiled.__name__]
+    assert len(lines) == (1 if compiled.numba_available() else 0)
+    assert all(line.startswith(f"block train: {problem}") for line in lines)
+
+
+def test_a_writable_cache_folder_is_made_and_no_problem(tmp_path, monkeypatch):
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "new" / "cache"))
+    assert compiled.cache_problem() is None
+    assert (tmp_path / "new" / "cache").is_dir()
+    assert list((tmp_path / "new" / "cache").iterdir()) == []  # the probe file is gone
+
+
 def test_every_copy_of_the_sources_shares_one_cache(tmp_path, monkeypatch):
     """Two copies of the sources at different paths (as two extracted FMUs) have one cache
     folder, inside ``WIRE_FMU_CACHE_DIR``; a change of the kernel, or of the shared loop its

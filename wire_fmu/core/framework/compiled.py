@@ -27,6 +27,7 @@ import hashlib
 import logging
 import os
 import re
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -38,6 +39,7 @@ __all__ = [
     "CACHE_ENV",
     "KernelChoiceError",
     "cache_directory",
+    "cache_problem",
     "jit",
     "jit_inline",
     "kernel_choice",
@@ -91,7 +93,8 @@ def kernel_choice() -> str:
 
 
 def use_compiled(unit: str) -> bool:
-    """Whether ``unit`` should run compiled kernels now; logs once when it cannot.
+    """Whether ``unit`` should run compiled kernels now; logs once when it cannot, or when
+    their compiled code cannot be cached (:func:`cache_problem`).
 
     Parameters
     ----------
@@ -103,6 +106,14 @@ def use_compiled(unit: str) -> bool:
     if numba is None:
         logger.info("%s: numba is not installed; running the Python kernel", unit)
         return False
+    problem = cache_problem()
+    if problem:
+        logger.warning(
+            "%s: %s; compiled kernels are cached where numba chooses, for an FMU extracted to "
+            "a temporary folder inside it, so they are compiled afresh every run",
+            unit,
+            problem,
+        )
     return True
 
 
@@ -113,6 +124,24 @@ def cache_directory() -> Path:
         return Path(explicit)
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
     return Path(base) / "wire_fmu" / "numba"
+
+
+def cache_problem() -> str | None:
+    """Why compiled kernels cannot be cached in :func:`cache_directory`, or None.
+
+    The folder is made if missing and must take a new file. numba itself would
+    go on silently with another place (the source's ``__pycache__``, which for an
+    extracted FMU is a new temporary folder each run), so the units say it.
+    """
+    folder = cache_directory()
+    named = f"{CACHE_ENV}={folder}" if os.environ.get(CACHE_ENV) else f"the cache folder {folder}"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        return f"{named} cannot be written ({exc.strerror or exc})"
+    return None
 
 
 def _package_relative(py_file: str) -> str | None:
