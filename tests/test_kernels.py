@@ -206,10 +206,8 @@ def test_without_numba_units_fall_back_with_one_log_line(monkeypatch, caplog):
     assert lines == ["block train: numba is not installed; running the Python kernel"]
 
 
-def test_a_cache_folder_that_cannot_be_written_is_said_once_per_unit(
-    tmp_path, monkeypatch, caplog
-):
-    """numba would go on silently caching elsewhere (for an extracted FMU: anew every run);
+def test_a_cache_folder_that_cannot_be_written_is_said_once_per_unit(tmp_path, monkeypatch, caplog):
+    """Numba would go on silently caching elsewhere (for an extracted FMU: anew every run);
     the unit's log names the variable, the folder and why."""
     (tmp_path / "a_file").write_text("")
     monkeypatch.setenv(KERNEL_ENV, "compiled")
