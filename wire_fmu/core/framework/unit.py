@@ -398,14 +398,39 @@ class HeldInputsUnit(Unit):
         self.initial_energy = model.stored_energy()
         self._update_outputs()
 
+    _step_inputs: Any = None
+    """The inputs object of the step under way (see :meth:`advance`), else None."""
+
+    def advance(self, time: float, step: float) -> StepResult:
+        """:meth:`Unit.advance`, the inputs object built once for the step: the check of
+        the inputs and the integration take the same one.
+
+        Parameters
+        ----------
+        time : float
+            Start of the step, s.
+        step : float
+            Its length, s.
+        """
+        self._step_inputs = self._inputs()
+        try:
+            return super().advance(time, step)
+        finally:
+            self._step_inputs = None
+
+    def step_inputs(self) -> Any:
+        """The inputs object of the step under way, else one from :attr:`values` now."""
+        inputs = self._step_inputs
+        return self._inputs() if inputs is None else inputs
+
     def input_problems(self) -> list[str]:
         """Inputs the model cannot step with, as its inputs object names them."""
-        return self._inputs().problems()
+        return self.step_inputs().problems()
 
     def _advance(self, time: float, step: float) -> list[str]:
         """Integrate the model with the inputs held; its events as text."""
         model = self._require_model()
-        model.advance(time, step, self._inputs())
+        model.advance(time, step, self.step_inputs())
         return [f"t = {t:.9g} s: {text}" for t, text in model.last_events]
 
     @abstractmethod

@@ -488,14 +488,10 @@ class BlockTrainUnit(Unit):
         out["path_start.tension"] = tensions[0]
         out["path_end.tension"] = tensions[-1]
         out["tension_max"] = max(tensions) if tensions else 0.0
-        broken = m.broken_mask.tolist()
-        out["slack_spans"] = sum(
-            1 for taut, gone in zip(m.taut_mask.tolist(), broken, strict=True) if not (taut or gone)
-        )
-        out["broken"] = any(broken)
-        kinetic = 0.5 * sum(
-            mass * v * v for mass, v in zip(m.masses.tolist(), x[n : 2 * n], strict=True)
-        )
+        broken = m.broken_mask
+        out["slack_spans"] = len(broken) - int(np.count_nonzero(m.taut_mask | broken))
+        out["broken"] = bool(broken.any())
+        kinetic = 0.5 * float(m.masses @ m.v**2)  # as the model's stored_energy
         stored = kinetic + rope_energy + potential
         out["stored_energy"] = float(stored)
         out["dissipated_energy"] = x[2 * n]

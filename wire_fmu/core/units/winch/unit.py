@@ -165,7 +165,7 @@ class WinchUnit(HeldInputsUnit):
     def input_problems(self) -> list[str]:
         """Inputs the winch cannot step with (each named), also a rope model with a solver
         that integrates against a held tension only."""
-        inputs = self._inputs()
+        inputs = self.step_inputs()
         problems = inputs.problems()
         settings = getattr(self._require_model(), "settings", None)  # None: kinetostatic
         if inputs.rope_model.active and settings is not None and settings.method in ENERGY_SOLVERS:
