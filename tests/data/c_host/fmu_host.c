@@ -2,13 +2,16 @@
  * fmu_host: the smallest FMI 2.0 co-simulation host, in C, for checking that
  * a wire_fmu (pythonfmu) FMU runs outside Python.
  *
- *   fmu_host UNZIPPED_FMU_DIR VARIABLE [STEPS [STEP]]
+ *   fmu_host UNZIPPED_FMU_DIR VARIABLE [STEPS [STEP [thread]]]
  *
  * Reads modelIdentifier, guid and VARIABLE's valueReference from
  * UNZIPPED_FMU_DIR/modelDescription.xml (plain text search, enough for the
  * files our builder writes), dlopen()s binaries/linux64/<modelIdentifier>.so,
  * instantiates it, initialises it with its start values, takes STEPS steps
  * of STEP seconds (default 10 x 0.01 s) and prints "t value" after each.
+ * With "thread" the steps are taken on a thread of the host's own, as a C++
+ * master's worker threads take them, and the host then prints
+ * "thread_states N": how many Python thread states the interpreter holds.
  * Exit status 0 on success, 1 on any FMI error.
  *
  * The host leaves with _exit() and never dlclose()s the FMU: a pythonfmu
@@ -17,10 +20,11 @@
  * exits, and with numpy/scipy imported that finalisation can crash in the
  * garbage collector after all FMI work is done.
  *
- * Build (headers from FMPy): gcc -o fmu_host fmu_host.c -I<fmpy>/c-code -ldl
+ * Build (headers from FMPy): gcc -o fmu_host fmu_host.c -I<fmpy>/c-code -ldl -lpthread
  * Run with libpython preloaded, see docs/interop.md.
  */
 #include <dlfcn.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -83,22 +87,63 @@ static void *symbol(void *lib, const char *name)
     return f;
 }
 
+typedef struct {
+    fmi2DoStepTYPE *do_step;
+    fmi2GetRealTYPE *get_real;
+    fmi2Component c;
+    fmi2ValueReference vr;
+    int steps;
+    double step;
+    int failed;
+} Steps;
+
+/* Take the steps, printing "t value" after each; failed = 1 on an FMI error. */
+static void *take_steps(void *arg)
+{
+    Steps *s = arg;
+    double t = 0.0, value = 0.0;
+    int i;
+    for (i = 0; i < s->steps; i++) {
+        if (s->do_step(s->c, t, s->step, fmi2True) > fmi2Warning
+            || s->get_real(s->c, &s->vr, 1, &value) > fmi2Warning) {
+            fprintf(stderr, "fmu_host: step %d failed\n", i);
+            s->failed = 1;
+            return NULL;
+        }
+        t += s->step;
+        printf("%.17g %.17g\n", t, value);
+    }
+    return NULL;
+}
+
+/* Python thread states in the main interpreter (libpython's symbols, preloaded). */
+static int thread_states(void)
+{
+    void *(*main_interpreter)(void) = dlsym(RTLD_DEFAULT, "PyInterpreterState_Main");
+    void *(*head)(void *) = dlsym(RTLD_DEFAULT, "PyInterpreterState_ThreadHead");
+    void *(*next)(void *) = dlsym(RTLD_DEFAULT, "PyThreadState_Next");
+    int n = 0;
+    void *state;
+    if (!main_interpreter || !head || !next) return -1;
+    for (state = head(main_interpreter()); state; state = next(state)) n++;
+    return n;
+}
+
 int main(int argc, char **argv)
 {
     char path[4096], id[256], guid[256], vr_text[32], key[512], uri[4200];
     const char *dir, *variable, *where;
     char *xml;
     int steps = argc > 3 ? atoi(argv[3]) : 10;
-    double step = argc > 4 ? atof(argv[4]) : 0.01, t = 0.0, value = 0.0;
+    double step = argc > 4 ? atof(argv[4]) : 0.01;
     fmi2ValueReference vr;
     fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     void *lib;
     fmi2Component c;
-    int i;
 
     setvbuf(stdout, NULL, _IOLBF, 0);
     if (argc < 3) {
-        fprintf(stderr, "usage: fmu_host UNZIPPED_FMU_DIR VARIABLE [STEPS [STEP]]\n");
+        fprintf(stderr, "usage: fmu_host UNZIPPED_FMU_DIR VARIABLE [STEPS [STEP [thread]]]\n");
         return 2;
     }
     dir = argv[1];
@@ -147,14 +192,20 @@ int main(int argc, char **argv)
             fprintf(stderr, "fmu_host: initialisation failed\n");
             return 1;
         }
-        for (i = 0; i < steps; i++) {
-            if (do_step(c, t, step, fmi2True) > fmi2Warning
-                || get_real(c, &vr, 1, &value) > fmi2Warning) {
-                fprintf(stderr, "fmu_host: step %d failed\n", i);
-                return 1;
+        {
+            Steps s = {do_step, get_real, c, vr, steps, step, 0};
+            if (argc > 5 && strcmp(argv[5], "thread") == 0) {
+                pthread_t worker;
+                if (pthread_create(&worker, NULL, take_steps, &s) != 0
+                    || pthread_join(worker, NULL) != 0) {
+                    fprintf(stderr, "fmu_host: no thread\n");
+                    return 1;
+                }
+                if (!s.failed) printf("thread_states %d\n", thread_states());
+            } else {
+                take_steps(&s);
             }
-            t += step;
-            printf("%.17g %.17g\n", t, value);
+            if (s.failed) return 1;
         }
         terminate(c);
         free_instance(c);

@@ -30,6 +30,11 @@
  *    the end of the process, since finalising an interpreter from a
  *    library destructor races the host's own exit.
  *  - Messages are escaped for the logger's printf-style format.
+ *  - A host thread that has no Python thread state gets one on its first
+ *    call and keeps it (enter_python): PyGILState_Ensure alone makes and
+ *    frees a thread state, with its frame stack, on every call from such a
+ *    thread (every call of a C++ host's worker threads, libcosim's among
+ *    them). One thread state stays per host thread that ever called in.
  *
  * The binary is not linked against libpython: in a Python host the
  * interpreter's symbols are already loaded; a C host preloads libpython
@@ -65,6 +70,18 @@ typedef struct {
 } Component;
 
 static pthread_mutex_t start_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* Take the GIL, as PyGILState_Ensure (release with PyGILState_Release). A thread
+   without a Python thread state gets one that it keeps: a second Ensure, never
+   released, holds it, so that its later calls only take and release the GIL. */
+static PyGILState_STATE enter_python(void)
+{
+    int fresh = PyGILState_GetThisThreadState() == NULL;
+    PyGILState_STATE gil = PyGILState_Ensure();
+    if (fresh)
+        (void)PyGILState_Ensure();
+    return gil;
+}
 
 /* ------------------------------------------------------------------------- */
 /* logging                                                                    */
@@ -208,7 +225,7 @@ static PyObject *call(Component *c, const char *method, PyObject *args)
 static fmi2Status call_status(Component *c, const char *fmi_name, const char *method,
                               PyObject *args)
 {
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *result = call(c, method, args);
     fmi2Status status = result ? fmi2OK : exception_status(c, fmi_name);
     Py_XDECREF(result);
@@ -261,7 +278,7 @@ static int ensure_interpreter(void)
     if (!Py_IsInitialized()) {
         Py_InitializeEx(0);
         if (Py_IsInitialized())
-            PyEval_SaveThread(); /* release the GIL; every call takes it with PyGILState_Ensure */
+            PyEval_SaveThread(); /* release the GIL; every call takes it (enter_python) */
     }
     int ok = Py_IsInitialized();
     pthread_mutex_unlock(&start_lock);
@@ -391,7 +408,7 @@ static int create_facade(Component *c, const char *guid, int visible)
                        guid, built_guid);
         return 0;
     }
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *cls = facade_class(c->resources, module, cls_name);
     PyObject *instance = cls ? new_facade(c, cls, visible) : NULL;
     Py_XDECREF(cls);
@@ -475,7 +492,7 @@ void fmi2FreeInstance(fmi2Component handle)
     if (c == NULL)
         return;
     if (c->instance != NULL || c->strings != NULL) {
-        PyGILState_STATE gil = PyGILState_Ensure();
+        PyGILState_STATE gil = enter_python();
         Py_CLEAR(c->strings);
         Py_CLEAR(c->instance);
         PyGILState_Release(gil);
@@ -500,7 +517,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component handle, fmi2Boolean toleranceDefine
 {
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *stop = stopTimeDefined ? PyFloat_FromDouble(stopTime) : Py_NewRef(Py_None);
     PyObject *tol = toleranceDefined ? PyFloat_FromDouble(tolerance) : Py_NewRef(Py_None);
     PyObject *args = (stop && tol) ? Py_BuildValue("(dOO)", startTime, stop, tol) : NULL;
@@ -516,7 +533,7 @@ static fmi2Status call_no_arguments(fmi2Component handle, const char *fmi_name,
 {
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *args = PyTuple_New(0);
     PyGILState_Release(gil);
     return call_status(c, fmi_name, method, args);
@@ -541,7 +558,7 @@ fmi2Status fmi2Reset(fmi2Component handle)
 {
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *cls = Py_NewRef((PyObject *)Py_TYPE(c->instance));
     PyObject *fresh = new_facade(c, cls, 0);
     Py_DECREF(cls);
@@ -610,7 +627,7 @@ static fmi2Status get_values(Component *c, const char *fmi_name, const char *met
 {
     if (nvr == 0)
         return fmi2OK;
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     if (convert == to_string) {
         Py_CLEAR(c->strings);
         c->strings = PyList_New(0);
@@ -723,7 +740,7 @@ static fmi2Status set_all(fmi2Component handle, const char *fmi_name, const char
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, fmi_name, vr, nvr);
     REQUIRE_ARRAY(c, fmi_name, value, nvr);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *values = PyList_New((Py_ssize_t)nvr);
     for (size_t i = 0; values && i < nvr; ++i) {
         PyObject *item = convert(value, i);
@@ -769,7 +786,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component handle, fmi2FMUstate *FMUstate)
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, "fmi2GetFMUstate", FMUstate, 1);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *state = call(c, "_get_fmu_state", PyTuple_New(0));
     fmi2Status status = fmi2OK;
     if (state == NULL) {
@@ -787,7 +804,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component handle, fmi2FMUstate FMUstate)
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, "fmi2SetFMUstate", FMUstate, 1);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *args = PyTuple_Pack(1, (PyObject *)FMUstate);
     PyGILState_Release(gil);
     fmi2Status status = call_status(c, "fmi2SetFMUstate", "_set_fmu_state", args);
@@ -802,7 +819,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component handle, fmi2FMUstate *FMUstate)
     REQUIRE_COMPONENT(c);
     if (FMUstate == NULL || *FMUstate == NULL)
         return fmi2OK;
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     Py_DECREF((PyObject *)*FMUstate);
     *FMUstate = NULL;
     PyGILState_Release(gil);
@@ -833,7 +850,7 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component handle, fmi2FMUstate FMUstat
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, "fmi2SerializedFMUstateSize", FMUstate, 1);
     REQUIRE_ARRAY(c, "fmi2SerializedFMUstateSize", size, 1);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *bytes = state_bytes(c, "fmi2SerializedFMUstateSize", FMUstate);
     if (bytes != NULL)
         *size = (size_t)PyBytes_GET_SIZE(bytes);
@@ -849,7 +866,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component handle, fmi2FMUstate FMUstate,
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, "fmi2SerializeFMUstate", FMUstate, 1);
     REQUIRE_ARRAY(c, "fmi2SerializeFMUstate", serializedState, size);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *bytes = state_bytes(c, "fmi2SerializeFMUstate", FMUstate);
     fmi2Status status = bytes ? fmi2OK : fmi2Error;
     if (bytes != NULL && (size_t)PyBytes_GET_SIZE(bytes) != size) {
@@ -871,7 +888,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component handle, const fmi2Byte serializ
     REQUIRE_COMPONENT(c);
     REQUIRE_ARRAY(c, "fmi2DeSerializeFMUstate", serializedState, size);
     REQUIRE_ARRAY(c, "fmi2DeSerializeFMUstate", FMUstate, 1);
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *bytes = PyBytes_FromStringAndSize(serializedState, (Py_ssize_t)size);
     PyObject *state = call(c, "_fmu_state_from_bytes", bytes ? PyTuple_Pack(1, bytes) : NULL);
     Py_XDECREF(bytes);
@@ -931,7 +948,7 @@ fmi2Status fmi2DoStep(fmi2Component handle, fmi2Real currentCommunicationPoint,
     Component *c = component_of(handle);
     REQUIRE_COMPONENT(c);
     (void)noSetFMUStatePriorToCurrentPoint;
-    PyGILState_STATE gil = PyGILState_Ensure();
+    PyGILState_STATE gil = enter_python();
     PyObject *args = Py_BuildValue("(dd)", currentCommunicationPoint, communicationStepSize);
     PyObject *result = call(c, "do_step", args);
     fmi2Status status;
