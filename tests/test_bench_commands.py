@@ -42,12 +42,8 @@ def test_the_libcosim_benchmark_runs_both_masters_on_the_scenes_named(tmp_path):
 def test_the_libcosim_benchmark_runs_libcosims_algorithm():
     scene = bench_libcosim.jacobi_scene("drawworks", 1.0)
     run = scene.run
-    assert (run.algorithm, run.extrapolation, run.iterations, run.adaptive) == (
-        "jacobi",
-        "constant",
-        1,
-        False,
-    )
+    settings = (run.algorithm, run.extrapolation, run.iterations, run.adaptive, run.ramped_flows)
+    assert settings == ("jacobi", "constant", 1, False, False)
     assert run.stop_time == 1.0
 
 

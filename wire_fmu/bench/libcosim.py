@@ -4,7 +4,7 @@ Run ``python -m wire_fmu.bench.libcosim [--stop-time S] [--repeats N] [--scenes 
 [--out FILE]``. Each shipped scene (or each one named; shortened to ``--stop-time``,
 default 5 s) is run with libcosim's fixed-step algorithm in both masters: every unit
 steps on the values its partners gave at the step's start, held (our ``jacobi`` with
-``constant`` extrapolation, one sweep, fixed steps), as in
+``constant`` extrapolation, one sweep, fixed steps, no ramped flows), as in
 ``tests/test_interop_libcosim.py``, which shows that the two then compute the same
 numbers. libcosim (libcosimpy) runs the scene exported as an SSP package, whose
 drivers and events are one more FMU (the signals FMU). Neither records anything.
@@ -91,6 +91,7 @@ def jacobi_scene(name: str, stop_time: float) -> Scene:
         stop_time=min(scene.run.stop_time, stop_time),
         iterations=1,
         adaptive=False,
+        ramped_flows=False,  # an exported system holds every input (docs/interop.md)
     )
 
 
