@@ -221,6 +221,15 @@ def test_a_cache_folder_that_cannot_be_written_is_said_once_per_unit(tmp_path, m
     assert all(line.startswith(f"block train: {problem}") for line in lines)
 
 
+def test_the_cache_variable_takes_the_home_and_relative_paths(tmp_path, monkeypatch):
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.setenv(compiled.CACHE_ENV, "~/kernels")
+    assert compiled.cache_directory() == tmp_path / "home" / "kernels"
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(compiled.CACHE_ENV, "relative/kernels")
+    assert compiled.cache_directory() == tmp_path / "relative" / "kernels"
+
+
 def test_a_writable_cache_folder_is_made_and_no_problem(tmp_path, monkeypatch):
     monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "new" / "cache"))
     assert compiled.cache_problem() is None

@@ -118,10 +118,15 @@ def use_compiled(unit: str) -> bool:
 
 
 def cache_directory() -> Path:
-    """The folder compiled kernels are cached in (``WIRE_FMU_CACHE_DIR`` or the user cache)."""
+    """The folder compiled kernels are cached in (``WIRE_FMU_CACHE_DIR`` or the user cache).
+
+    A ``~`` in the variable is the user's home (as a shell would not expand it inside
+    quotes); a relative path is taken from the working folder, made absolute here, so
+    that a host changing its working folder later (to load a binary) keeps the cache.
+    """
     explicit = os.environ.get(CACHE_ENV)
     if explicit:
-        return Path(explicit)
+        return Path(explicit).expanduser().absolute()
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
     return Path(base) / "wire_fmu" / "numba"
 
