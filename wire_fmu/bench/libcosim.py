@@ -27,7 +27,6 @@ benchmark carries from one machine to another.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import statistics
 import tempfile
@@ -42,6 +41,7 @@ from wire_fmu.master.scene import Scene
 from wire_fmu.master.simulation import Simulation
 from wire_fmu.master.validate import validate_scene
 
+from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
 
 __all__ = ["MasterPair", "jacobi_scene", "measure", "table", "main"]
@@ -204,25 +204,13 @@ def main(argv: list[str] | None = None) -> None:
     argv : list of str, optional
         The arguments; None reads the command line.
     """
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--stop-time", type=float, default=5.0, help="simulated time, s")
-    parser.add_argument("--repeats", type=int, default=3, help="runs per master (median)")
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
-    shipped = list(shipped_scenes())
-    parser.add_argument(
-        "--scenes",
-        nargs="+",
-        choices=shipped,
-        default=shipped,
-        metavar="NAME",
-        help=f"scenes to run (default: all of {', '.join(shipped)})",
+    parser = scene_parser(
+        __doc__.splitlines()[0], list(shipped_scenes()), "runs per master (median)"
     )
-    args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats must be at least 1, got {args.repeats}")
+    parser.add_argument("--stop-time", type=float, default=5.0, help="simulated time, s")
+    args = parse_scene_options(parser, argv)
     if not args.stop_time > 0.0:
         parser.error(f"--stop-time must be above 0 s, got {args.stop_time}")
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.scenes:
@@ -234,10 +222,7 @@ def main(argv: list[str] | None = None) -> None:
                 rows[-1].theirs,
                 rows[-1].ratio,
             )
-    text = table(rows)
-    logger.info("\n%s", text)
-    if args.out:
-        args.out.write_text(text + "\n")
+    report_table(table(rows), args.out)
 
 
 if __name__ == "__main__":

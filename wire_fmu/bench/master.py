@@ -22,7 +22,6 @@ call and its time), so
 
 from __future__ import annotations
 
-import argparse
 import logging
 import tempfile
 from dataclasses import dataclass
@@ -31,6 +30,7 @@ from pathlib import Path
 from wire_fmu.master.observers import CsvRecorder
 from wire_fmu.master.run import run_scene, shipped_scenes
 
+from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
 
 logger = logging.getLogger(__name__)
@@ -147,25 +147,13 @@ def main(argv: list[str] | None = None) -> None:
     argv : list of str, optional
         The arguments; None reads the command line.
     """
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = scene_parser(
+        __doc__.splitlines()[0],
+        list(shipped_scenes()),
+        "runs per scene; the one of median overhead counts",
+    )
     parser.add_argument("--stop-time", type=float, help="shorten every scene to this, s")
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
-    parser.add_argument(
-        "--repeats", type=int, default=3, help="runs per scene; the one of median overhead counts"
-    )
-    shipped = list(shipped_scenes())
-    parser.add_argument(
-        "--scenes",
-        nargs="+",
-        choices=shipped,
-        default=shipped,
-        metavar="NAME",
-        help=f"scenes to run (default: all of {', '.join(shipped)})",
-    )
-    args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats must be at least 1, got {args.repeats}")
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    args = parse_scene_options(parser, argv)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.scenes:
@@ -180,10 +168,7 @@ def main(argv: list[str] | None = None) -> None:
                 rows[-1].recording_us,
                 rows[-1].setup_ms,
             )
-    text = table(rows)
-    logger.info("\n%s", text)
-    if args.out:
-        args.out.write_text(text + "\n")
+    report_table(table(rows), args.out)
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ with that cache filled (*warm*). FMUs are built before anything is timed.
 
 from __future__ import annotations
 
-import argparse
 import json
 import logging
 import os
@@ -29,6 +28,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wire_fmu.core.framework.compiled import CACHE_ENV, KERNEL_ENV
+
+from .scene_options import parse_scene_options, report_table, scene_parser
 
 __all__ = ["SceneFigures", "measure_scene", "start_times", "table", "main"]
 
@@ -228,25 +229,12 @@ def main(argv: list[str] | None = None) -> int:
     argv : list of str, optional
         Command-line arguments (default: ``sys.argv[1:]``).
     """
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = scene_parser(__doc__.splitlines()[0], SCENES, "runs per kernel (median)")
     parser.add_argument("--stop-time", type=float, help="shorten every scene to this, s")
-    parser.add_argument("--repeats", type=int, default=3, help="runs per kernel (median)")
-    parser.add_argument(
-        "--scenes",
-        nargs="+",
-        choices=SCENES,
-        default=list(SCENES),
-        metavar="NAME",
-        help=f"scenes to run (default: all of {', '.join(SCENES)})",
-    )
-    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
     parser.add_argument(
         "--start-only", action="store_true", help="only the start of the first scene's command"
     )
-    args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats must be at least 1, got {args.repeats}")
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    args = parse_scene_options(parser, argv)
     stop = "own" if args.stop_time is None else str(args.stop_time)
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -256,10 +244,7 @@ def main(argv: list[str] | None = None) -> int:
             figures.append(measure_scene(scene, stop, args.repeats, work))
             logger.info("%s: %.1fx", scene, figures[-1].ratio)
         starts = start_times(args.scenes[0], work, args.repeats)
-    text = table(figures, starts, args.scenes[0])
-    logger.info("\n%s", text)
-    if args.out:
-        args.out.write_text(text + "\n")
+    report_table(table(figures, starts, args.scenes[0]), args.out)
     return 0
 
 

@@ -1,0 +1,81 @@
+"""The command-line options the scene benchmarks share: which scenes, how many runs, where
+the table goes (:mod:`~wire_fmu.bench.master`, :mod:`~wire_fmu.bench.scenes`,
+:mod:`~wire_fmu.bench.libcosim`)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from collections.abc import Sequence
+from pathlib import Path
+
+__all__ = ["parse_scene_options", "report_table", "scene_parser"]
+
+logger = logging.getLogger(__name__)
+
+
+def scene_parser(
+    description: str, scenes: Sequence[str], repeats_help: str
+) -> argparse.ArgumentParser:
+    """A parser with ``--repeats N``, ``--scenes NAME ...`` and ``--out FILE``.
+
+    Parameters
+    ----------
+    description : str
+        What the command does (its help's first line).
+    scenes : sequence of str
+        The scenes it can run, in the order it runs them by default.
+    repeats_help : str
+        What ``--repeats`` counts (default 3).
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        For the command to add its own options to.
+    """
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--repeats", type=int, default=3, help=repeats_help)
+    parser.add_argument(
+        "--scenes",
+        nargs="+",
+        choices=list(scenes),
+        default=list(scenes),
+        metavar="NAME",
+        help=f"scenes to run (default: all of {', '.join(scenes)})",
+    )
+    parser.add_argument("--out", type=Path, help="also write the table (Markdown) here")
+    return parser
+
+
+def parse_scene_options(
+    parser: argparse.ArgumentParser, argv: list[str] | None
+) -> argparse.Namespace:
+    """The options, ``--repeats`` checked (an argparse error below 1); logging set up.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        From :func:`scene_parser`.
+    argv : list of str or None
+        The arguments; None reads the command line.
+    """
+    args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be at least 1, got {args.repeats}")
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    return args
+
+
+def report_table(text: str, out: Path | None) -> None:
+    """Log the Markdown table ``text``; write it to ``out`` too when given.
+
+    Parameters
+    ----------
+    text : str
+        The table.
+    out : Path or None
+        The file ``--out`` named.
+    """
+    logger.info("\n%s", text)
+    if out:
+        out.write_text(text + "\n")
