@@ -23,7 +23,8 @@ import numpy as np
 import pytest
 
 from wire_fmu.interop import export_osp, export_ssp
-from wire_fmu.master.run import shipped_scenes, with_run_settings
+from wire_fmu.interop.plan import as_fixed_step_host_runs_it
+from wire_fmu.master.run import shipped_scenes
 from wire_fmu.master.scene import load_scene
 
 from .interop_helpers import STEP, STOP, build_test_fmus, run_libcosim, run_ours, two_mass_scene
@@ -104,14 +105,7 @@ CROSS_CHECK_TIME = 2.0
 @pytest.mark.parametrize("name", sorted(SHIPPED) or ["none"])
 def test_libcosim_runs_each_shipped_scene_like_our_master(name, tmp_path):
     scene = load_scene(SHIPPED[name])
-    scene = with_run_settings(
-        scene,
-        algorithm="jacobi",
-        extrapolation="constant",
-        stop_time=min(scene.run.stop_time, CROSS_CHECK_TIME),
-        iterations=1,
-        adaptive=False,
-    )
+    scene = as_fixed_step_host_runs_it(scene, stop_time=min(scene.run.stop_time, CROSS_CHECK_TIME))
     fmu_dir = tmp_path / "fmus"
     path = export_ssp(scene, tmp_path / "ssp", fmu_dir=fmu_dir)
     names, ours = run_ours(scene)

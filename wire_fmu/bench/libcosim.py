@@ -3,8 +3,8 @@
 Run ``python -m wire_fmu.bench.libcosim [--stop-time S] [--repeats N] [--scenes NAME ...]
 [--out FILE]``. Each shipped scene (or each one named; shortened to ``--stop-time``,
 default 5 s) is run with libcosim's fixed-step algorithm in both masters: every unit
-steps on the values its partners gave at the step's start, held (our ``jacobi`` with
-``constant`` extrapolation, one sweep, fixed steps, no ramped flows), as in
+steps on the values its partners gave at the step's start, held
+(:data:`~wire_fmu.interop.plan.FIXED_STEP_HOST_RUN`), as in
 ``tests/test_interop_libcosim.py``, which shows that the two then compute the same
 numbers. libcosim (libcosimpy) runs the scene exported as an SSP package, whose
 drivers and events are one more FMU (the signals FMU). Neither records anything.
@@ -35,8 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wire_fmu.interop import export_ssp
+from wire_fmu.interop.plan import as_fixed_step_host_runs_it
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
-from wire_fmu.master.run import find_scene, load_scene_file, shipped_scenes, with_run_settings
+from wire_fmu.master.run import find_scene, load_scene_file, shipped_scenes
 from wire_fmu.master.scene import Scene
 from wire_fmu.master.simulation import Simulation
 from wire_fmu.master.validate import validate_scene
@@ -84,15 +85,7 @@ def jacobi_scene(name: str, stop_time: float) -> Scene:
         Simulated time, s (the scene's own if that is shorter).
     """
     scene = load_scene_file(find_scene(name))
-    return with_run_settings(
-        scene,
-        algorithm="jacobi",
-        extrapolation="constant",
-        stop_time=min(scene.run.stop_time, stop_time),
-        iterations=1,
-        adaptive=False,
-        ramped_flows=False,  # an exported system holds every input (docs/interop.md)
-    )
+    return as_fixed_step_host_runs_it(scene, stop_time=min(scene.run.stop_time, stop_time))
 
 
 def _ours(scene: Scene, fmu_dir: Path) -> tuple[float, float, float, int]:

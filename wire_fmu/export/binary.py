@@ -21,10 +21,10 @@ import shutil
 import subprocess
 import sys
 import sysconfig
-import tempfile
 from pathlib import Path
 
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.export.replaced_whole import replaced_whole
 
 __all__ = ["BinaryError", "SOURCE", "platform_folder", "compiled_binary"]
 
@@ -131,13 +131,11 @@ def compiled_binary(cache: Path) -> Path:
     if target.is_file():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix="wire_fmu_cc_", dir=target.parent) as tmp:
-        built = Path(tmp) / target.name
+    with replaced_whole(target) as built:  # a concurrent build sees all of it or none
         run = subprocess.run(_command(compiler, built), capture_output=True, text=True, check=False)
         if run.returncode != 0:
             raise BinaryError(
                 "FMU binary", [f"{compiler[0]} failed on {SOURCE.name}:\n{run.stderr.strip()}"]
             )
-        os.replace(built, target)  # atomic: a concurrent build sees all of it or none
     logger.info("compiled the FMU binary %s", target.name)
     return target

@@ -40,6 +40,7 @@ from wire_fmu.export.facade import CoreFacade
 from wire_fmu.export.fmu_archive import FACADE_FILE, MODEL_DESCRIPTION, rewrite_zip
 from wire_fmu.export.guard import BUILD_INFO_FILE, BuildInfo, imported_core
 from wire_fmu.export.model_description import check_units, patch_model_description
+from wire_fmu.export.replaced_whole import replaced_whole
 
 __all__ = ["BuildError", "build_fmu", "find_facade_class", "unique_module_name"]
 
@@ -286,13 +287,10 @@ def build_fmu(facade_script: Path, out_dir: Path, *, extra_modules: Iterable[Pat
             facade = _load_facade(script, staging.script)
             files = staging.project_files(_write_build_info(staging, facade))
             target = out_dir / f"{facade.unit_class.NAME}.fmu"
-            # built and finished beside the FMU, then moved into place (as the binary is):
-            # a process loading it while another builds it reads the old one or the new one
-            with tempfile.TemporaryDirectory(prefix=".wire_fmu_build_", dir=out_dir) as own:
-                partial = Path(own) / target.name
+            # a process loading the FMU while another builds it reads the old one or the new one
+            with replaced_whole(target) as partial:
                 FmuBuilder.build_FMU(staging.script, dest=partial, project_files=files)
                 _finish(partial, facade, staging.script.stem)
-                os.replace(partial, target)
         finally:
             module_dir = str(staging.script.parent)
             sys.modules.pop(staging.script.stem, None)

@@ -1,4 +1,5 @@
-"""What an FMU archive of ours holds where, and rewriting one (standard library only).
+"""What an FMU archive of ours holds where, and rewriting one (the standard library only,
+and :mod:`~wire_fmu.export.replaced_whole`).
 
 The builder finishes pythonfmu's archive with these; :mod:`wire_fmu.export.start_values`
 configures a copy of a finished one.
@@ -6,11 +7,11 @@ configures a copy of a finished one.
 
 from __future__ import annotations
 
-import os
-import tempfile
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
+
+from wire_fmu.export.replaced_whole import replaced_whole
 
 __all__ = ["FACADE_FILE", "MODEL_DESCRIPTION", "rewrite_zip"]
 
@@ -34,14 +35,11 @@ def rewrite_zip(
     drop : callable
         Whether to leave out an existing entry, by name.
     """
-    # written beside it under a name of its own, then moved into place in one step: a
-    # reader sees the archive before or after, never half of it
-    with tempfile.TemporaryDirectory(prefix=".wire_fmu_zip_", dir=archive.parent) as own:
-        rewritten = Path(own) / archive.name
+    # a reader sees the archive before or after, never half of it
+    with replaced_whole(archive) as rewritten:
         with zipfile.ZipFile(archive) as src, zipfile.ZipFile(rewritten, "w") as dst:
             for item in src.infolist():
                 if not drop(item.filename) and item.filename not in add:
                     dst.writestr(item, src.read(item.filename), zipfile.ZIP_DEFLATED)
             for name, data in add.items():
                 dst.writestr(name, data, zipfile.ZIP_DEFLATED)
-        os.replace(rewritten, archive)

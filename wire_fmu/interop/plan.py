@@ -27,15 +27,18 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
+from types import MappingProxyType, SimpleNamespace
 from typing import Any
 
 from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.master.catalog import DEFAULT_FMU_DIR
+from wire_fmu.master.run import with_run_settings
 from wire_fmu.master.scene import Bond, Connection, Scene, VarRef
 from wire_fmu.master.validate import Structure, unit_start_values, validate_scene
 
 __all__ = [
+    "FIXED_STEP_HOST_RUN",
+    "as_fixed_step_host_runs_it",
     "ExportError",
     "TypedValue",
     "PlannedUnit",
@@ -47,6 +50,19 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
+
+FIXED_STEP_HOST_RUN = MappingProxyType(
+    {
+        "algorithm": "jacobi",
+        "extrapolation": "constant",
+        "iterations": 1,
+        "adaptive": False,
+        "ramped_flows": False,
+    }
+)
+"""The run settings under which our master does what a fixed-step host (libcosim, FMPy's
+SSP runner) does with an exported scene: every unit steps on its partners' values at the
+step's start, held, once per fixed step (docs/interop.md)."""
 
 SIGNALS_UNIT = "signals"
 """Instance name of the generated signals unit (suffixed if a scene uses it)."""
@@ -326,6 +342,25 @@ def _metadata(scene: Scene) -> dict[str, Any]:
         "effects": {name: list(u.effects) for name, u in scene.units.items() if u.effects},
         "fmus": {name: u.fmu for name, u in scene.units.items()},
     }
+
+
+def as_fixed_step_host_runs_it(scene: Scene, **changes: Any) -> Scene:
+    """``scene`` with :data:`FIXED_STEP_HOST_RUN` and ``changes`` as its run settings.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    **changes
+        Further run settings by name, e.g. ``stop_time=5.0`` (s).
+
+    Returns
+    -------
+    Scene
+        What our master runs to compute what a fixed-step host computes from the
+        scene's export.
+    """
+    return with_run_settings(scene, **{**FIXED_STEP_HOST_RUN, **changes})
 
 
 def _warn_about_run_settings(scene: Scene) -> None:
