@@ -52,7 +52,8 @@ from __future__ import annotations
 import functools
 import logging
 import math
-from collections.abc import Mapping
+import operator
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
@@ -131,8 +132,8 @@ class CoreFacade(FacadeState, Fmi2Slave):
         self._initial_outputs_stale = True
         self._core_reals: dict[int, Variable] = {}  # value reference -> declared Real
         self._core_integers: dict[int, Variable] = {}  # value reference -> declared Integer
-        self._read_plans: dict[tuple[int, ...], tuple[tuple[str, ...], bool] | None] = {}
-        self._integer_plans: dict[tuple[int, ...], tuple[tuple[str, ...], bool] | None] = {}
+        self._read_plans: dict[tuple[int, ...], tuple[Callable, bool] | None] = {}
+        self._integer_plans: dict[tuple[int, ...], tuple[Callable, bool] | None] = {}
         self._write_plans: dict[tuple[int, ...], tuple[str, ...] | None] = {}
         for var in unit_class.variables():
             self._register(var)
@@ -336,22 +337,21 @@ class CoreFacade(FacadeState, Fmi2Slave):
             plan = plans[key] = self._read_plan(key, declared)
         if plan is None or self._phase is not Phase.step:
             return None
-        names, feedthrough = plan
+        take, feedthrough = plan
         if feedthrough and self._inputs_changed:
             return None
-        values = self.unit.values
-        return [kind(values[name]) for name in names]
+        return list(map(kind, take(self.unit.values)))
 
     def _read_plan(
         self, vrs: tuple[int, ...], declared: dict[int, Variable]
-    ) -> tuple[tuple[str, ...], bool] | None:
+    ) -> tuple[Callable[[Mapping[str, Any]], tuple], bool] | None:
         # None: not all declared variables of the unit, of one type (the generic path
-        # answers, or refuses)
+        # answers, or refuses); else what takes their values out of the unit's, in order
         found = [declared.get(vr) for vr in vrs]
         if not all(found):
             return None
         feedthrough = any(v.causality is Causality.output and v.depends_on for v in found)
-        return tuple(v.name for v in found), feedthrough
+        return _values_of(tuple(v.name for v in found)), feedthrough
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         """fmi2SetReal: set ``vrs`` to ``values``, in their declared units.
@@ -378,9 +378,7 @@ class CoreFacade(FacadeState, Fmi2Slave):
             and len(values) == len(names)
             and all(map(math.isfinite, values))
         ):
-            held = self.unit.values
-            for name, value in zip(names, values, strict=True):
-                held[name] = float(value)
+            self.unit.values.update(zip(names, map(float, values), strict=True))
             self._initial_outputs_stale = True
             self._inputs_changed = True
             return
@@ -489,3 +487,17 @@ class CoreFacade(FacadeState, Fmi2Slave):
         unit.values.update(values)
         unit.configure()
         self.unit = unit
+
+
+def _values_of(names: tuple[str, ...]) -> Callable[[Mapping[str, Any]], tuple]:
+    """What takes the values of ``names`` out of a mapping: a tuple, in their order.
+
+    :func:`operator.itemgetter` does it in C; it gives a bare value for one name and
+    takes none, so those two are wrapped.
+    """
+    if len(names) > 1:
+        return operator.itemgetter(*names)
+    if names:
+        name = names[0]
+        return lambda values: (values[name],)
+    return lambda values: ()

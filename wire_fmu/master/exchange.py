@@ -58,7 +58,8 @@ class UnitExchange:
     def _build_plans(self) -> None:
         """Each unit's batched set and end-of-step reads (after the observers' watches)."""
         for name, slave in self.slaves.items():
-            links = tuple(self.links_into.get(name, ()))
+            # the links held constant first: the batch takes their values in one go
+            links = tuple(sorted(self.links_into.get(name, ()), key=lambda k: not k.constant))
             driven = tuple(self.drivers.targets(name))
             variables = [slave.variables.get(n) for n in driven]
             reals = all(v is not None and v.type == "Real" for v in variables)
@@ -203,14 +204,12 @@ class UnitExchange:
         plan = self._inputs[unit]
         if plan.idle:
             return
-        held, values = self.held, []
+        held = self.held
+        values = plan.constant_values(fresh)  # most links
+        held.update(zip(plan.constant_targets, values, strict=True))
         ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
-        for link in plan.links:  # every history holds its latest value from initialisation on
-            if link.constant:  # held_value's first case, without the call: most links
-                value = fresh.get(link.key) if fresh else None
-                if value is None:
-                    value = link.history.points[-1][1]
-            elif link.position:
+        for link in plan.others:  # every history holds its latest value from initialisation on
+            if link.position:
                 value = link.history.points[-1][1]  # the unit advances it with the held velocity
             elif link.ramp:
                 ramps = {} if ramps is None else ramps

@@ -108,6 +108,13 @@ class InputPlan:
     ----------
     idle : bool
         Whether nothing sets an input of the unit during the run.
+    constant_keys, constant_targets : tuple of str
+        Source and target of each of the leading links that are held ``constant``
+        (:attr:`Link.constant`): set from their sources' values without a Python loop.
+    constant_points : tuple of deque
+        Their sources' histories' points.
+    others : tuple of Link
+        The links after them.
     """
 
     links: tuple[Link, ...]
@@ -121,9 +128,40 @@ class InputPlan:
     _event_values: list[float] = field(default_factory=list, repr=False)
     _event_others: dict[str, tuple[list[int], list[Any]]] = field(default_factory=dict, repr=False)
     idle: bool = field(init=False)
+    constant_keys: tuple[str, ...] = field(init=False)
+    constant_targets: tuple[str, ...] = field(init=False)
+    constant_points: tuple = field(init=False)
+    others: tuple[Link, ...] = field(init=False)
 
     def __post_init__(self) -> None:
         self.idle = not (self.links or self.driven or self.evented)
+        leading = 0
+        while leading < len(self.links) and self.links[leading].constant:
+            leading += 1
+        constant, self.others = self.links[:leading], self.links[leading:]
+        self.constant_keys = tuple(link.key for link in constant)
+        self.constant_targets = tuple(link.target for link in constant)
+        self.constant_points = tuple(link.history.points for link in constant)
+
+    def constant_values(self, fresh: Mapping[str, float] | None) -> list[float]:
+        """The values of the ``constant`` links: their sources' new values where ``fresh``
+        has them (the source stepped first), else their latest.
+
+        Parameters
+        ----------
+        fresh : mapping of str to float, or None
+            Source outputs at the step's end by ``"unit.variable"``.
+        """
+        if fresh:
+            values = list(map(fresh.get, self.constant_keys))
+            if None not in values:
+                return values
+            latest = self._latest()  # some sources have not stepped yet
+            return [y if v is None else v for v, y in zip(values, latest, strict=True)]
+        return self._latest()
+
+    def _latest(self) -> list[float]:
+        return list(map(_VALUE, map(_NEWEST, self.constant_points)))
 
     def event_inputs(
         self, slave: Slave, events: ScheduledEvents
@@ -308,6 +346,10 @@ class Watch:
 _NO_OTHERS: Mapping[str, list[Any]] = MappingProxyType({})
 """The values of FMI types other than Real of a read that has only Reals (shared, read-only)."""
 _DOUBLE = Struct("d")
+_NEWEST = itemgetter(-1)
+"""A history's newest point, ``(t, value)``."""
+_VALUE = itemgetter(1)
+"""A point's value."""
 """One native double, as a C double array holds it."""
 
 

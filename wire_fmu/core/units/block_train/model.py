@@ -34,7 +34,9 @@ The equations of motion are Lagrange's with the rope strain energy of
 
 from __future__ import annotations
 
+import itertools
 import math
+import operator
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -247,15 +249,18 @@ class BlockTrainModel(
 
     def _held(self, t: float, inputs: BlockTrainInputs) -> np.ndarray:
         """The held-input vector of the kernels (see :mod:`kernel`) for ``inputs`` from ``t``."""
-        lines = list(zip(LINE_PORTS, self._line_signs, strict=True))
-        held = [t]
-        held += [sign * inputs.payout.get(p, 0.0) for p, sign in lines]
-        held += [sign * inputs.payout_rate.get(p, 0.0) for p, sign in lines]
-        held += [inputs.mover_position.get(p, 0.0) for p in self.driver_ports]
-        held += [inputs.mover_velocity.get(p, 0.0) for p in self.driver_ports]
-        held += [sign * inputs.payout_acceleration.get(p, 0.0) for p, sign in lines]
-        held += [inputs.mover_acceleration.get(p, 0.0) for p in self.driver_ports]
-        return np.array(held)
+        signs, drivers, none = self._line_signs, self.driver_ports, itertools.repeat(0.0)
+        return np.array(
+            [
+                t,
+                *map(operator.mul, signs, map(inputs.payout.get, LINE_PORTS, none)),
+                *map(operator.mul, signs, map(inputs.payout_rate.get, LINE_PORTS, none)),
+                *map(inputs.mover_position.get, drivers, none),
+                *map(inputs.mover_velocity.get, drivers, none),
+                *map(operator.mul, signs, map(inputs.payout_acceleration.get, LINE_PORTS, none)),
+                *map(inputs.mover_acceleration.get, drivers, none),
+            ]
+        )
 
     def _hold(self, t: float, inputs: BlockTrainInputs, vector: np.ndarray) -> None:
         """Hold ``inputs`` (and their vector ``vector``, from :meth:`_held`) from ``t`` on."""

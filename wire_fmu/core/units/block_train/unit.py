@@ -21,8 +21,10 @@ those inputs; block positions and velocities are states and depend on none.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
+import operator
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
@@ -65,12 +67,26 @@ _KINEMATIC_INPUTS = tuple(
     + [f"{p}.position" for p in MOVER_PORTS]
     + [f"{p}.velocity" for p in MOVER_PORTS]
 )
-_LINE_INPUTS = tuple(
-    (p, f"{p}.payout", f"{p}.payout_rate", f"{p}.payout_acceleration") for p in LINE_PORTS
+_FIELD_INPUTS = (  # a field of BlockTrainInputs, its ports, the inputs' names after the port
+    ("payout", LINE_PORTS, "payout"),
+    ("payout_rate", LINE_PORTS, "payout_rate"),
+    ("payout_acceleration", LINE_PORTS, "payout_acceleration"),
+    ("mover_position", MOVER_PORTS, "position"),
+    ("mover_velocity", MOVER_PORTS, "velocity"),
+    ("mover_acceleration", MOVER_PORTS, "acceleration"),
 )
-_MOVER_INPUTS = tuple(
-    (p, f"{p}.position", f"{p}.velocity", f"{p}.acceleration") for p in MOVER_PORTS
+_TAKE_INPUTS = operator.itemgetter(*(f"{p}.{q}" for _, ports, q in _FIELD_INPUTS for p in ports))
+"""Every kinematic input's value, in the order of :data:`_FIELD_INPUTS`."""
+_INPUT_FIELDS = tuple(
+    (field, ports, slice(end - len(ports), end))
+    for (field, ports, _), end in zip(
+        _FIELD_INPUTS,
+        itertools.accumulate(len(ports) for _, ports, _ in _FIELD_INPUTS),
+        strict=True,
+    )
 )
+"""Each field of BlockTrainInputs, its ports and where their values sit in
+:data:`_TAKE_INPUTS`'s answer."""
 
 
 def _variables():
@@ -440,14 +456,9 @@ class BlockTrainUnit(Unit):
 
     # -------------------------------------------------------------- helpers
     def _inputs(self) -> BlockTrainInputs:
-        v = self.values
+        got = list(map(float, _TAKE_INPUTS(self.values)))
         return BlockTrainInputs(
-            payout={p: float(v[name]) for p, name, _, _ in _LINE_INPUTS},
-            payout_rate={p: float(v[rate]) for p, _, rate, _ in _LINE_INPUTS},
-            mover_position={p: float(v[name]) for p, name, _, _ in _MOVER_INPUTS},
-            mover_velocity={p: float(v[rate]) for p, _, rate, _ in _MOVER_INPUTS},
-            payout_acceleration={p: float(v[ramp]) for p, _, _, ramp in _LINE_INPUTS},
-            mover_acceleration={p: float(v[ramp]) for p, _, _, ramp in _MOVER_INPUTS},
+            **{field: dict(zip(ports, got[at], strict=True)) for field, ports, at in _INPUT_FIELDS}
         )
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:

@@ -139,7 +139,11 @@ class RefinedStepping:
         self.last_events = []
         self.first_event_time = math.inf
         self.force = float(force)
-        self.interface = replace(interface, start=float(t)) if interface.active else NO_INTERFACE
+        if not interface.active:
+            interface = NO_INTERFACE
+        elif interface.start != t:
+            interface = replace(interface, start=float(t))
+        self.interface = interface
         self.time = t
         self.step_report = None
         start = float(self.state[0])

@@ -317,8 +317,7 @@ class HydraulicsUnit(Unit):
         start : float
             The communication point ``t0`` the model is about, s.
         """
-        v = self.values
-        values = (float(v[name]) for name in INTERFACE_INPUTS)
+        values = map(float, map(self.values.__getitem__, INTERFACE_INPUTS))
         return RodInterface(*values, start=float(start))
 
     def _advance(self, time: float, step: float) -> list[str]:
