@@ -204,9 +204,10 @@ class UnitExchange:
         plan = self._inputs[unit]
         if plan.idle:
             return
-        held = self.held
-        values = plan.constant_values(fresh)  # most links
-        held.update(zip(plan.constant_targets, values, strict=True))
+        held, values = self.held, []
+        if plan.constant_keys:  # most links
+            values = plan.constant_values(fresh)
+            held.update(zip(plan.constant_targets, values, strict=True))
         ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
         for link in plan.others:  # every history holds its latest value from initialisation on
             if link.position:

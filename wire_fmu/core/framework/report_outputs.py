@@ -14,8 +14,9 @@ external work, J; zero while the books close) and ``mode_changes``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, MutableMapping
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, MutableMapping
+from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import Any
 
 from wire_fmu.core.framework.unit import MODE_CHANGE_TIME, Causality, Variable
@@ -47,6 +48,18 @@ class ReportOutputs:
 
     fields: tuple[tuple[str, str], ...]
     finite: tuple[str, ...] = ()
+    _names: tuple[str, ...] = field(init=False, repr=False, compare=False)
+    _take: Callable[[Any], tuple] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # the copy of every field in C (attrgetter): publish runs after every step
+        names = tuple(name for name, _ in self.fields)
+        take = attrgetter(*(f for _, f in self.fields)) if self.fields else (lambda r: ())
+        if len(self.fields) == 1:
+            one = take
+            take = lambda report: (one(report),)  # noqa: E731 - attrgetter of one: no tuple
+        object.__setattr__(self, "_names", names)
+        object.__setattr__(self, "_take", take)
 
     @classmethod
     def of(cls, variables: Iterable[Variable], finite: tuple[str, ...] = ()) -> ReportOutputs:
@@ -102,8 +115,7 @@ class ReportOutputs:
         FloatingPointError
             If an output named in :attr:`finite` is not finite (all are written first).
         """
-        for name, field in self.fields:
-            values[name] = getattr(report, field)
+        values.update(zip(self._names, self._take(report), strict=True))
         values["stored_energy"] = report.stored_energy
         values["dissipated_energy"] = report.dissipated_energy
         values["external_work"] = report.external_work
@@ -111,5 +123,5 @@ class ReportOutputs:
             report.stored_energy - initial_energy + report.dissipated_energy - report.external_work
         )
         values["mode_changes"] = int(mode_changes)
-        if not all(math.isfinite(values[name]) for name in self.finite):
+        if not all(map(math.isfinite, map(values.__getitem__, self.finite))):
             raise FloatingPointError(f"{who}: non-finite outputs")

@@ -521,14 +521,11 @@ class BlockTrainUnit(Unit):
         kept = getattr(self, "_interface", None)
         if kept is None or kept[0] is not m:
             plan = interface_plan(m)
-            names = [[f"{p}.{q}" for q in INTERFACE_QUANTITIES] for p in plan.names]
+            names = tuple(f"{p}.{q}" for p in plan.names for q in INTERFACE_QUANTITIES)
             kept = self._interface = (m, plan, names)
         _, plan, names = kept
-        out = self.values
-        table = linearisation_table(m, plan, self.time, m.state).tolist()
-        for port_names, row in zip(names, table, strict=True):
-            for name, value in zip(port_names, row, strict=True):
-                out[name] = value
+        table = linearisation_table(m, plan, self.time, m.state)  # a row per port
+        self.values.update(zip(names, table.ravel().tolist(), strict=True))
 
 
 class _BlockTrainOde(ModelOdeView):
