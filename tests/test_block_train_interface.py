@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS
-from wire_fmu.core.units.block_train.interface import port_linearisations
+from wire_fmu.core.units.block_train.interface import interface_plan, port_linearisations
 from wire_fmu.core.units.block_train.reevings import (
     drilling_block_train,
     riser_tensioner,
@@ -220,10 +220,28 @@ def test_every_port_declares_its_interface_model_and_its_switch():
     variables = {v.get("name"): v for v in root.find("ModelVariables")}
     for element in ports:
         assert element.get("interface") == "true"
-        assert element.get("interface_switch") == "interface_model"
+        switch = element.get("interface_switch")
+        assert switch == f"{element.get('name')}.interface_model"  # the port's own
+        assert variables[switch].get("causality") == "parameter"
         kind = element.get("kind")
         for quantity, unit in zip(INTERFACE_QUANTITIES, INTERFACE_UNITS[kind], strict=True):
             variable = variables[f"{element.get('name')}.{quantity}"]
             assert variable.get("causality") == "output"
             assert variable.find("Real").get("unit") == unit
     assert variables["interface_model"].get("causality") == "parameter"
+
+
+def test_a_ports_own_switch_publishes_its_model_alone():
+    """``mover_a.interface_model``, what the master sets for a bond that wires the rod's
+    model: the rod's port publishes it bit for bit as with every port's switched on, and
+    the ring's port, which no bond reads here, is not linearised at all."""
+    every = riser(True)
+    unit = riser_rope(False)
+    unit.values["mover_a.interface_model"] = True
+    assert unit.advance(0.0, 1e-4).success
+    for quantity in INTERFACE_QUANTITIES:
+        assert unit.values[f"mover_a.{quantity}"] == every.values[f"mover_a.{quantity}"]
+        assert unit.values[f"mover_b.{quantity}"] == 0.0
+        assert every.values[f"mover_b.{quantity}"] != 0.0 or quantity == "effort_rate"
+    assert interface_plan(unit.model, ("mover_a",)).names == ("mover_a",)
+    assert interface_plan(unit.model).names == ("mover_a", "mover_b")

@@ -37,6 +37,7 @@ force held). A compiled block train takes them all in one call
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import astuple, dataclass
 
 import numpy as np
@@ -208,9 +209,20 @@ class InterfacePlan:
     rows: np.ndarray
 
 
-def interface_plan(model) -> InterfacePlan:
-    """The ports ``model`` linearises (see :class:`InterfacePlan`)."""
+def interface_plan(model, ports: Collection[str] | None = None) -> InterfacePlan:
+    """The ports ``model`` linearises (see :class:`InterfacePlan`).
+
+    Parameters
+    ----------
+    model : BlockTrainModel
+        The block train.
+    ports : collection of str, optional
+        Only these of its ports (the others are not evaluated); None: every port the
+        reeving uses.
+    """
     slots = _slots(model)
+    if ports is not None:
+        slots = {name: slot for name, slot in slots.items() if name in ports}
     rows = [
         (
             s.position,

@@ -61,6 +61,8 @@ from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
 __all__ = ["BlockTrainUnit"]
 
+_INTERFACE_PORTS = LINE_PORTS + MOVER_PORTS
+"""The ports that can publish an interface model."""
 _KINEMATIC_INPUTS = tuple(
     [f"{p}.payout" for p in LINE_PORTS]
     + [f"{p}.payout_rate" for p in LINE_PORTS]
@@ -127,8 +129,19 @@ def _variables():
             "Publish each port's effort linearised about the state at the end of every step "
             "(stiffness, damping, effort_rate) and the port motion it was taken at "
             "(reference_position, reference_velocity), for a flow-side unit to integrate "
-            "against",
+            "against; <port>.interface_model publishes one port's",
             type=bool,
+        ),
+        *(
+            parameter(
+                f"{p}.interface_model",
+                False,
+                "",
+                f"Publish the interface model of port {p} alone (as interface_model does for "
+                "every port): the master sets it for a port whose bond wires the model",
+                type=bool,
+            )
+            for p in _INTERFACE_PORTS
         ),
     )
     inputs = []
@@ -169,29 +182,30 @@ def _variables():
                 f"{p}.stiffness",
                 "N/m",
                 f"-d {effort} / d position at {p} with the rope's state frozen "
-                "(with interface_model; else 0)",
+                "(with its interface_model; else 0)",
             ),
             output(
                 f"{p}.damping",
                 "N.s/m",
-                f"-d {effort} / d velocity at {p} (with interface_model; else 0)",
+                f"-d {effort} / d velocity at {p} (with its interface_model; else 0)",
             ),
             output(
                 f"{p}.effort_rate",
                 "N/s",
                 f"d {effort} / d t with {p} held still: the other inputs' share "
-                "(with interface_model; else 0)",
+                "(with its interface_model; else 0)",
             ),
             output(
                 f"{p}.reference_position",
                 "m",
                 f"{position} at {p} the {effort} was linearised at: the held input at the "
-                "step's end (with interface_model; else 0)",
+                "step's end (with its interface_model; else 0)",
             ),
             output(
                 f"{p}.reference_velocity",
                 "m/s",
-                f"{velocity} at {p} the {effort} was linearised at (with interface_model; else 0)",
+                f"{velocity} at {p} the {effort} was linearised at "
+                "(with its interface_model; else 0)",
             ),
         ]
     for p in BLOCK_PORTS:
@@ -231,8 +245,10 @@ def _variables():
     return params + tuple(inputs) + tuple(outputs)
 
 
-_INTERFACE = {"interface": True, "interface_switch": "interface_model"}
-"""Every port publishes its interface model when the parameter ``interface_model`` is set."""
+def _interface(port_name: str) -> dict[str, object]:
+    """A port's interface model and the parameter that switches it on for the port alone
+    (``interface_model`` switches every port's)."""
+    return {"interface": True, "interface_switch": f"{port_name}.interface_model"}
 
 
 class BlockTrainUnit(Unit):
@@ -252,7 +268,7 @@ class BlockTrainUnit(Unit):
                 "payout_rate",
                 "payout",
                 flow_ramp="payout_acceleration",
-                **_INTERFACE,
+                **_interface(n),
             )
             for n in LINE_PORTS
         ),
@@ -265,7 +281,7 @@ class BlockTrainUnit(Unit):
                 "velocity",
                 "position",
                 flow_ramp="acceleration",
-                **_INTERFACE,
+                **_interface(n),
             )
             for n in MOVER_PORTS
         ),
@@ -511,19 +527,28 @@ class BlockTrainUnit(Unit):
             stored - self.initial_energy + out["dissipated_energy"] - out["external_work"]
         )
         out["mode_changes"] = int(m.mode_changes)
-        if self.values["interface_model"]:
-            self._update_interface_outputs(m)
+        ports = self._interface_ports()
+        if ports:
+            self._update_interface_outputs(m, ports)
         if not (math.isfinite(out["stored_energy"]) and math.isfinite(out["tension_max"])):
             raise FloatingPointError(f"{self.instance_name}: non-finite outputs")
 
-    def _update_interface_outputs(self, m: BlockTrainModel) -> None:
-        """Each port's interface model (see :mod:`.interface`) into its outputs."""
+    def _interface_ports(self) -> tuple[str, ...]:
+        """The ports whose interface model is published: all with ``interface_model``, else
+        those whose own ``<port>.interface_model`` is set."""
+        v = self.values
+        every = v["interface_model"]
+        return tuple(p for p in _INTERFACE_PORTS if every or v[f"{p}.interface_model"])
+
+    def _update_interface_outputs(self, m: BlockTrainModel, ports: tuple[str, ...]) -> None:
+        """The interface model (see :mod:`.interface`) of each of ``ports`` the reeving
+        uses into its outputs; the other ports' are left as they are."""
         kept = getattr(self, "_interface", None)
-        if kept is None or kept[0] is not m:
-            plan = interface_plan(m)
+        if kept is None or kept[0] is not m or kept[1] != ports:
+            plan = interface_plan(m, ports)
             names = tuple(f"{p}.{q}" for p in plan.names for q in INTERFACE_QUANTITIES)
-            kept = self._interface = (m, plan, names)
-        _, plan, names = kept
+            kept = self._interface = (m, ports, plan, names)
+        _, _, plan, names = kept
         table = linearisation_table(m, plan, self.time, m.state)  # a row per port
         self.values.update(zip(names, table.ravel().tolist(), strict=True))
 
