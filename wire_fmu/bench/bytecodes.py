@@ -4,11 +4,14 @@ Run ``python -m wire_fmu.bench.bytecodes [--stop-time S] [--scenes NAME ...] [--
 [--out FILE]``. Each shipped scene (or each one named) is run once, shortened to
 ``--stop-time`` (default 1 s), with an observer that counts, from the start of the
 stepping loop to its end, every bytecode the interpreter executes (:func:`sys.settrace`
-with opcode events). Compiled kernels run no bytecodes, so the count is the
-interpreter's work alone, and it is the same on every machine and in every run: where
-wall-clock figures (:mod:`~wire_fmu.bench.master`) move by a quarter from run to run on a
-busy machine, this one moves only when the code does. Its cost in time is the machine's
-cost per bytecode (some tens of nanoseconds), which :mod:`~wire_fmu.bench.master` measures.
+with opcode events). The count is the interpreter's work alone, and it is the same on
+every machine and in every run: where wall-clock figures (:mod:`~wire_fmu.bench.master`)
+move by a quarter from run to run on a busy machine, this one moves only when the code
+does. It is not a time: calls into C run no bytecodes, however long they take -- the
+compiled kernels, numba unboxing their arguments and boxing their results, numpy on
+small arrays, the FMI crossings through ctypes and the FMU binary. A step's time follows
+its bytecodes only where the interpreter is most of it (the master's own loop: some tens
+of nanoseconds a bytecode); the units' doStep is mostly those calls.
 
 The count is split by where the code lives:
 
