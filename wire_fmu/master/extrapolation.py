@@ -58,6 +58,7 @@ class History:
 
     def __init__(self, size: int = 3) -> None:
         self.points: deque[tuple[float, float]] = deque(maxlen=size)
+        """Oldest first; changed in place, never replaced (input plans keep it)."""
 
     def push(self, t: float, value: float) -> None:
         """Record the value at an accepted step end.
