@@ -34,7 +34,6 @@ every macro step of a scene runs much the same code.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import math
 import sys
@@ -45,19 +44,9 @@ from pathlib import Path
 from types import CodeType, FrameType
 from typing import Any
 
-from wire_fmu.master.catalog import DEFAULT_FMU_DIR
-from wire_fmu.master.observers import CsvRecorder
-from wire_fmu.master.run import (
-    find_scene,
-    load_scene_file,
-    make_results_folder,
-    shipped_scenes,
-    with_run_settings,
-)
-from wire_fmu.master.simulation import Simulation
-from wire_fmu.master.validate import validate_scene
+from wire_fmu.master.run import run_scene, shipped_scenes
 
-from .scene_options import report_table
+from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
 
 __all__ = ["BytecodeCounter", "SceneBytecodes", "layer_of", "main", "measure", "short_file"]
@@ -252,15 +241,18 @@ def measure(name: str, stop_time: float, warm_up: float, out: Path) -> SceneByte
         Folder the scene's results go into (in a subfolder named after it).
     """
     counter = BytecodeCounter(warm_up)
-    scene = with_run_settings(load_scene_file(find_scene(name)), stop_time=stop_time)
-    directory = out / name
-    make_results_folder(directory)
     # Rows are written out every 0.1 s of wall-clock time, hundreds of them a batch in a
     # run at full speed but a few in a traced one: written at the end here instead, so
     # that the count does not depend on the clock (a batch's cost per row is numpy's).
-    recorder = CsvRecorder(directory, scene.run.output_interval, flush_every=math.inf)
-    sim = Simulation(scene, validate_scene(scene, Path(DEFAULT_FMU_DIR)), [recorder, counter])
-    result = sim.run()
+    outcome = run_scene(
+        name,
+        out / name,
+        plots=False,
+        observers=(counter,),
+        flush_every=math.inf,
+        stop_time=stop_time,
+    )
+    result = outcome.result
     if result.status != "finished":
         raise RuntimeError(f"{name}: {result.status}: {result.message}")
     by_layer: Counter[str] = Counter()
@@ -268,7 +260,8 @@ def measure(name: str, stop_time: float, warm_up: float, out: Path) -> SceneByte
     for (code, layer), count in counter.by_code.items():
         by_layer[layer] += count
         by_function[f"{short_file(code.co_filename)}:{code.co_name} ({layer})"] += count
-    return SceneBytecodes(name, len(sim.slaves), counter.steps, dict(by_layer), by_function)
+    units = len(outcome.simulation.slaves)
+    return SceneBytecodes(name, units, counter.steps, dict(by_layer), by_function)
 
 
 def short_file(filename: str) -> str:
@@ -338,16 +331,7 @@ def main(argv: list[str] | None = None) -> None:
     argv : list of str, optional
         The arguments; None reads the command line.
     """
-    scenes = list(shipped_scenes())
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--scenes",
-        nargs="+",
-        choices=scenes,
-        default=scenes,
-        metavar="NAME",
-        help=f"scenes to run (default: all of {', '.join(scenes)})",
-    )
+    parser = scene_parser(__doc__.splitlines()[0], list(shipped_scenes()), None)
     parser.add_argument(
         "--stop-time", type=float, default=1.0, help="simulated time per scene, s (default 1)"
     )
@@ -360,15 +344,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--top", type=int, default=0, help="also list each scene's N costliest functions"
     )
-    parser.add_argument("--out", type=Path, help="also write the tables (Markdown) here")
-    args = parser.parse_args(argv)
+    args = parse_scene_options(parser, argv)
     if not args.stop_time > 0.0:
         parser.error(f"--stop-time must be positive, got {args.stop_time}")
     if not 0.0 <= args.warm_up < 1.0:
         parser.error(f"--warm-up must be at least 0 and below 1, got {args.warm_up}")
     if args.top < 0:
         parser.error(f"--top must be at least 0, got {args.top}")
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
     with tempfile.TemporaryDirectory() as tmp:
         rows = [
             measure(name, args.stop_time, args.warm_up * args.stop_time, Path(tmp))

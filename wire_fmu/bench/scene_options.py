@@ -15,9 +15,10 @@ logger = logging.getLogger(__name__)
 
 
 def scene_parser(
-    description: str, scenes: Sequence[str], repeats_help: str
+    description: str, scenes: Sequence[str], repeats_help: str | None
 ) -> argparse.ArgumentParser:
-    """A parser with ``--repeats N``, ``--scenes NAME ...`` and ``--out FILE``.
+    """A parser with ``--repeats N`` (unless ``repeats_help`` is None), ``--scenes NAME ...``
+    and ``--out FILE``.
 
     Parameters
     ----------
@@ -25,8 +26,9 @@ def scene_parser(
         What the command does (its help's first line).
     scenes : sequence of str
         The scenes it can run, in the order it runs them by default.
-    repeats_help : str
-        What ``--repeats`` counts (default 3).
+    repeats_help : str or None
+        What ``--repeats`` counts (default 3); None: a command that runs each scene once
+        has no ``--repeats``.
 
     Returns
     -------
@@ -34,7 +36,8 @@ def scene_parser(
         For the command to add its own options to.
     """
     parser = argparse.ArgumentParser(description=description)
-    parser.add_argument("--repeats", type=int, default=3, help=repeats_help)
+    if repeats_help is not None:
+        parser.add_argument("--repeats", type=int, default=3, help=repeats_help)
     parser.add_argument(
         "--scenes",
         nargs="+",
@@ -50,7 +53,8 @@ def scene_parser(
 def parse_scene_options(
     parser: argparse.ArgumentParser, argv: list[str] | None
 ) -> argparse.Namespace:
-    """The options, ``--repeats`` checked (an argparse error below 1); logging set up.
+    """The options, ``--repeats`` (where there is one) checked (an argparse error below 1);
+    logging set up.
 
     Parameters
     ----------
@@ -60,7 +64,7 @@ def parse_scene_options(
         The arguments; None reads the command line.
     """
     args = parser.parse_args(argv)
-    if args.repeats < 1:
+    if getattr(args, "repeats", 1) < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return args

@@ -61,6 +61,7 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variabil
 
 import wire_fmu
 from wire_fmu.core.errors import WireFmuError
+from wire_fmu.core.framework.tuple_getter import tuple_getter
 from wire_fmu.core.framework.unit import Causality, Unit, Variability, Variable
 from wire_fmu.export.facade_calls import FacadeError, Phase, fmi_access, fmi_entry
 from wire_fmu.export.facade_state import STATE_FORMAT, FacadeState
@@ -351,7 +352,7 @@ class CoreFacade(FacadeState, Fmi2Slave):
         if not all(found):
             return None
         feedthrough = any(v.causality is Causality.output and v.depends_on for v in found)
-        return _values_of(tuple(v.name for v in found)), feedthrough
+        return tuple_getter(operator.itemgetter, [v.name for v in found]), feedthrough
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         """fmi2SetReal: set ``vrs`` to ``values``, in their declared units.
@@ -487,17 +488,3 @@ class CoreFacade(FacadeState, Fmi2Slave):
         unit.values.update(values)
         unit.configure()
         self.unit = unit
-
-
-def _values_of(names: tuple[str, ...]) -> Callable[[Mapping[str, Any]], tuple]:
-    """What takes the values of ``names`` out of a mapping: a tuple, in their order.
-
-    :func:`operator.itemgetter` does it in C; it gives a bare value for one name and
-    takes none, so those two are wrapped.
-    """
-    if len(names) > 1:
-        return operator.itemgetter(*names)
-    if names:
-        name = names[0]
-        return lambda values: (values[name],)
-    return lambda values: ()

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .catalog import DEFAULT_FMU_DIR
-from .observers import CsvRecorder, Progress
+from .observers import FLUSH_EVERY, CsvRecorder, Progress
 from .results_frame import IncompleteResultsWarning, ResultsError, read_results_frame
 from .run_result import RunResult
 from .scene import Scene, SceneError, read_scene
@@ -230,6 +230,7 @@ def run_scene(
     plots: bool = True,
     fmu_dir: str | Path = DEFAULT_FMU_DIR,
     observers=(),
+    flush_every: float = FLUSH_EVERY,
     **run_overrides,
 ) -> Outcome:
     """Validate and run a scene; write results (and plots) to ``results``.
@@ -248,6 +249,9 @@ def run_scene(
         Where our FMUs are built and cached.
     observers : sequence
         More observers (see :class:`~wire_fmu.master.observers.Observer`).
+    flush_every : float
+        Longest wall-clock time recorded rows wait before they are written, s
+        (:class:`~wire_fmu.master.observers.CsvRecorder`; ``math.inf``: at the end).
     **run_overrides
         Replace run settings of the scene, e.g. ``stop_time=5.0`` for a quick run.
 
@@ -264,7 +268,7 @@ def run_scene(
     make_results_folder(directory)
     with WarningLog() as said:
         structure = validate_scene(scene, Path(fmu_dir))
-        recorder = CsvRecorder(directory, scene.run.output_interval)
+        recorder = CsvRecorder(directory, scene.run.output_interval, flush_every)
         chain = [recorder, *observers] + ([Progress()] if progress else [])
         sim = Simulation(scene, structure, chain)
         result = sim.run()

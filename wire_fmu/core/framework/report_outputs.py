@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from operator import attrgetter
 from typing import Any
 
+from wire_fmu.core.framework.tuple_getter import tuple_getter
 from wire_fmu.core.framework.unit import MODE_CHANGE_TIME, Causality, Variable
 
 __all__ = ["ReportOutputs", "LEDGER_OUTPUTS"]
@@ -54,10 +55,7 @@ class ReportOutputs:
     def __post_init__(self) -> None:
         # the copy of every field in C (attrgetter): publish runs after every step
         names = tuple(name for name, _ in self.fields)
-        take = attrgetter(*(f for _, f in self.fields)) if self.fields else (lambda r: ())
-        if len(self.fields) == 1:
-            one = take
-            take = lambda report: (one(report),)  # noqa: E731 - attrgetter of one: no tuple
+        take = tuple_getter(attrgetter, [f for _, f in self.fields])
         object.__setattr__(self, "_names", names)
         object.__setattr__(self, "_take", take)
 
