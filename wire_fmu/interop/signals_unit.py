@@ -32,7 +32,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from wire_fmu.core.framework.unit import StepResult, Unit, output, parameter
+from wire_fmu.core.framework.unit import STEP_TAKEN, StepResult, Unit, output, parameter
 
 __all__ = ["make_unit_class", "MODES", "EVENT_TOLERANCE"]
 
@@ -134,7 +134,7 @@ class SignalsUnit(Unit):
         Parameters as in :meth:`wire_fmu.core.framework.unit.Unit.advance`.
         """
         self._publish(time + step)
-        return StepResult(True)
+        return STEP_TAKEN
 
     def _publish(self, t: float) -> None:
         h = float(self.values["step"])

@@ -49,6 +49,7 @@ __all__ = [
     "Variability",
     "Variable",
     "StepResult",
+    "STEP_TAKEN",
     "Unit",
     "parameter",
     "input_",
@@ -118,6 +119,10 @@ class StepResult:
     success: bool
     message: str = ""
     events: tuple[str, ...] = field(default=())
+
+
+STEP_TAKEN = StepResult(True)
+"""A step taken without events (a frozen result: one serves every such step)."""
 
 
 class Unit(ABC):
@@ -252,7 +257,7 @@ class Unit(ABC):
             return StepResult(
                 False, f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
             )
-        return StepResult(True, events=tuple(events))
+        return StepResult(True, events=tuple(events)) if events else STEP_TAKEN
 
     def _note_mode_change_time(self, time: float, step: float) -> None:
         """Write when the mode changed in the step just taken from ``time`` (s): the model's

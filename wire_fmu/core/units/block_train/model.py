@@ -608,8 +608,20 @@ class BlockTrainModel(
         """
         t = self._t_step if t is None else t
         rope_energy, potential, _, _ = self.summary(t, self.state)
-        kinetic = 0.5 * float(self.masses @ self.v**2)
-        return kinetic + rope_energy + potential
+        return self.kinetic_energy(self.state.tolist()) + rope_energy + potential
+
+    def kinetic_energy(self, x: list[float]) -> float:
+        """Kinetic energy of the coordinates' masses at state ``x``, J.
+
+        Parameters
+        ----------
+        x : list of float
+            The state ``[q, v, dissipated, external work]`` as a list (m, m/s, J, J): a
+            sum over a few floats costs less in Python than a numpy call on them.
+        """
+        n = self.n_coords
+        v = x[n : 2 * n]
+        return 0.5 * sum(map(operator.mul, self.masses.tolist(), map(operator.mul, v, v)))
 
 
 def _floor_contact(floor, position: float, velocity: float):

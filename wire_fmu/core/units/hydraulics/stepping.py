@@ -72,6 +72,9 @@ CUSHION_CHUNK_STEPS = 8
 """In a cushion the step is re-chosen (and the Jacobian refreshed) every this many steps."""
 
 _FIXED_STEP = ("rk4", "ros2")
+_NO_WORK = np.zeros(1)
+"""The interface model's work at a step's start, J (read only: copied into the state)."""
+_NO_WORK.flags.writeable = False
 
 
 class RefinedStepping:
@@ -151,7 +154,7 @@ class RefinedStepping:
             events = self._step(t, t + h)
             self.external_work += self.force * (float(self.state[0]) - start)
             return events
-        self.state = np.append(self.state, 0.0)  # the interface model's work, J
+        self.state = np.concatenate((self.state, _NO_WORK))  # the interface model's work, J
         self.use_layout(self.interface_layout)
         try:
             events = self._step(t, t + h)

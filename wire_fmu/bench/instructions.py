@@ -1,0 +1,434 @@
+"""What a macro step costs in machine instructions, counted by valgrind's callgrind.
+
+Run ``python -m wire_fmu.bench.instructions [--stop-time S] [--warm-up F]
+[--scenes NAME ...] [--out FILE]``. The scenes (each shipped one, or each one named)
+run one after another in one Python process under ``valgrind --tool=callgrind``,
+each shortened to ``--stop-time`` (default 1 s). Counting is off while the process
+starts and loads its units, and on from the first macro step after the warm-up
+(``--warm-up``, a fraction of the run, default 0.4) to the end of the stepping loop;
+an observer of the run switches it with callgrind's client requests (a small C library
+built for the purpose with the machine's C compiler). A compiled kernel's first call
+(numba loading it from its cache: thousands of steps' instructions, once per run) is
+left out of the count, as :mod:`~wire_fmu.bench.bytecodes` leaves it out; the table says
+how many were.
+
+The count is every instruction the machine executes for those steps: the master, the
+FMI crossings through ctypes and the FMU binary, the facades and the units' Python,
+numba unboxing the kernels' arguments and the compiled kernels themselves, numpy and
+the allocator. Where wall-clock figures (:mod:`~wire_fmu.bench.master`,
+:mod:`~wire_fmu.bench.scenes`) move by a fifth from run to run on a busy machine, this
+one is the same in every run of the same code on the same software (the hash seed is
+fixed, the results recorder writes at the end of the run, not by the clock), and it
+moves when the code does: it compares two versions of the code to a fraction of a per
+cent where a timing cannot tell them apart. It is not a time -- an instruction that
+misses the cache costs more than one that does not, and one machine runs more
+instructions a nanosecond than another -- so the speed targets stay with the
+wall-clock benchmarks; this one says whether a change made a step cheaper, and where
+(:mod:`~wire_fmu.bench.bytecodes` counts the interpreter's part alone).
+
+Under valgrind the process runs some fifty times slower: a run of the three hoisting
+scenes takes about a quarter of an hour, most of it the start (numba loading the
+kernels from their cache). valgrind (with its ``callgrind.h``) and a C compiler are
+tools of the machine, not dependencies of the project; without valgrind the command says
+so and stops.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import json
+import logging
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from wire_fmu.master.run import run_scene, shipped_scenes
+
+from .scene_options import parse_scene_options, report_table, scene_parser
+from .tables import markdown_table
+
+logger = logging.getLogger(__name__)
+
+TOOLS = ("valgrind",)
+"""The programs this benchmark runs (valgrind's)."""
+
+MODULE = "wire_fmu.bench.instructions"
+"""This module's name, as ``python -m`` runs it under valgrind."""
+
+HASH_SEED = "0"
+"""``PYTHONHASHSEED`` of the counted process: the same sets and dicts in every run."""
+
+_TOTALS = re.compile(r"^(?:summary|totals):\s+(\d+)", re.MULTILINE)
+
+
+@dataclass(frozen=True)
+class SceneInstructions:
+    """Instructions of one scene's counted macro steps.
+
+    Attributes
+    ----------
+    scene : str
+        The scene's name.
+    units : int
+        Its units.
+    steps : int
+        Macro steps counted.
+    instructions : int
+        Instructions executed in them.
+    kernel_loads : int
+        Compiled kernels' loads in them, left out of the count.
+    """
+
+    scene: str
+    units: int
+    steps: int
+    instructions: int
+    kernel_loads: int = 0
+
+    @property
+    def per_step(self) -> float:
+        """Instructions per macro step."""
+        return self.instructions / max(1, self.steps)
+
+    @property
+    def per_unit_step(self) -> float:
+        """Instructions per unit and macro step."""
+        return self.per_step / max(1, self.units)
+
+
+def missing_tools() -> list[str]:
+    """The programs of :data:`TOOLS` not found on the ``PATH`` (none: the benchmark can run)."""
+    return [tool for tool in TOOLS if shutil.which(tool) is None]
+
+
+def callgrind_total(path: Path) -> int:
+    """The instructions a callgrind output file counts (its ``totals:`` or ``summary:``).
+
+    Parameters
+    ----------
+    path : Path
+        A file written by callgrind (``--callgrind-out-file``, or a dump of it).
+
+    Raises
+    ------
+    ValueError
+        If the file holds no total.
+    """
+    found = _TOTALS.search(path.read_text(errors="replace"))
+    if found is None:
+        raise ValueError(f"{path}: no 'totals:' or 'summary:' line (not a callgrind file?)")
+    return int(found.group(1))
+
+
+_CLIENT_REQUESTS = r"""
+#include <valgrind/callgrind.h>
+void counting_on(void) { CALLGRIND_START_INSTRUMENTATION; }
+void counting_off(void) { CALLGRIND_STOP_INSTRUMENTATION; }
+void dump(void) { CALLGRIND_DUMP_STATS; }
+"""
+"""Callgrind's client requests as C functions: a few instructions each, where running
+``callgrind_control`` would fork a process; outside valgrind they do nothing."""
+
+
+class CallgrindControl:
+    """Callgrind's client requests (count on, count off, dump), from a library built here.
+
+    Parameters
+    ----------
+    folder : Path
+        Where the library is built (with the C compiler ``CC``, else ``cc``).
+
+    Raises
+    ------
+    RuntimeError
+        If no C compiler or valgrind's ``callgrind.h`` is found, or the build fails.
+    """
+
+    def __init__(self, folder: Path) -> None:
+        compiler = os.environ.get("CC", "").split() or [shutil.which("cc") or "gcc"]
+        source, library = folder / "client_requests.c", folder / "client_requests.so"
+        source.write_text(_CLIENT_REQUESTS)
+        try:
+            done = subprocess.run(
+                [*compiler, "-O1", "-shared", "-fPIC", "-o", str(library), str(source)],
+                capture_output=True,
+                text=True,
+            )
+        except OSError as err:
+            raise RuntimeError(
+                f"no C compiler to build callgrind's client requests: {err}"
+            ) from None
+        if done.returncode != 0:
+            raise RuntimeError(f"callgrind's client requests did not build: {done.stderr.strip()}")
+        functions = ctypes.PyDLL(str(library))  # the GIL kept: nothing to release it for
+        self.on, self.off, self.dump = functions.counting_on, functions.counting_off, functions.dump
+
+
+class CallgrindWindow:
+    """An observer that has callgrind count the stepping loop from the first macro step
+    after the warm-up to the last one, without the compiled kernels' loads, then dump.
+
+    The results recorder writes its rows after the last step (the run's
+    ``flush_every`` is infinite), so the count holds keeping a row each step but not
+    writing it as text.
+
+    A compiled kernel's first call with new argument types (numba loading it from its
+    cache, or compiling it) is a cost of the start, paid once per run, and costs
+    thousands of macro steps' instructions: counting is off while one runs
+    (:meth:`loading`).
+
+    Parameters
+    ----------
+    warm_up : float
+        Simulated time before counting starts, s.
+    control : CallgrindControl
+        Switches counting on and off and dumps (anything with ``on``, ``off``, ``dump``).
+
+    Attributes
+    ----------
+    steps : int
+        Macro steps counted.
+    kernel_loads : int
+        Kernel loads left out of the count.
+    """
+
+    def __init__(self, warm_up: float, control: Any) -> None:
+        self.warm_up = warm_up
+        self.control = control
+        self.steps = 0
+        self.kernel_loads = 0
+        self.counting = False
+
+    def on_start(self, sim: Any) -> None:
+        """Nothing at the start (the observer protocol)."""
+
+    def on_step(self, sim: Any) -> None:
+        """Count a step; switch counting on once the warm-up is over, and off after the
+        last step (the observer protocol)."""
+        if self.counting:
+            self.steps += 1
+            if sim.time >= sim.run_settings.stop_time * (1.0 - 1e-12):
+                self._stop()  # the loop is over: the results written after it are not a step's
+        elif sim.time >= self.warm_up and not self.steps:
+            self.counting = True
+            self.control.on()
+
+    def on_end(self, sim: Any, result: Any) -> None:
+        """Switch counting off and dump, if a run that stopped early left it on (the
+        observer protocol)."""
+        self._stop()
+
+    def _stop(self) -> None:
+        if self.counting:
+            self.control.off()
+            self.control.dump()
+        self.counting = False
+
+    @contextmanager
+    def loading(self) -> Iterator[None]:
+        """Counting off inside the ``with`` block (a kernel's load), if it was on."""
+        if not self.counting:
+            yield
+            return
+        self.control.off()
+        self.kernel_loads += 1
+        try:
+            yield
+        finally:
+            self.control.on()
+
+
+@contextmanager
+def kernel_loads_left_out(window: CallgrindWindow) -> Iterator[None]:
+    """Inside the ``with`` block, every numba dispatcher's load of a kernel (its
+    ``_compile_for_args``, which its C code calls when no loaded version takes the
+    arguments) runs inside ``window.loading()``."""
+    from numba.core.dispatcher import _DispatcherBase
+
+    load = _DispatcherBase._compile_for_args
+
+    def counted_apart(self, *args, **kwargs):
+        with window.loading():
+            return load(self, *args, **kwargs)
+
+    _DispatcherBase._compile_for_args = counted_apart
+    try:
+        yield
+    finally:
+        _DispatcherBase._compile_for_args = load
+
+
+def count_scenes(names: Sequence[str], stop_time: float, warm_up: float, report: Path) -> None:
+    """Run ``names`` in this process (under callgrind) and write each one's units and
+    counted steps to ``report`` (JSON), in the order of the dumps.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Shipped scenes' names.
+    stop_time, warm_up : float
+        Simulated time of each run, and before counting starts, s.
+    report : Path
+        The JSON file written.
+    """
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        control = CallgrindControl(Path(tmp))
+        for name in names:
+            window = CallgrindWindow(warm_up, control)
+            with kernel_loads_left_out(window):
+                outcome = run_scene(
+                    name,
+                    Path(tmp) / name,
+                    plots=False,
+                    observers=(window,),
+                    flush_every=math.inf,
+                    stop_time=stop_time,
+                )
+            result = outcome.result
+            if result.status != "finished":
+                raise RuntimeError(f"{name}: {result.status}: {result.message}")
+            units = len(outcome.simulation.slaves)
+            rows.append(
+                {"scene": name, "units": units, "steps": window.steps, "loads": window.kernel_loads}
+            )
+    report.write_text(json.dumps(rows))
+
+
+def measure(names: Sequence[str], stop_time: float, warm_up: float) -> list[SceneInstructions]:
+    """Count the instructions of ``names``' macro steps after ``warm_up`` (s), one process
+    under callgrind running them all.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Shipped scenes' names.
+    stop_time, warm_up : float
+        Simulated time of each run, and before counting starts, s.
+
+    Raises
+    ------
+    RuntimeError
+        If valgrind is missing, or the counted process fails (with its last lines).
+    """
+    missing = missing_tools()
+    if missing:
+        raise RuntimeError(
+            f"{' and '.join(missing)} not found: install valgrind to count instructions"
+        )
+    with tempfile.TemporaryDirectory() as tmp:
+        out, report = Path(tmp) / "callgrind.out", Path(tmp) / "steps.json"
+        command = [
+            "valgrind",
+            "--tool=callgrind",
+            "--instr-atstart=no",
+            f"--callgrind-out-file={out}",
+            sys.executable,
+            "-m",
+            MODULE,
+            "--count",
+            str(report),
+            "--stop-time",
+            str(stop_time),
+            "--warm-up-time",
+            str(warm_up),
+            "--scenes",
+            *names,
+        ]
+        env = dict(os.environ, PYTHONHASHSEED=HASH_SEED, OPENBLAS_NUM_THREADS="1")
+        done = subprocess.run(command, env=env, capture_output=True, text=True)
+        if done.returncode != 0 or not report.exists():
+            tail = "\n".join((done.stderr or "").splitlines()[-15:])
+            raise RuntimeError(f"the counted run failed (exit code {done.returncode}):\n{tail}")
+        rows = json.loads(report.read_text())
+        dumps = sorted(Path(tmp).glob("callgrind.out.*"), key=lambda p: int(p.suffix[1:]))
+        if len(dumps) != len(rows):
+            raise RuntimeError(f"{len(dumps)} callgrind dumps for {len(rows)} scenes")
+        return [
+            SceneInstructions(
+                row["scene"], row["units"], row["steps"], callgrind_total(dump), row["loads"]
+            )
+            for row, dump in zip(rows, dumps, strict=True)
+        ]
+
+
+def table(rows: list[SceneInstructions]) -> str:
+    """Markdown table: instructions per macro step and per unit and step, one row per scene.
+
+    Parameters
+    ----------
+    rows : list of SceneInstructions
+        One per scene.
+    """
+    return markdown_table(
+        "scene | units | macro steps counted | instructions per step | per unit and step"
+        " | kernel loads left out",
+        (
+            f"{r.scene} | {r.units} | {r.steps} | {r.per_step:,.0f} | {r.per_unit_step:,.0f}"
+            f" | {r.kernel_loads}"
+            for r in rows
+        ),
+    )
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = scene_parser(__doc__.splitlines()[0], list(shipped_scenes()), None)
+    parser.add_argument(
+        "--stop-time", type=float, default=1.0, help="simulated time per scene, s (default 1)"
+    )
+    parser.add_argument(
+        "--warm-up",
+        type=float,
+        default=0.4,
+        help="fraction of the run before counting starts (default 0.4)",
+    )
+    # the process valgrind runs: counts the scenes and writes their steps here
+    parser.add_argument("--count", type=Path, help=argparse.SUPPRESS)
+    parser.add_argument("--warm-up-time", type=float, help=argparse.SUPPRESS)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Command-line entry point.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments; None reads the command line.
+    """
+    parser = _parser()
+    args = parse_scene_options(parser, argv)
+    if args.count is not None:
+        count_scenes(args.scenes, args.stop_time, args.warm_up_time, args.count)
+        return
+    problems = []
+    if not args.stop_time > 0.0:
+        problems.append(f"--stop-time must be positive, got {args.stop_time}")
+    if not 0.0 <= args.warm_up < 1.0:
+        problems.append(f"--warm-up must be at least 0 and below 1, got {args.warm_up}")
+    missing = missing_tools()
+    if missing:
+        problems.append(
+            f"{' and '.join(missing)} not found: install valgrind to count instructions"
+        )
+    if problems:
+        parser.error("; ".join(problems))
+    try:
+        rows = measure(args.scenes, args.stop_time, args.warm_up * args.stop_time)
+    except RuntimeError as err:
+        parser.exit(1, f"{parser.prog}: {err}\n")
+    report_table(table(rows), args.out)
+
+
+if __name__ == "__main__":
+    main()
