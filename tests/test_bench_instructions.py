@@ -71,10 +71,18 @@ def test_a_kernel_load_while_counting_is_left_out():
     assert load.__name__ == "_compile_for_args"  # numba's own again after the block
 
 
-@pytest.mark.parametrize("line", ["summary: 123456789", "totals: 123456789"])
-def test_the_total_is_read_from_a_callgrind_file(tmp_path, line):
+@pytest.mark.parametrize(
+    ("header", "end"),
+    [
+        ("summary: 0", "totals: 123456789"),  # a dump made while the program runs
+        ("summary: 123456789", ""),  # a file with its summary only
+    ],
+)
+def test_the_total_is_read_from_a_callgrind_file(tmp_path, header, end):
     dump = tmp_path / "callgrind.out.1"
-    dump.write_text(f"# callgrind format\nversion: 1\nevents: Ir\n{line}\nfn=(1) main\n3 5\n")
+    dump.write_text(
+        f"# callgrind format\nversion: 1\nevents: Ir\n{header}\nfn=(1) main\n3 5\n{end}\n"
+    )
     assert bench_instructions.callgrind_total(dump) == 123456789
 
 

@@ -1,16 +1,17 @@
 """What a macro step costs in machine instructions, counted by valgrind's callgrind.
 
 Run ``python -m wire_fmu.bench.instructions [--stop-time S] [--warm-up F]
-[--scenes NAME ...] [--out FILE]``. The scenes (each shipped one, or each one named)
-run one after another in one Python process under ``valgrind --tool=callgrind``,
-each shortened to ``--stop-time`` (default 1 s). Counting is off while the process
-starts and loads its units, and on from the first macro step after the warm-up
-(``--warm-up``, a fraction of the run, default 0.4) to the end of the stepping loop;
-an observer of the run switches it with callgrind's client requests (a small C library
+[--scenes NAME ...] [--out FILE] [--keep FOLDER]``. The scenes (each shipped one, or
+each one named) run one after another in one Python process under ``valgrind
+--tool=callgrind``, each shortened to ``--stop-time`` (default 1 s). Counting is off
+while the process starts and loads its units, and on from the first macro step after
+the warm-up (``--warm-up``, a fraction of the run, default 0.4) to the last one (the
+results recorder writes its rows as text after it, and that is not counted); an
+observer of the run switches it with callgrind's client requests (a small C library
 built for the purpose with the machine's C compiler). A compiled kernel's first call
 (numba loading it from its cache: thousands of steps' instructions, once per run) is
-left out of the count, as :mod:`~wire_fmu.bench.bytecodes` leaves it out; the table says
-how many were.
+left out of the count, as :mod:`~wire_fmu.bench.bytecodes` leaves it out; the table
+says how many were.
 
 The count is every instruction the machine executes for those steps: the master, the
 FMI crossings through ctypes and the FMU binary, the facades and the units' Python,
@@ -68,7 +69,8 @@ MODULE = "wire_fmu.bench.instructions"
 HASH_SEED = "0"
 """``PYTHONHASHSEED`` of the counted process: the same sets and dicts in every run."""
 
-_TOTALS = re.compile(r"^(?:summary|totals):\s+(\d+)", re.MULTILINE)
+_TOTALS = re.compile(r"^totals:\s+(\d+)", re.MULTILINE)
+_SUMMARY = re.compile(r"^summary:\s+(\d+)", re.MULTILINE)
 
 
 @dataclass(frozen=True)
@@ -112,7 +114,8 @@ def missing_tools() -> list[str]:
 
 
 def callgrind_total(path: Path) -> int:
-    """The instructions a callgrind output file counts (its ``totals:`` or ``summary:``).
+    """The instructions a callgrind output file counts: its last ``totals:`` line (a dump
+    made while the program runs writes ``summary: 0`` in its header), else ``summary:``.
 
     Parameters
     ----------
@@ -124,10 +127,11 @@ def callgrind_total(path: Path) -> int:
     ValueError
         If the file holds no total.
     """
-    found = _TOTALS.search(path.read_text(errors="replace"))
-    if found is None:
+    text = path.read_text(errors="replace")
+    found = _TOTALS.findall(text) or _SUMMARY.findall(text)
+    if not found:
         raise ValueError(f"{path}: no 'totals:' or 'summary:' line (not a callgrind file?)")
-    return int(found.group(1))
+    return int(found[-1])
 
 
 _CLIENT_REQUESTS = r"""
@@ -305,7 +309,9 @@ def count_scenes(names: Sequence[str], stop_time: float, warm_up: float, report:
     report.write_text(json.dumps(rows))
 
 
-def measure(names: Sequence[str], stop_time: float, warm_up: float) -> list[SceneInstructions]:
+def measure(
+    names: Sequence[str], stop_time: float, warm_up: float, keep: Path | None = None
+) -> list[SceneInstructions]:
     """Count the instructions of ``names``' macro steps after ``warm_up`` (s), one process
     under callgrind running them all.
 
@@ -315,6 +321,10 @@ def measure(names: Sequence[str], stop_time: float, warm_up: float) -> list[Scen
         Shipped scenes' names.
     stop_time, warm_up : float
         Simulated time of each run, and before counting starts, s.
+    keep : Path, optional
+        A folder to copy callgrind's files into, one per scene
+        (``callgrind.<scene>.out``), for ``callgrind_annotate`` to say which functions
+        the instructions ran in.
 
     Raises
     ------
@@ -328,25 +338,12 @@ def measure(names: Sequence[str], stop_time: float, warm_up: float) -> list[Scen
         )
     with tempfile.TemporaryDirectory() as tmp:
         out, report = Path(tmp) / "callgrind.out", Path(tmp) / "steps.json"
-        command = [
-            "valgrind",
-            "--tool=callgrind",
-            "--instr-atstart=no",
-            f"--callgrind-out-file={out}",
-            sys.executable,
-            "-m",
-            MODULE,
-            "--count",
-            str(report),
-            "--stop-time",
-            str(stop_time),
-            "--warm-up-time",
-            str(warm_up),
-            "--scenes",
-            *names,
-        ]
-        env = dict(os.environ, PYTHONHASHSEED=HASH_SEED, OPENBLAS_NUM_THREADS="1")
-        done = subprocess.run(command, env=env, capture_output=True, text=True)
+        done = subprocess.run(
+            _counted_command(out, report, names, stop_time, warm_up),
+            env=dict(os.environ, PYTHONHASHSEED=HASH_SEED, OPENBLAS_NUM_THREADS="1"),
+            capture_output=True,
+            text=True,
+        )
         if done.returncode != 0 or not report.exists():
             tail = "\n".join((done.stderr or "").splitlines()[-15:])
             raise RuntimeError(f"the counted run failed (exit code {done.returncode}):\n{tail}")
@@ -354,12 +351,40 @@ def measure(names: Sequence[str], stop_time: float, warm_up: float) -> list[Scen
         dumps = sorted(Path(tmp).glob("callgrind.out.*"), key=lambda p: int(p.suffix[1:]))
         if len(dumps) != len(rows):
             raise RuntimeError(f"{len(dumps)} callgrind dumps for {len(rows)} scenes")
+        if keep is not None:
+            keep.mkdir(parents=True, exist_ok=True)
+            for row, dump in zip(rows, dumps, strict=True):
+                shutil.copyfile(dump, keep / f"callgrind.{row['scene']}.out")
         return [
             SceneInstructions(
                 row["scene"], row["units"], row["steps"], callgrind_total(dump), row["loads"]
             )
             for row, dump in zip(rows, dumps, strict=True)
         ]
+
+
+def _counted_command(
+    out: Path, report: Path, names: Sequence[str], stop_time: float, warm_up: float
+) -> list[str]:
+    """The command that runs this module's counting side (:func:`count_scenes`) on
+    ``names`` under callgrind."""
+    return [
+        "valgrind",
+        "--tool=callgrind",
+        "--instr-atstart=no",
+        f"--callgrind-out-file={out}",
+        sys.executable,
+        "-m",
+        MODULE,
+        "--count",
+        str(report),
+        "--stop-time",
+        str(stop_time),
+        "--warm-up-time",
+        str(warm_up),
+        "--scenes",
+        *names,
+    ]
 
 
 def table(rows: list[SceneInstructions]) -> str:
@@ -391,6 +416,12 @@ def _parser() -> argparse.ArgumentParser:
         type=float,
         default=0.4,
         help="fraction of the run before counting starts (default 0.4)",
+    )
+    parser.add_argument(
+        "--keep",
+        type=Path,
+        metavar="FOLDER",
+        help="also keep callgrind's file of each scene here (for callgrind_annotate)",
     )
     # the process valgrind runs: counts the scenes and writes their steps here
     parser.add_argument("--count", type=Path, help=argparse.SUPPRESS)
@@ -424,7 +455,7 @@ def main(argv: list[str] | None = None) -> None:
     if problems:
         parser.error("; ".join(problems))
     try:
-        rows = measure(args.scenes, args.stop_time, args.warm_up * args.stop_time)
+        rows = measure(args.scenes, args.stop_time, args.warm_up * args.stop_time, args.keep)
     except RuntimeError as err:
         parser.exit(1, f"{parser.prog}: {err}\n")
     report_table(table(rows), args.out)
