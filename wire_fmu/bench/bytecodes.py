@@ -35,7 +35,6 @@ every macro step of a scene runs much the same code.
 from __future__ import annotations
 
 import logging
-import math
 import sys
 import tempfile
 from collections import Counter
@@ -44,8 +43,9 @@ from pathlib import Path
 from types import CodeType, FrameType
 from typing import Any
 
-from wire_fmu.master.run import run_scene, shipped_scenes
+from wire_fmu.master.run import shipped_scenes
 
+from .counted_run import run_counted
 from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
 
@@ -241,20 +241,7 @@ def measure(name: str, stop_time: float, warm_up: float, out: Path) -> SceneByte
         Folder the scene's results go into (in a subfolder named after it).
     """
     counter = BytecodeCounter(warm_up)
-    # Rows are written out every 0.1 s of wall-clock time, hundreds of them a batch in a
-    # run at full speed but a few in a traced one: written at the end here instead, so
-    # that the count does not depend on the clock (a batch's cost per row is numpy's).
-    outcome = run_scene(
-        name,
-        out / name,
-        plots=False,
-        observers=(counter,),
-        flush_every=math.inf,
-        stop_time=stop_time,
-    )
-    result = outcome.result
-    if result.status != "finished":
-        raise RuntimeError(f"{name}: {result.status}: {result.message}")
+    outcome = run_counted(name, out / name, counter, stop_time)
     by_layer: Counter[str] = Counter()
     by_function: Counter[str] = Counter()
     for (code, layer), count in counter.by_code.items():

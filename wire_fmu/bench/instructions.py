@@ -40,7 +40,6 @@ import argparse
 import ctypes
 import json
 import logging
-import math
 import os
 import re
 import shutil
@@ -53,8 +52,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from wire_fmu.master.run import run_scene, shipped_scenes
+from wire_fmu.master.run import shipped_scenes
 
+from .counted_run import run_counted
 from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
 
@@ -291,17 +291,7 @@ def count_scenes(names: Sequence[str], stop_time: float, warm_up: float, report:
         for name in names:
             window = CallgrindWindow(warm_up, control)
             with kernel_loads_left_out(window):
-                outcome = run_scene(
-                    name,
-                    Path(tmp) / name,
-                    plots=False,
-                    observers=(window,),
-                    flush_every=math.inf,
-                    stop_time=stop_time,
-                )
-            result = outcome.result
-            if result.status != "finished":
-                raise RuntimeError(f"{name}: {result.status}: {result.message}")
+                outcome = run_counted(name, Path(tmp) / name, window, stop_time)
             units = len(outcome.simulation.slaves)
             rows.append(
                 {"scene": name, "units": units, "steps": window.steps, "loads": window.kernel_loads}
