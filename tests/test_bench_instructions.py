@@ -71,33 +71,33 @@ def test_a_kernel_load_while_counting_is_left_out():
     assert load.__name__ == "_compile_for_args"  # numba's own again after the block
 
 
-@pytest.mark.parametrize(
-    ("header", "end"),
-    [
-        ("summary: 0", "totals: 123456789"),  # a dump made while the program runs
-        ("summary: 123456789", ""),  # a file with its summary only
-    ],
-)
-def test_the_total_is_read_from_a_callgrind_file(tmp_path, header, end):
-    dump = tmp_path / "callgrind.out.1"
-    dump.write_text(
-        f"# callgrind format\nversion: 1\nevents: Ir\n{header}\nfn=(1) main\n3 5\n{end}\n"
-    )
-    assert bench_instructions.callgrind_total(dump) == 123456789
-
-
-def test_a_file_without_a_total_is_refused_naming_it(tmp_path):
-    dump = tmp_path / "not_callgrind.txt"
-    dump.write_text("hello\n")
-    with pytest.raises(ValueError, match="not_callgrind.txt"):
-        bench_instructions.callgrind_total(dump)
-
-
 def test_per_step_figures_divide_by_steps_and_units():
     row = bench_instructions.SceneInstructions("riser_tensioner", 2, 100, 3_000_000)
     assert row.per_step == 30_000 and row.per_unit_step == 15_000
     table = bench_instructions.table([row])
     assert "| riser_tensioner | 2 | 100 | 30,000 | 15,000 | 0 |" in table
+    assert "where the instructions ran" not in table  # no libraries read: no second table
+
+
+def test_the_libraries_shares_are_tabled_per_scene():
+    kernels = "the compiled kernels (numba's machine code)"
+    rows = [
+        bench_instructions.SceneInstructions(
+            "riser_tensioner",
+            2,
+            100,
+            1000,
+            by_library={"the Python interpreter": 750, kernels: 250},
+        ),
+        bench_instructions.SceneInstructions(
+            "drawworks", 2, 100, 2000, by_library={"the Python interpreter": 1000, kernels: 1000}
+        ),
+    ]
+    table = bench_instructions.table(rows)
+    assert "| where the instructions ran | riser_tensioner | drawworks |" in table
+    assert "| the Python interpreter | 75.0 % | 50.0 % |" in table
+    assert f"| {kernels} | 25.0 % | 50.0 % |" in table
+    assert "numpy" not in table  # a library no scene ran in is left out
 
 
 def test_bad_options_are_refused_all_at_once(capsys):

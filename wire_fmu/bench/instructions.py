@@ -41,19 +41,19 @@ import ctypes
 import json
 import logging
 import os
-import re
 import shutil
 import subprocess
 import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from wire_fmu.master.run import shipped_scenes
 
+from .callgrind_file import LIBRARIES, OTHER, callgrind_total, instructions_by_library
 from .counted_run import run_counted
 from .scene_options import parse_scene_options, report_table, scene_parser
 from .tables import markdown_table
@@ -68,9 +68,6 @@ MODULE = "wire_fmu.bench.instructions"
 
 HASH_SEED = "0"
 """``PYTHONHASHSEED`` of the counted process: the same sets and dicts in every run."""
-
-_TOTALS = re.compile(r"^totals:\s+(\d+)", re.MULTILINE)
-_SUMMARY = re.compile(r"^summary:\s+(\d+)", re.MULTILINE)
 
 
 @dataclass(frozen=True)
@@ -89,6 +86,8 @@ class SceneInstructions:
         Instructions executed in them.
     kernel_loads : int
         Compiled kernels' loads in them, left out of the count.
+    by_library : dict of str to int
+        The instructions by where they ran (see :func:`.callgrind_file.library_of`).
     """
 
     scene: str
@@ -96,6 +95,7 @@ class SceneInstructions:
     steps: int
     instructions: int
     kernel_loads: int = 0
+    by_library: dict[str, int] = field(default_factory=dict)
 
     @property
     def per_step(self) -> float:
@@ -111,27 +111,6 @@ class SceneInstructions:
 def missing_tools() -> list[str]:
     """The programs of :data:`TOOLS` not found on the ``PATH`` (none: the benchmark can run)."""
     return [tool for tool in TOOLS if shutil.which(tool) is None]
-
-
-def callgrind_total(path: Path) -> int:
-    """The instructions a callgrind output file counts: its last ``totals:`` line (a dump
-    made while the program runs writes ``summary: 0`` in its header), else ``summary:``.
-
-    Parameters
-    ----------
-    path : Path
-        A file written by callgrind (``--callgrind-out-file``, or a dump of it).
-
-    Raises
-    ------
-    ValueError
-        If the file holds no total.
-    """
-    text = path.read_text(errors="replace")
-    found = _TOTALS.findall(text) or _SUMMARY.findall(text)
-    if not found:
-        raise ValueError(f"{path}: no 'totals:' or 'summary:' line (not a callgrind file?)")
-    return int(found[-1])
 
 
 _CLIENT_REQUESTS = r"""
@@ -347,7 +326,12 @@ def measure(
                 shutil.copyfile(dump, keep / f"callgrind.{row['scene']}.out")
         return [
             SceneInstructions(
-                row["scene"], row["units"], row["steps"], callgrind_total(dump), row["loads"]
+                row["scene"],
+                row["units"],
+                row["steps"],
+                callgrind_total(dump),
+                row["loads"],
+                instructions_by_library(dump),
             )
             for row, dump in zip(rows, dumps, strict=True)
         ]
@@ -378,14 +362,15 @@ def _counted_command(
 
 
 def table(rows: list[SceneInstructions]) -> str:
-    """Markdown table: instructions per macro step and per unit and step, one row per scene.
+    """Markdown tables: instructions per macro step and per unit and step, one row per
+    scene; then each library's share of them, one column per scene.
 
     Parameters
     ----------
     rows : list of SceneInstructions
         One per scene.
     """
-    return markdown_table(
+    counts = markdown_table(
         "scene | units | macro steps counted | instructions per step | per unit and step"
         " | kernel loads left out",
         (
@@ -394,6 +379,21 @@ def table(rows: list[SceneInstructions]) -> str:
             for r in rows
         ),
     )
+    groups = [group for group, _ in LIBRARIES] + [OTHER]
+    shown = [g for g in groups if any(r.by_library.get(g) for r in rows)]
+    if not shown:
+        return counts
+    shares = markdown_table(
+        "where the instructions ran | " + " | ".join(r.scene for r in rows),
+        (
+            f"{group} | "
+            + " | ".join(
+                f"{100 * r.by_library.get(group, 0) / max(1, r.instructions):.1f} %" for r in rows
+            )
+            for group in shown
+        ),
+    )
+    return counts + "\n\n" + shares
 
 
 def _parser() -> argparse.ArgumentParser:

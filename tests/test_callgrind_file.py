@@ -1,0 +1,113 @@
+"""Reading callgrind's files: the total, and the instructions each library ran (exclusive
+costs, which add up to the total), on a file written by hand in callgrind's format."""
+
+from __future__ import annotations
+
+import pytest
+
+from wire_fmu.bench import callgrind_file
+
+# Two objects, names given once and then by id, relative positions, a call whose
+# inclusive cost line must not count again, and code in no object file (???).
+_FILE = """# callgrind format
+version: 1
+creator: callgrind-3.19.0
+part: 1
+positions: line
+events: Ir
+summary: 0
+
+ob=(1) /usr/lib/libpython3.11.so.1.0
+fl=(1) ceval.c
+fn=(1) _PyEval_EvalFrameDefault
+10 100
++2 50
+cob=(2) /usr/lib/x86_64-linux-gnu/libc.so.6
+cfi=(2) malloc.c
+cfn=(2) malloc
+calls=3 20
+* 30
+-1 5
+
+ob=(2)
+fl=(2)
+fn=(2)
+20 30
+
+ob=(3) ???
+fl=(3) ???
+fn=(3) 0x0000000012345678
+0 40
+
+ob=(1)
+fl=(1)
+fn=(1)
+12 25
+
+totals: 250
+"""
+
+
+@pytest.fixture
+def dump(tmp_path):
+    path = tmp_path / "callgrind.out.1"
+    path.write_text(_FILE)
+    return path
+
+
+def test_each_object_gets_its_own_lines_and_not_the_calls_it_makes(dump):
+    by_object = callgrind_file.instructions_by_object(dump)
+    assert by_object == {
+        "/usr/lib/libpython3.11.so.1.0": 100 + 50 + 5 + 25,  # the call's 30 is malloc's
+        "/usr/lib/x86_64-linux-gnu/libc.so.6": 30,
+        "???": 40,
+    }
+    assert sum(by_object.values()) == callgrind_file.callgrind_total(dump) == 250
+
+
+def test_libraries_are_grouped_most_first(dump):
+    assert callgrind_file.instructions_by_library(dump) == {
+        "the Python interpreter": 180,
+        "the compiled kernels (numba's machine code)": 40,
+        "the C library (malloc, free, memset, memcpy)": 30,
+    }
+
+
+@pytest.mark.parametrize(
+    ("obj", "group"),
+    [
+        ("/tmp/wire_fmu_fmu_x/binaries/linux64/BlockTrain.so", "the FMU binaries"),
+        (
+            "/venv/site-packages/numba/core/runtime/_nrt_python.cpython-311.so",
+            "numba's runtime and dispatch",
+        ),
+        ("/venv/site-packages/numpy/_core/_multiarray_umath.cpython-311.so", "numpy"),
+        ("/usr/lib/x86_64-linux-gnu/libffi.so.8.1.2", "ctypes and libffi (the FMI calls)"),
+        ("/usr/lib/x86_64-linux-gnu/libm.so.6", "libm"),
+        ("/python3.11/lib-dynload/_struct.cpython-311.so", callgrind_file.OTHER),
+    ],
+)
+def test_object_files_are_put_in_their_library(obj, group):
+    assert callgrind_file.library_of(obj) == group
+
+
+@pytest.mark.parametrize(
+    ("header", "end"),
+    [
+        ("summary: 0", "totals: 123456789"),  # a dump made while the program runs
+        ("summary: 123456789", ""),  # a file with its summary only
+    ],
+)
+def test_the_total_is_read_from_a_callgrind_file(tmp_path, header, end):
+    path = tmp_path / "callgrind.out.1"
+    path.write_text(
+        f"# callgrind format\nversion: 1\nevents: Ir\n{header}\nfn=(1) main\n3 5\n{end}\n"
+    )
+    assert callgrind_file.callgrind_total(path) == 123456789
+
+
+def test_a_file_without_a_total_is_refused_naming_it(tmp_path):
+    path = tmp_path / "not_callgrind.txt"
+    path.write_text("hello\n")
+    with pytest.raises(ValueError, match="not_callgrind.txt"):
+        callgrind_file.callgrind_total(path)
