@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 import pytest
 
+from wire_fmu.bench import callgrind_window
 from wire_fmu.bench import instructions as bench_instructions
 
 
@@ -28,7 +29,7 @@ class _Control:
 
 def test_the_window_counts_the_steps_after_the_warm_up_and_dumps_once_at_the_end():
     control = _Control()
-    window = bench_instructions.CallgrindWindow(0.01, control)
+    window = callgrind_window.CallgrindWindow(0.01, control)
     settings = SimpleNamespace(stop_time=0.02)
     for k in range(1, 5):  # steps ending at 4, 8, 12, 16 ms of a 20 ms run
         window.on_step(SimpleNamespace(time=0.004 * k, run_settings=settings))
@@ -44,7 +45,7 @@ def test_the_window_counts_the_steps_after_the_warm_up_and_dumps_once_at_the_end
 
 def test_a_run_that_ends_in_its_warm_up_switches_nothing():
     control = _Control()
-    window = bench_instructions.CallgrindWindow(1.0, control)
+    window = callgrind_window.CallgrindWindow(1.0, control)
     window.on_step(SimpleNamespace(time=0.004, run_settings=SimpleNamespace(stop_time=0.004)))
     with window.loading():
         pass  # a load before counting starts: nothing to switch off
@@ -55,14 +56,14 @@ def test_a_run_that_ends_in_its_warm_up_switches_nothing():
 def test_a_kernel_load_while_counting_is_left_out():
     numba = pytest.importorskip("numba")
     control = _Control()
-    window = bench_instructions.CallgrindWindow(0.0, control)
+    window = callgrind_window.CallgrindWindow(0.0, control)
     window.on_step(SimpleNamespace(time=0.004, run_settings=SimpleNamespace(stop_time=1.0)))
 
     @numba.njit
     def twice(x):
         return 2.0 * x
 
-    with bench_instructions.kernel_loads_left_out(window):
+    with callgrind_window.kernel_loads_left_out(window):
         assert twice(1.5) == 3.0  # the first call with floats: numba compiles it
         assert twice(2.5) == 5.0  # loaded: no load
     assert control.sent == ["on", "off", "on"]
@@ -134,7 +135,7 @@ def test_the_count_is_the_same_in_two_runs():
     reason="needs a C compiler and valgrind's callgrind.h",
 )
 def test_the_client_requests_build_and_do_nothing_outside_valgrind(tmp_path):
-    control = bench_instructions.CallgrindControl(tmp_path)
+    control = callgrind_window.CallgrindControl(tmp_path)
     control.on()
     control.off()
     control.dump()
