@@ -127,7 +127,8 @@ def test_the_count_is_the_same_in_two_runs():
     )
     assert first.steps == second.steps > 0
     assert first.instructions > 10_000 * first.steps  # a step runs the units, not nothing
-    assert abs(first.instructions - second.instructions) <= 1e-3 * first.instructions
+    # the same to the instruction on one machine; objects' addresses move their hashes
+    assert abs(first.instructions - second.instructions) <= 5e-3 * first.instructions
 
 
 @pytest.mark.skipif(
