@@ -127,8 +127,10 @@ def test_the_count_is_the_same_in_two_runs():
     )
     assert first.steps == second.steps > 0
     assert first.instructions > 10_000 * first.steps  # a step runs the units, not nothing
-    # the same to the instruction on one machine; objects' addresses move their hashes
-    assert abs(first.instructions - second.instructions) <= 5e-3 * first.instructions
+    # to the instruction with the address space fixed (setarch); else objects' addresses,
+    # and the hashes made from them, may move from run to run
+    allowed = 0 if shutil.which("setarch") else 5e-3 * first.instructions
+    assert abs(first.instructions - second.instructions) <= allowed
 
 
 @pytest.mark.skipif(

@@ -18,20 +18,25 @@ FMI crossings through ctypes and the FMU binary, the facades and the units' Pyth
 numba unboxing the kernels' arguments and the compiled kernels themselves, numpy and
 the allocator. Where wall-clock figures (:mod:`~wire_fmu.bench.master`,
 :mod:`~wire_fmu.bench.scenes`) move by a fifth from run to run on a busy machine, this
-one is the same in every run of the same code on the same software (the hash seed is
-fixed, the results recorder writes at the end of the run, not by the clock), and it
-moves when the code does: it compares two versions of the code to a fraction of a per
-cent where a timing cannot tell them apart. It is not a time -- an instruction that
-misses the cache costs more than one that does not, and one machine runs more
-instructions a nanosecond than another -- so the speed targets stay with the
+one is the same to the instruction in every run of the same code and command, however
+busy the machine: the hash seed is fixed, the address space is laid out the same in
+every run (``setarch -R``: objects' addresses, and the hashes made from them, do not
+move), the garbage collector runs just before counting starts (its runs inside the
+count then follow from the counted steps alone), and the results recorder writes after
+the last step, not by the clock. It moves when the code does, so it compares two
+versions of the code where a timing cannot tell them apart. It is not a time -- an
+instruction that misses the cache costs more than one that does not, and one machine
+runs more instructions a nanosecond than another -- so the speed targets stay with the
 wall-clock benchmarks; this one says whether a change made a step cheaper, and where
-(:mod:`~wire_fmu.bench.bytecodes` counts the interpreter's part alone).
+(:mod:`~wire_fmu.bench.bytecodes` counts the interpreter's part alone). A second table
+gives each library's share of the instructions (:mod:`.callgrind_file`).
 
-Under valgrind the process runs some fifty times slower: a run of the three hoisting
-scenes takes about a quarter of an hour, most of it the start (numba loading the
-kernels from their cache). valgrind (with its ``callgrind.h``) and a C compiler are
-tools of the machine, not dependencies of the project; without valgrind the command says
-so and stops.
+Under valgrind the counted steps run some fifty times slower: a run of the three
+hoisting scenes takes about a minute once their kernels are in numba's cache (ten, if
+valgrind has to watch numba compile them first). valgrind (with its ``callgrind.h``),
+``setarch`` and a C compiler are tools of the machine, not dependencies of the project:
+without valgrind the command says so and stops; without ``setarch`` it counts with the
+layout the system gives, and runs may then differ by a per cent.
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ import argparse
 import json
 import logging
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -201,8 +207,11 @@ def _counted_command(
     out: Path, report: Path, names: Sequence[str], stop_time: float, warm_up: float
 ) -> list[str]:
     """The command that runs this module's counting side (:func:`count_scenes`) on
-    ``names`` under callgrind."""
+    ``names`` under callgrind; with the address space laid out the same in every run
+    (``setarch -R``), where the machine has ``setarch``."""
+    fixed_layout = ["setarch", platform.machine(), "-R"] if shutil.which("setarch") else []
     return [
+        *fixed_layout,
         "valgrind",
         "--tool=callgrind",
         "--instr-atstart=no",
