@@ -63,6 +63,8 @@ __all__ = ["BlockTrainUnit"]
 
 _INTERFACE_PORTS = LINE_PORTS + MOVER_PORTS
 """The ports that can publish an interface model."""
+_TAKE_SWITCHES = operator.itemgetter(*(f"{p}.interface_model" for p in _INTERFACE_PORTS))
+"""Each of :data:`_INTERFACE_PORTS`' own interface-model switch, in their order."""
 _KINEMATIC_INPUTS = tuple(
     [f"{p}.payout" for p in LINE_PORTS]
     + [f"{p}.payout_rate" for p in LINE_PORTS]
@@ -89,6 +91,7 @@ _INPUT_FIELDS = tuple(
 )
 """Each field of BlockTrainInputs, its ports and where their values sit in
 :data:`_TAKE_INPUTS`'s answer."""
+_FIELD_NAMES, _FIELD_PORTS, _FIELD_SLICES = zip(*_INPUT_FIELDS, strict=True)
 
 
 def _variables():
@@ -473,9 +476,9 @@ class BlockTrainUnit(Unit):
     # -------------------------------------------------------------- helpers
     def _inputs(self) -> BlockTrainInputs:
         got = list(map(float, _TAKE_INPUTS(self.values)))
-        return BlockTrainInputs(
-            **{field: dict(zip(ports, got[at], strict=True)) for field, ports, at in _INPUT_FIELDS}
-        )
+        # each field's {port: value}, from its slice of got: built in C, every step
+        fields = map(dict, map(zip, _FIELD_PORTS, map(got.__getitem__, _FIELD_SLICES)))
+        return BlockTrainInputs(**dict(zip(_FIELD_NAMES, fields, strict=True)))
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
         """Which span, body and coordinate feed each port output (built once per model)."""
@@ -537,8 +540,9 @@ class BlockTrainUnit(Unit):
         """The ports whose interface model is published: all with ``interface_model``, else
         those whose own ``<port>.interface_model`` is set."""
         v = self.values
-        every = v["interface_model"]
-        return tuple(p for p in _INTERFACE_PORTS if every or v[f"{p}.interface_model"])
+        if v["interface_model"]:
+            return _INTERFACE_PORTS
+        return tuple(itertools.compress(_INTERFACE_PORTS, _TAKE_SWITCHES(v)))
 
     def _update_interface_outputs(self, m: BlockTrainModel, ports: tuple[str, ...]) -> None:
         """The interface model (see :mod:`.interface`) of each of ``ports`` the reeving
