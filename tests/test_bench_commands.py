@@ -109,3 +109,11 @@ def test_the_bytecode_benchmark_refuses_bad_options_naming_them(options, named, 
         bench_bytecodes.main(options)
     assert stopped.value.code == 2
     assert named in capsys.readouterr().err
+
+
+def test_the_bytecode_benchmark_reports_every_bad_option_at_once(capsys):
+    with pytest.raises(SystemExit) as stopped:
+        bench_bytecodes.main(["--stop-time", "-1", "--warm-up", "2", "--top", "-3"])
+    assert stopped.value.code == 2
+    err = capsys.readouterr().err
+    assert "--stop-time" in err and "--warm-up" in err and "--top" in err

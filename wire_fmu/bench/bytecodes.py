@@ -46,7 +46,13 @@ from typing import Any
 from wire_fmu.master.run import shipped_scenes
 
 from .counted_run import run_counted
-from .scene_options import parse_scene_options, report_table, scene_parser
+from .scene_options import (
+    add_counting_window,
+    counting_window_problems,
+    parse_scene_options,
+    report_table,
+    scene_parser,
+)
 from .tables import markdown_table
 
 __all__ = ["BytecodeCounter", "SceneBytecodes", "layer_of", "main", "measure", "short_file"]
@@ -319,25 +325,16 @@ def main(argv: list[str] | None = None) -> None:
         The arguments; None reads the command line.
     """
     parser = scene_parser(__doc__.splitlines()[0], list(shipped_scenes()), None)
-    parser.add_argument(
-        "--stop-time", type=float, default=1.0, help="simulated time per scene, s (default 1)"
-    )
-    parser.add_argument(
-        "--warm-up",
-        type=float,
-        default=0.2,
-        help="fraction of the run before counting starts (default 0.2)",
-    )
+    add_counting_window(parser, warm_up=0.2)
     parser.add_argument(
         "--top", type=int, default=0, help="also list each scene's N costliest functions"
     )
     args = parse_scene_options(parser, argv)
-    if not args.stop_time > 0.0:
-        parser.error(f"--stop-time must be positive, got {args.stop_time}")
-    if not 0.0 <= args.warm_up < 1.0:
-        parser.error(f"--warm-up must be at least 0 and below 1, got {args.warm_up}")
+    problems = counting_window_problems(args)
     if args.top < 0:
-        parser.error(f"--top must be at least 0, got {args.top}")
+        problems.append(f"--top must be at least 0, got {args.top}")
+    if problems:
+        parser.error("; ".join(problems))
     with tempfile.TemporaryDirectory() as tmp:
         rows = [
             measure(name, args.stop_time, args.warm_up * args.stop_time, Path(tmp))

@@ -59,13 +59,16 @@ from wire_fmu.master.run import shipped_scenes
 from .callgrind_file import LIBRARIES, OTHER, callgrind_total, instructions_by_library
 from .callgrind_window import CallgrindControl, CallgrindWindow, kernel_loads_left_out
 from .counted_run import run_counted
-from .scene_options import parse_scene_options, report_table, scene_parser
+from .scene_options import (
+    add_counting_window,
+    counting_window_problems,
+    parse_scene_options,
+    report_table,
+    scene_parser,
+)
 from .tables import markdown_table
 
 logger = logging.getLogger(__name__)
-
-TOOLS = ("valgrind",)
-"""The programs this benchmark runs (valgrind's)."""
 
 MODULE = "wire_fmu.bench.instructions"
 """This module's name, as ``python -m`` runs it under valgrind."""
@@ -112,9 +115,11 @@ class SceneInstructions:
         return self.per_step / max(1, self.units)
 
 
-def missing_tools() -> list[str]:
-    """The programs of :data:`TOOLS` not found on the ``PATH`` (none: the benchmark can run)."""
-    return [tool for tool in TOOLS if shutil.which(tool) is None]
+def valgrind_problem() -> str | None:
+    """Why this benchmark cannot run here (valgrind not on the ``PATH``), or None."""
+    if shutil.which("valgrind") is None:
+        return "valgrind not found: install valgrind to count instructions"
+    return None
 
 
 def count_scenes(names: Sequence[str], stop_time: float, warm_up: float, report: Path) -> None:
@@ -166,11 +171,9 @@ def measure(
     RuntimeError
         If valgrind is missing, or the counted process fails (with its last lines).
     """
-    missing = missing_tools()
+    missing = valgrind_problem()
     if missing:
-        raise RuntimeError(
-            f"{' and '.join(missing)} not found: install valgrind to count instructions"
-        )
+        raise RuntimeError(missing)
     with tempfile.TemporaryDirectory() as tmp:
         out, report = Path(tmp) / "callgrind.out", Path(tmp) / "steps.json"
         done = subprocess.run(
@@ -267,15 +270,7 @@ def table(rows: list[SceneInstructions]) -> str:
 
 def _parser() -> argparse.ArgumentParser:
     parser = scene_parser(__doc__.splitlines()[0], list(shipped_scenes()), None)
-    parser.add_argument(
-        "--stop-time", type=float, default=1.0, help="simulated time per scene, s (default 1)"
-    )
-    parser.add_argument(
-        "--warm-up",
-        type=float,
-        default=0.4,
-        help="fraction of the run before counting starts (default 0.4)",
-    )
+    add_counting_window(parser, warm_up=0.4)
     parser.add_argument(
         "--keep",
         type=Path,
@@ -301,16 +296,10 @@ def main(argv: list[str] | None = None) -> None:
     if args.count is not None:
         count_scenes(args.scenes, args.stop_time, args.warm_up_time, args.count)
         return
-    problems = []
-    if not args.stop_time > 0.0:
-        problems.append(f"--stop-time must be positive, got {args.stop_time}")
-    if not 0.0 <= args.warm_up < 1.0:
-        problems.append(f"--warm-up must be at least 0 and below 1, got {args.warm_up}")
-    missing = missing_tools()
+    problems = counting_window_problems(args)
+    missing = valgrind_problem()
     if missing:
-        problems.append(
-            f"{' and '.join(missing)} not found: install valgrind to count instructions"
-        )
+        problems.append(missing)
     if problems:
         parser.error("; ".join(problems))
     try:

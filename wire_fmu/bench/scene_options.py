@@ -9,7 +9,13 @@ import logging
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["parse_scene_options", "report_table", "scene_parser"]
+__all__ = [
+    "add_counting_window",
+    "counting_window_problems",
+    "parse_scene_options",
+    "report_table",
+    "scene_parser",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -68,6 +74,44 @@ def parse_scene_options(
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return args
+
+
+def add_counting_window(parser: argparse.ArgumentParser, warm_up: float) -> None:
+    """Add ``--stop-time S`` (default 1 s) and ``--warm-up F`` (a fraction of the run) to
+    the parser of a benchmark that counts (bytecodes, instructions) over a shortened run.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        From :func:`scene_parser`.
+    warm_up : float
+        The default fraction of the run before counting starts.
+    """
+    parser.add_argument(
+        "--stop-time", type=float, default=1.0, help="simulated time per scene, s (default 1)"
+    )
+    parser.add_argument(
+        "--warm-up",
+        type=float,
+        default=warm_up,
+        help=f"fraction of the run before counting starts (default {warm_up:g})",
+    )
+
+
+def counting_window_problems(args: argparse.Namespace) -> list[str]:
+    """What is wrong with the options of :func:`add_counting_window` (nothing: an empty list).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    """
+    problems = []
+    if not args.stop_time > 0.0:
+        problems.append(f"--stop-time must be positive, got {args.stop_time}")
+    if not 0.0 <= args.warm_up < 1.0:
+        problems.append(f"--warm-up must be at least 0 and below 1, got {args.warm_up}")
+    return problems
 
 
 def report_table(text: str, out: Path | None) -> None:

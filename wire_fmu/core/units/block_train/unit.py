@@ -81,17 +81,13 @@ _FIELD_INPUTS = (  # a field of BlockTrainInputs, its ports, the inputs' names a
 )
 _TAKE_INPUTS = operator.itemgetter(*(f"{p}.{q}" for _, ports, q in _FIELD_INPUTS for p in ports))
 """Every kinematic input's value, in the order of :data:`_FIELD_INPUTS`."""
-_INPUT_FIELDS = tuple(
-    (field, ports, slice(end - len(ports), end))
-    for (field, ports, _), end in zip(
-        _FIELD_INPUTS,
-        itertools.accumulate(len(ports) for _, ports, _ in _FIELD_INPUTS),
-        strict=True,
-    )
+_FIELD_NAMES = tuple(field for field, _, _ in _FIELD_INPUTS)
+_FIELD_PORTS = tuple(ports for _, ports, _ in _FIELD_INPUTS)
+_FIELD_SLICES = tuple(
+    slice(end - len(ports), end)
+    for ports, end in zip(_FIELD_PORTS, itertools.accumulate(map(len, _FIELD_PORTS)), strict=True)
 )
-"""Each field of BlockTrainInputs, its ports and where their values sit in
-:data:`_TAKE_INPUTS`'s answer."""
-_FIELD_NAMES, _FIELD_PORTS, _FIELD_SLICES = zip(*_INPUT_FIELDS, strict=True)
+"""Where each field's values sit in :data:`_TAKE_INPUTS`'s answer."""
 
 
 def _variables():
