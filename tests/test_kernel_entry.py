@@ -3,9 +3,10 @@
 A compiled function is loaded from the on-disk cache at its first call with given
 argument types. The block train's and the winch's loops after an event go through
 their quiet step's own function (``resume``), and initialisation calls it once with a
-step of nothing, so that no loading falls inside the stepping. These tests check that
-that call takes the very argument types of the steps that follow (else it would load
-a specialisation no step uses) and that it changes nothing.
+step of nothing, so that no loading falls inside the stepping; the cylinder's quiet
+step and its loop after an event are two functions, and initialisation loads both.
+These tests check that that call takes the very argument types of the steps that
+follow (else it would load a specialisation no step uses) and that it changes nothing.
 """
 
 from __future__ import annotations
@@ -21,9 +22,11 @@ from wire_fmu.core.framework import compiled
 from wire_fmu.core.framework.compiled_step import CompiledFixedStep
 from wire_fmu.core.units.block_train import kernel as block_train_kernel
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
+from wire_fmu.core.units.hydraulics import kernel as hydraulics_kernel
 from wire_fmu.core.units.winch import kernel as winch_kernel
 from wire_fmu.master.run import find_scene
 
+from .hydraulics_helpers import make_free_rod
 from .winch_helpers import make_unit as make_winch
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
@@ -93,4 +96,23 @@ def test_the_winch_loads_its_step_with_the_types_its_steps_use(monkeypatch):
         assert unit.advance(k * 0.002, 0.002).success
     assert unit.model.mode_changes > 0
     assert len(calls) > 50
+    assert set(calls) == {calls[0]}
+
+
+def test_the_cylinder_loads_its_loop_after_an_event_before_its_first_step(monkeypatch):
+    calls: list[tuple] = []
+    original = hydraulics_kernel.resume
+
+    def recording(*args):
+        calls.append(tuple(numba.typeof(a) for a in args))
+        return original(*args)
+
+    monkeypatch.setattr(hydraulics_kernel, "resume", recording)
+    unit = make_free_rod("seal_friction", 0.05, solver="rk4")  # friction stops the rod
+    assert isinstance(unit.model.solver, CompiledFixedStep)
+    assert len(calls) == 1  # the preload, at initialisation
+    for k in range(100):
+        assert unit.advance(k * 0.002, 0.002).success
+    assert unit.model.mode_changes > 0  # the seal stuck: the loop went on through ``resume``
+    assert len(calls) > 1
     assert set(calls) == {calls[0]}

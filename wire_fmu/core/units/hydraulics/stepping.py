@@ -189,12 +189,14 @@ class RefinedStepping:
         return self.force * (x1 - x0) + self.interface.elastic_work(x0, x1, x_ref) + varying
 
     def _preload_quiet_step(self) -> None:
-        """Load :func:`kernel.quiet_step` from the compiled-code cache now, by a call of no
-        internal steps, so that the first step does not pay for it."""
+        """Load :func:`kernel.quiet_step` and the loop after an event (:func:`kernel.advance`,
+        :meth:`preload_kernel`) from the compiled-code cache now, by calls that take no
+        step, so that neither the first step nor the first event pays for it."""
         method = COMPILED_METHODS.get(self.settings.method) if self.compiled else None
         if method is not None:
             t = self.time
             kernel.quiet_step(method, t, t, 0, self.state, self._directions, self.kernel_data())
+            self.preload_kernel(t)
 
     def _quiet_step(self, t: float, t_end: float) -> bool:
         """Take a step in which nothing happens in one call of the compiled kernel.
