@@ -111,3 +111,68 @@ def test_a_file_without_a_total_is_refused_naming_it(tmp_path):
     path.write_text("hello\n")
     with pytest.raises(ValueError, match="not_callgrind.txt"):
         callgrind_file.callgrind_total(path)
+
+
+# libffi calls into an FMU binary twice (the second call's object named by its id), the
+# binary calls into the interpreter and within itself; the interpreter calls libffi.
+_CROSSINGS = """# callgrind format
+version: 1
+positions: line
+events: Ir
+summary: 0
+
+ob=(1) /usr/lib/x86_64-linux-gnu/libffi.so.8
+fl=(1) unix64.S
+fn=(1) ffi_call_unix64
+1 10
+cob=(2) /tmp/wire_fmu_x/binaries/linux64/Rope.so
+cfi=(2) fmi2Functions.cpp
+cfn=(2) fmi2DoStep
+calls=1 5
+* 700
+cob=(2)
+cfn=(3) fmi2GetReal
+calls=1 9
+* 80
+cfn=(4) ffi_prep
+calls=1 3
+* 6
+
+ob=(2)
+fl=(2)
+fn=(2)
+5 20
+cob=(3) /usr/lib/libpython3.11.so.1.0
+cfi=(3) ceval.c
+cfn=(5) PyObject_Call
+calls=1 1
+* 600
+cfn=(3)
+calls=1 9
+* 80
+fn=(3)
+9 80
+
+ob=(1)
+fl=(1)
+fn=(4)
+3 6
+
+ob=(3)
+fl=(3)
+fn=(5)
+1 600
+
+totals: 716
+"""
+
+
+def test_calls_into_the_fmus_count_everything_they_ran_once(tmp_path):
+    path = tmp_path / "callgrind.out.1"
+    path.write_text(_CROSSINGS)
+    # fmi2DoStep (its 20, the interpreter's 600, GetReal's 80 inside it) and a GetReal;
+    # not the binary's call to itself, nor libffi's to itself
+    assert callgrind_file.instructions_called_into(path, ("/binaries/",)) == 700 + 80
+    assert callgrind_file.instructions_called_into(path, ("libpython",)) == 600
+    assert callgrind_file.instructions_called_into(path, ("libm.so",)) == 0
+    assert sum(callgrind_file.instructions_by_object(path).values()) == 716

@@ -9,8 +9,11 @@ is read here:
 * a cost line, a position (a number, or ``+n``, ``-n`` or ``*`` relative to the last
   one) followed by the events' counts (here the instructions, ``Ir``), is the cost of
   that line of the present function;
-* ``calls=`` announces a call from the present function; the cost line after it is
-  the call's inclusive cost, counted again in the callee's own lines, and is skipped;
+* ``calls=`` announces a call from the present function to the one ``cfn=`` names
+  (in the object file ``cob=`` names, for that call only; without it, the caller's);
+  the cost line after it is the call's inclusive cost: counted again in the callee's
+  own lines, so skipped in the exclusive costs, and summed by
+  :func:`instructions_called_into`;
 * ``totals:`` (or ``summary:``) is the file's total.
 
 The exclusive costs of all functions add up to the total, which the test of this
@@ -25,6 +28,8 @@ from pathlib import Path
 
 __all__ = [
     "callgrind_total",
+    "FMU_BINARIES",
+    "instructions_called_into",
     "instructions_by_library",
     "instructions_by_object",
     "library_of",
@@ -39,6 +44,9 @@ _NAMED = re.compile(r"\((\d+)\)(?:\s+(.*))?")
 UNKNOWN_OBJECT = "???"
 """callgrind's name for code in no object file it knows (numba's machine code)."""
 
+FMU_BINARIES = ("/binaries/",)
+"""What the path of an FMU's binary contains (its folder in the unzipped FMU)."""
+
 LIBRARIES = (
     ("the Python interpreter", ("libpython",)),
     ("the compiled kernels (numba's machine code)", (UNKNOWN_OBJECT,)),
@@ -46,7 +54,7 @@ LIBRARIES = (
     ("numpy", ("numpy", "_multiarray_umath", "libopenblas", "libscipy_openblas")),
     ("numba's runtime and dispatch", ("numba", "_nrt_python", "_dispatcher", "_helperlib")),
     ("ctypes and libffi (the FMI calls)", ("_ctypes", "libffi")),
-    ("the FMU binaries", ("/binaries/",)),
+    ("the FMU binaries", FMU_BINARIES),
     ("libm", ("libm.so", "libm-")),
 )
 """The groups :func:`library_of` puts object files in, with what their paths contain."""
@@ -86,27 +94,63 @@ def instructions_by_object(path: Path) -> Counter[str]:
     Counter
         Instructions per object file's path (:data:`UNKNOWN_OBJECT` for code in none).
     """
+    return _costs(path)[0]
+
+
+def instructions_called_into(path: Path, marks: tuple[str, ...]) -> int:
+    """The instructions run inside calls into the object files whose paths contain one of
+    ``marks``, made from object files whose paths contain none (everything those calls
+    ran, callees included: their inclusive costs).
+
+    Parameters
+    ----------
+    path : Path
+        A callgrind output file with the event ``Ir`` first.
+    marks : tuple of str
+        What the called object files' paths contain (e.g. ``("/binaries/",)``, the FMUs).
+    """
+
+    def inside(obj: str) -> bool:
+        return any(mark in obj for mark in marks)
+
+    return sum(
+        count
+        for (caller, callee), count in _costs(path)[1].items()
+        if inside(callee) and not inside(caller)
+    )
+
+
+def _costs(path: Path) -> tuple[Counter[str], Counter[tuple[str, str]]]:
+    """Exclusive instructions per object file, and the inclusive instructions of the calls
+    from each object file to each other one (keyed ``(caller, callee)``)."""
     names: dict[tuple[str, str], str] = {}
     by_object: Counter[str] = Counter()
+    calls: Counter[tuple[str, str]] = Counter()
     obj = UNKNOWN_OBJECT
-    skip_next_cost = False
+    callee: str | None = None  # the object file of the next call, if ``cob=`` named one
+    call_cost_next = False
     with path.open(errors="replace") as lines:
         for line in lines:
             first = line[:1]
             if first.isdigit() or first in "+-*":
-                if skip_next_cost:
-                    skip_next_cost = False
-                    continue
                 fields = line.split()
-                if len(fields) > 1:
-                    by_object[obj] += int(fields[1])
+                if len(fields) < 2:
+                    continue
+                if call_cost_next:
+                    call_cost_next = False
+                    target = obj if callee is None else callee
+                    if target != obj:
+                        calls[(obj, target)] += int(fields[1])
+                    callee = None
+                    continue
+                by_object[obj] += int(fields[1])
             elif line.startswith("ob="):
                 obj = _name(names, "ob", line[3:].strip())
             elif line.startswith("cob="):
-                _name(names, "ob", line[4:].strip())  # defines the name for later
+                callee = _name(names, "ob", line[4:].strip())
             elif line.startswith("calls="):
-                skip_next_cost = True
-    return by_object
+                call_cost_next = True
+    return by_object, calls
 
 
 def _name(names: dict[tuple[str, str], str], kind: str, text: str) -> str:

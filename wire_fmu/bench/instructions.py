@@ -13,23 +13,26 @@ built for the purpose with the machine's C compiler). A compiled kernel's first 
 left out of the count, as :mod:`~wire_fmu.bench.bytecodes` leaves it out; the table
 says how many were.
 
-The count is every instruction the machine executes for those steps: the master, the
-FMI crossings through ctypes and the FMU binary, the facades and the units' Python,
-numba unboxing the kernels' arguments and the compiled kernels themselves, numpy and
-the allocator. Where wall-clock figures (:mod:`~wire_fmu.bench.master`,
-:mod:`~wire_fmu.bench.scenes`) move by a fifth from run to run on a busy machine, this
-one is the same to the instruction in every run of the same code and command, however
-busy the machine: the hash seed is fixed, the address space is laid out the same in
-every run (``setarch -R``: objects' addresses, and the hashes made from them, do not
-move), the garbage collector runs just before counting starts (its runs inside the
-count then follow from the counted steps alone), and the results recorder writes after
-the last step, not by the clock. It moves when the code does, so it compares two
-versions of the code where a timing cannot tell them apart. It is not a time -- an
-instruction that misses the cache costs more than one that does not, and one machine
-runs more instructions a nanosecond than another -- so the speed targets stay with the
-wall-clock benchmarks; this one says whether a change made a step cheaper, and where
-(:mod:`~wire_fmu.bench.bytecodes` counts the interpreter's part alone). A second table
-gives each library's share of the instructions (:mod:`.callgrind_file`).
+The count is every instruction the machine executes for those steps: the master, the FMI
+crossings through ctypes and the FMU binary, the facades and the units' Python, numba
+unboxing the kernels' arguments and the compiled kernels themselves, numpy and the
+allocator. Of these, the master's own are those outside the FMU binaries' FMI functions
+(everything a call into a binary runs, callees included, is the unit's): the master's
+Python, its recorder and the ctypes crossing, the figure the master's cost target speaks
+of (:mod:`~wire_fmu.bench.master` measures it as a time). Where wall-clock figures
+(:mod:`~wire_fmu.bench.master`, :mod:`~wire_fmu.bench.scenes`) move by a fifth from run
+to run on a busy machine, this one is the same to the instruction in every run of the
+same code and command, however busy the machine: the hash seed is fixed, the address
+space is laid out the same in every run (``setarch -R``: objects' addresses, and the
+hashes made from them, do not move), the garbage collector runs just before counting
+starts (its runs inside the count then follow from the counted steps alone), and the
+results recorder writes after the last step, not by the clock. It moves when the code
+does, so it compares two versions of the code where a timing cannot tell them apart. It
+is not a time -- an instruction that misses the cache costs more than one that does not,
+and one machine runs more instructions a nanosecond than another -- so the speed targets
+stay with the wall-clock benchmarks; this one says whether a change made a step cheaper,
+and where (:mod:`~wire_fmu.bench.bytecodes` counts the interpreter's part alone). A
+second table gives each library's share of the instructions (:mod:`.callgrind_file`).
 
 Under valgrind the counted steps run some fifty times slower: a run of the three
 hoisting scenes takes about a minute once their kernels are in numba's cache (ten, if
@@ -56,7 +59,14 @@ from pathlib import Path
 
 from wire_fmu.master.run import shipped_scenes
 
-from .callgrind_file import LIBRARIES, OTHER, callgrind_total, instructions_by_library
+from .callgrind_file import (
+    FMU_BINARIES,
+    LIBRARIES,
+    OTHER,
+    callgrind_total,
+    instructions_by_library,
+    instructions_called_into,
+)
 from .callgrind_window import CallgrindControl, CallgrindWindow, kernel_loads_left_out
 from .counted_run import run_counted
 from .scene_options import (
@@ -95,6 +105,10 @@ class SceneInstructions:
         Compiled kernels' loads in them, left out of the count.
     by_library : dict of str to int
         The instructions by where they ran (see :func:`.callgrind_file.library_of`).
+    in_fmi_calls : int
+        Of :attr:`instructions`, those run inside the FMU binaries' FMI functions
+        (everything a unit's ``fmi2DoStep``, ``fmi2SetReal``, ... ran: its facade, its
+        Python, its kernels); the rest is the master's own, the ctypes crossing included.
     """
 
     scene: str
@@ -103,6 +117,7 @@ class SceneInstructions:
     instructions: int
     kernel_loads: int = 0
     by_library: dict[str, int] = field(default_factory=dict)
+    in_fmi_calls: int = 0
 
     @property
     def per_step(self) -> float:
@@ -113,6 +128,11 @@ class SceneInstructions:
     def per_unit_step(self) -> float:
         """Instructions per unit and macro step."""
         return self.per_step / max(1, self.units)
+
+    @property
+    def master_per_unit_step(self) -> float:
+        """The master's own instructions (outside the FMI calls) per unit and macro step."""
+        return (self.instructions - self.in_fmi_calls) / max(1, self.steps * self.units)
 
 
 def valgrind_problem() -> str | None:
@@ -201,6 +221,7 @@ def measure(
                 callgrind_total(dump),
                 row["loads"],
                 instructions_by_library(dump),
+                instructions_called_into(dump, FMU_BINARIES),
             )
             for row, dump in zip(rows, dumps, strict=True)
         ]
@@ -234,8 +255,9 @@ def _counted_command(
 
 
 def table(rows: list[SceneInstructions]) -> str:
-    """Markdown tables: instructions per macro step and per unit and step, one row per
-    scene; then each library's share of them, one column per scene.
+    """Markdown tables: instructions per macro step and per unit and step (and of these,
+    the master's own, outside the FMI calls), one row per scene; then each library's
+    share of them, one column per scene.
 
     Parameters
     ----------
@@ -244,10 +266,10 @@ def table(rows: list[SceneInstructions]) -> str:
     """
     counts = markdown_table(
         "scene | units | macro steps counted | instructions per step | per unit and step"
-        " | kernel loads left out",
+        " | of which the master's own | kernel loads left out",
         (
             f"{r.scene} | {r.units} | {r.steps} | {r.per_step:,.0f} | {r.per_unit_step:,.0f}"
-            f" | {r.kernel_loads}"
+            f" | {r.master_per_unit_step:,.0f} | {r.kernel_loads}"
             for r in rows
         ),
     )
