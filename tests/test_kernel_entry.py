@@ -21,6 +21,7 @@ import pytest
 from wire_fmu.core.framework import compiled
 from wire_fmu.core.framework.compiled_step import CompiledFixedStep
 from wire_fmu.core.units.block_train import kernel as block_train_kernel
+from wire_fmu.core.units.block_train import kernel_outputs as block_train_kernel_outputs
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 from wire_fmu.core.units.hydraulics import kernel as hydraulics_kernel
 from wire_fmu.core.units.winch import kernel as winch_kernel
@@ -115,4 +116,24 @@ def test_the_cylinder_loads_its_loop_after_an_event_before_its_first_step(monkey
         assert unit.advance(k * 0.002, 0.002).success
     assert unit.model.mode_changes > 0  # the seal stuck: the loop went on through ``resume``
     assert len(calls) > 1
+    assert set(calls) == {calls[0]}
+
+
+def test_the_block_train_loads_its_quiet_steps_outputs_at_initialisation(monkeypatch):
+    calls: list[tuple] = []
+    original = block_train_kernel_outputs.output_vector
+
+    def recording(*args):
+        calls.append(tuple(numba.typeof(a) for a in args))
+        return original(*args)
+
+    monkeypatch.setattr(block_train_kernel_outputs, "output_vector", recording)
+    unit = drawworks_rope()
+    unit.initialize(0.0)
+    assert len(calls) == 1  # the preload
+    for k in range(20):
+        unit.values["line_a.payout"] = 0.01 * k * 0.002
+        unit.values["line_a.payout_rate"] = 0.01
+        assert unit.advance(k * 0.002, 0.002).success
+    assert len(calls) > 10  # the quiet steps
     assert set(calls) == {calls[0]}

@@ -227,11 +227,13 @@ class Unit(ABC):
     def advance(self, time: float, step: float) -> StepResult:
         """Advance from ``time`` by ``step`` (s) with the inputs held: the life cycle all share.
 
-        Refuses the step when :meth:`input_problems` finds inputs the unit cannot take; else
-        saves the state, lets :meth:`_advance` integrate the model and, when it raises one of
-        :data:`STEP_ERRORS` (the physics or the numerics cannot go on), restores the state
-        and refuses the step with the reason. A step taken moves :attr:`time` and the
-        outputs. Every refusal names the unit, the time and the reason.
+        Takes a step in which nothing happens at once where the unit can
+        (:meth:`_take_quiet_step`). Else refuses the step when :meth:`input_problems` finds
+        inputs the unit cannot take; else saves the state, lets :meth:`_advance` integrate
+        the model and, when it raises one of :data:`STEP_ERRORS` (the physics or the
+        numerics cannot go on), restores the state and refuses the step with the reason. A
+        step taken moves :attr:`time` and the outputs. Every refusal names the unit, the
+        time and the reason.
 
         Parameters
         ----------
@@ -240,6 +242,8 @@ class Unit(ABC):
         step : float
             Its length, s.
         """
+        if self._take_quiet_step(time, step):
+            return STEP_TAKEN
         bad = self.input_problems()
         if bad:
             refused = f"{self.who} at t = {time:.6g} s: step refused: "
@@ -258,6 +262,24 @@ class Unit(ABC):
                 False, f"{self.who} at t = {time:.6g} s: step of {step:.3g} s refused: {err}"
             )
         return StepResult(True, events=tuple(events)) if events else STEP_TAKEN
+
+    def _take_quiet_step(self, time: float, step: float) -> bool:
+        """Take the step from ``time`` by ``step`` (s) at once if nothing happens in it.
+
+        A unit whose compiled kernel can take a step in which no mode changes and no
+        event falls, outputs included, in a few calls overrides this: it then takes the
+        whole step (state, time, outputs) and answers True, or changes nothing and
+        answers False, and :meth:`advance` takes the step the general way (checks, undo
+        snapshot, events). By default: False.
+
+        Parameters
+        ----------
+        time : float
+            Start of the step, s.
+        step : float
+            Its length, s.
+        """
+        return False
 
     def _note_mode_change_time(self, time: float, step: float) -> None:
         """Write when the mode changed in the step just taken from ``time`` (s): the model's

@@ -15,12 +15,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wire_fmu.core.framework import bordered_band
-from wire_fmu.core.framework.compiled_step import STATUS_PYTHON
-from wire_fmu.core.units.block_train import kernel
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON
+from wire_fmu.core.framework.step_limits import IntegrationError
+from wire_fmu.core.units.block_train import kernel, kernel_interface, kernel_outputs
+from wire_fmu.core.units.block_train.interface import RELATIVE_STEP, TIME_STEP
 from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian, jacobian_structure
 
 if TYPE_CHECKING:
     from wire_fmu.core.units.block_train.model import BlockTrainInputs
+    from wire_fmu.core.units.block_train.quiet_outputs import OutputPlan
 
 __all__ = ["BandedLinearAlgebra", "CompiledBlockTrain"]
 
@@ -178,6 +181,115 @@ class CompiledBlockTrain:
         if values is not None:
             self._step_summary = (t1, self.state, values)
         return True
+
+    def quiet_step_outputs(
+        self, t: float, h: float, flat: tuple[float, ...], plan: OutputPlan, initial_energy: float
+    ) -> list[float] | None:
+        """A step in which nothing happens, with its outputs: one call of the compiled step,
+        one of the interface model if ports publish it, one of the outputs.
+
+        What :meth:`advance` and then the unit's outputs do for such a step, with the same
+        arithmetic, to the last bit (:mod:`.kernel_outputs`), without the Python between
+        the calls. When anything happens in the step -- a mode switch, an event, a value
+        that is not finite -- it changes nothing and answers None: the step is then taken
+        the general way, which names what happened.
+
+        Parameters
+        ----------
+        t, h : float
+            Start and length of the step, s.
+        flat : tuple of float
+            The inputs at ``t``, in the order of :data:`.model.FLAT_INPUTS`.
+        plan : OutputPlan
+            Which outputs, in which order (:func:`.quiet_outputs.output_plan`).
+        initial_energy : float
+            The stored energy at the start, J.
+
+        Returns
+        -------
+        list of float or None
+            The values of ``plan.names``, in their units; None if the step was not taken.
+        """
+        solver, t1 = self.solver, t + h
+        try:
+            count = solver.internal_count(t, t1)
+        except IntegrationError:  # a step too long: refused the general way, with the reason
+            return None
+        held, data = self._held_from_flat(t, flat), self.kernel_data()
+        result = kernel.quiet_step(
+            solver.method,
+            t,
+            t1,
+            count,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            data,
+            held,
+            0,
+            t,
+            False,
+        )
+        if result[0] != STATUS_DONE:
+            return None
+        x, values = result[1], result[8]
+        held_positions = (
+            self.state[: self.n_coords].copy() if self.friction.links else self._held_positions
+        )
+        table = plan.no_ports
+        if plan.interface_rows.shape[0]:
+            after = data[:11] + (held,) + data[12:23] + (held_positions,) + data[24:]
+            table = kernel_interface.port_linearisations(
+                t1, x, after, plan.interface_rows, RELATIVE_STEP, TIME_STEP
+            )
+        out, finite = kernel_outputs.output_vector(
+            x,
+            values,
+            len(self.spans),
+            table,
+            self.masses,
+            plan.line_spans,
+            plan.driver_bodies,
+            plan.block_coords,
+            plan.block_starts,
+            initial_energy,
+        )
+        if not finite:
+            return None
+        self.last_events = []
+        self.first_event_time = math.inf
+        self._flat_inputs = flat
+        self._hold(t, None, held)
+        self._held_positions = held_positions
+        self.state = x
+        self._step_summary = (t1, x, values)
+        solver.steps += result[5]
+        solver.rhs_calls += result[6]
+        return out.tolist()
+
+    def preload_quiet_outputs(self, t: float, plan: OutputPlan) -> None:
+        """Load :func:`.kernel_outputs.output_vector` from the compiled-code cache now, by a
+        call whose answer is dropped, so that the first quiet step does not pay for it.
+
+        Parameters
+        ----------
+        t : float
+            The present time, s.
+        plan : OutputPlan
+            The unit's plan of its quiet steps' outputs.
+        """
+        kernel_outputs.output_vector(
+            self.state,
+            kernel.summary(t, self.state, self.kernel_data()),
+            len(self.spans),
+            plan.no_ports,
+            self.masses,
+            plan.line_spans,
+            plan.driver_bodies,
+            plan.block_coords,
+            plan.block_starts,
+            0.0,
+        )
 
     def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
         """What the outputs need at ``(t, x)``.

@@ -37,7 +37,7 @@ from __future__ import annotations
 import itertools
 import math
 import operator
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
@@ -59,10 +59,10 @@ from wire_fmu.core.units.block_train.ordered_sums import (
     ordered_vecmat,
 )
 from wire_fmu.core.units.block_train.path import ReevedPath
-from wire_fmu.core.units.block_train.reeving import LINE_PORTS, Reeving
+from wire_fmu.core.units.block_train.reeving import LINE_PORTS, MOVER_PORTS, Reeving
 from wire_fmu.core.units.block_train.start import StartingState
 
-__all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS"]
+__all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS", "FLAT_INPUTS"]
 
 _INERTIA = ("sheave_inertia",)
 _EFFECTS = (  # name, the model without it, with it, the effects it needs
@@ -102,6 +102,38 @@ class BlockTrainInputs:
     mover_velocity: dict[str, float]
     payout_acceleration: dict[str, float] = field(default_factory=dict)
     mover_acceleration: dict[str, float] = field(default_factory=dict)
+
+    @classmethod
+    def from_flat(cls, flat: Sequence[float]) -> BlockTrainInputs:
+        """The inputs from their values in the order of :data:`FLAT_INPUTS`.
+
+        Parameters
+        ----------
+        flat : sequence of float
+            Each field's value at each of its ports, in the order of :data:`FLAT_INPUTS`
+            (m, m/s, m/s²).
+        """
+        fields = map(dict, map(zip, _FLAT_PORTS, map(list(flat).__getitem__, _FLAT_SLICES)))
+        return cls(**dict(zip(_FLAT_FIELDS, fields, strict=True)))
+
+
+FLAT_INPUTS = (
+    ("payout", LINE_PORTS),
+    ("payout_rate", LINE_PORTS),
+    ("payout_acceleration", LINE_PORTS),
+    ("mover_position", MOVER_PORTS),
+    ("mover_velocity", MOVER_PORTS),
+    ("mover_acceleration", MOVER_PORTS),
+)
+"""The inputs as one flat sequence (:meth:`BlockTrainInputs.from_flat`): each field of
+:class:`BlockTrainInputs` with the ports it has a value at, in this order."""
+_FLAT_FIELDS = tuple(name for name, _ in FLAT_INPUTS)
+_FLAT_PORTS = tuple(ports for _, ports in FLAT_INPUTS)
+_FLAT_SLICES = tuple(
+    slice(end - len(ports), end)
+    for ports, end in zip(_FLAT_PORTS, itertools.accumulate(map(len, _FLAT_PORTS)), strict=True)
+)
+"""Where each field's values sit in the flat sequence."""
 
 
 class BlockTrainModel(
@@ -228,6 +260,7 @@ class BlockTrainModel(
             self.kernel_flow_values[i, : columns.size] = row[columns]
         self._line_signs = [float(c) for c in self.line_sign]
         self.driver_ports = [b.port for b in self.drivers]
+        self._build_held_gather()
         self.block_weight = np.array(
             [
                 b.mass * float(np.array(self.reeving.gravity) @ np.array(b.direction))
@@ -247,6 +280,38 @@ class BlockTrainModel(
         """
         self._hold(t, inputs, self._held(t, inputs))
 
+    @property
+    def inputs(self) -> BlockTrainInputs:
+        """The inputs held since the last step started (made from their flat values, when a
+        quiet step held them so, on first use)."""
+        if self._inputs is None:
+            self._inputs = BlockTrainInputs.from_flat(self._flat_inputs)
+        return self._inputs
+
+    def _build_held_gather(self) -> None:
+        """Where each entry of the held-input vector (:meth:`_held`) sits in
+        ``(t, *flat inputs)`` (:data:`FLAT_INPUTS`), and the sign it is taken with."""
+        flat = [(name, port) for name, ports in FLAT_INPUTS for port in ports]
+        at = {entry: 1 + k for k, entry in enumerate(flat)}  # 0 is the time
+        drivers, ones = self.driver_ports, [1.0] * len(self.driver_ports)
+        entries = [(1.0, 0)]
+        for name, ports, signs in (
+            ("payout", LINE_PORTS, self._line_signs),
+            ("payout_rate", LINE_PORTS, self._line_signs),
+            ("mover_position", drivers, ones),
+            ("mover_velocity", drivers, ones),
+            ("payout_acceleration", LINE_PORTS, self._line_signs),
+            ("mover_acceleration", drivers, ones),
+        ):
+            entries += [(sign, at[(name, port)]) for port, sign in zip(ports, signs, strict=True)]
+        self._held_signs = [sign for sign, _ in entries]
+        self._take_held = operator.itemgetter(*(index for _, index in entries))
+
+    def _held_from_flat(self, t: float, flat: Sequence[float]) -> np.ndarray:
+        """:meth:`_held` of the inputs whose flat values (:data:`FLAT_INPUTS`) are ``flat``:
+        the same vector, to the last bit (a value times its sign, 1 for a driven body's)."""
+        return np.array(list(map(operator.mul, self._held_signs, self._take_held((t, *flat)))))
+
     def _held(self, t: float, inputs: BlockTrainInputs) -> np.ndarray:
         """The held-input vector of the kernels (see :mod:`kernel`) for ``inputs`` from ``t``."""
         signs, drivers, none = self._line_signs, self.driver_ports, itertools.repeat(0.0)
@@ -262,9 +327,10 @@ class BlockTrainModel(
             ]
         )
 
-    def _hold(self, t: float, inputs: BlockTrainInputs, vector: np.ndarray) -> None:
-        """Hold ``inputs`` (and their vector ``vector``, from :meth:`_held`) from ``t`` on."""
-        self.inputs = inputs
+    def _hold(self, t: float, inputs: BlockTrainInputs | None, vector: np.ndarray) -> None:
+        """Hold ``inputs`` (and their vector ``vector``, from :meth:`_held`) from ``t`` on;
+        None: inputs whose flat values :attr:`_flat_inputs` holds."""
+        self._inputs = inputs
         self._t_step = t
         self._step_summary = None
         self.held_vector = vector

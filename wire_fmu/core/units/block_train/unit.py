@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from wire_fmu.core.errors import ConfigurationError
+from wire_fmu.core.framework.compiled_step import CompiledFixedStep
 from wire_fmu.core.framework.hybrid import RK4_STABILITY, fastest_mode
 from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, PortSide, port
 from wire_fmu.core.framework.solver_options import solver_parameters, solver_settings
@@ -47,9 +48,11 @@ from wire_fmu.core.framework.unit import (
 from wire_fmu.core.units.block_train.interface import interface_plan, linearisation_table
 from wire_fmu.core.units.block_train.model import (
     BLOCK_TRAIN_EFFECTS,
+    FLAT_INPUTS,
     BlockTrainInputs,
     BlockTrainModel,
 )
+from wire_fmu.core.units.block_train.quiet_outputs import OutputPlan, output_plan
 from wire_fmu.core.units.block_train.reeving import (
     BLOCK_PORTS,
     LINE_PORTS,
@@ -71,23 +74,18 @@ _KINEMATIC_INPUTS = tuple(
     + [f"{p}.position" for p in MOVER_PORTS]
     + [f"{p}.velocity" for p in MOVER_PORTS]
 )
-_FIELD_INPUTS = (  # a field of BlockTrainInputs, its ports, the inputs' names after the port
-    ("payout", LINE_PORTS, "payout"),
-    ("payout_rate", LINE_PORTS, "payout_rate"),
-    ("payout_acceleration", LINE_PORTS, "payout_acceleration"),
-    ("mover_position", MOVER_PORTS, "position"),
-    ("mover_velocity", MOVER_PORTS, "velocity"),
-    ("mover_acceleration", MOVER_PORTS, "acceleration"),
+_INPUT_NAMES = {  # each field of BlockTrainInputs: the input's name after the port
+    "payout": "payout",
+    "payout_rate": "payout_rate",
+    "payout_acceleration": "payout_acceleration",
+    "mover_position": "position",
+    "mover_velocity": "velocity",
+    "mover_acceleration": "acceleration",
+}
+_TAKE_INPUTS = operator.itemgetter(
+    *(f"{port}.{_INPUT_NAMES[field]}" for field, ports in FLAT_INPUTS for port in ports)
 )
-_TAKE_INPUTS = operator.itemgetter(*(f"{p}.{q}" for _, ports, q in _FIELD_INPUTS for p in ports))
-"""Every kinematic input's value, in the order of :data:`_FIELD_INPUTS`."""
-_FIELD_NAMES = tuple(field for field, _, _ in _FIELD_INPUTS)
-_FIELD_PORTS = tuple(ports for _, ports, _ in _FIELD_INPUTS)
-_FIELD_SLICES = tuple(
-    slice(end - len(ports), end)
-    for ports, end in zip(_FIELD_PORTS, itertools.accumulate(map(len, _FIELD_PORTS)), strict=True)
-)
-"""Where each field's values sit in :data:`_TAKE_INPUTS`'s answer."""
+"""Every kinematic input's value, in the order of :data:`~.model.FLAT_INPUTS`."""
 
 
 def _variables():
@@ -290,6 +288,7 @@ class BlockTrainUnit(Unit):
         super().__init__(instance_name)
         self.model: BlockTrainModel | None = None
         self.initial_energy = 0.0
+        self._outputs_of_quiet_steps: OutputPlan | None = None
 
     # ------------------------------------------------------------ life cycle
     def configure(self) -> None:
@@ -349,6 +348,9 @@ class BlockTrainUnit(Unit):
         self.time = start_time
         self.initial_energy = model.stored_energy(start_time)
         self._update_outputs()
+        plan = self._quiet_plan()
+        if plan is not None:
+            model.preload_quiet_outputs(start_time, plan)
 
     def _stability_problems(self) -> list[str]:
         """An rk4 step the stiffest mode of the initial state cannot be stable with."""
@@ -378,6 +380,40 @@ class BlockTrainUnit(Unit):
         if 0 <= segment <= n:
             return []
         return [f"break_segment {segment} does not exist (0 for none, 1..{n})"]
+
+    def _take_quiet_step(self, time: float, step: float) -> bool:
+        """A step in which nothing happens, outputs included, in a few compiled calls.
+
+        Implements :meth:`Unit._take_quiet_step` with :meth:`CompiledBlockTrain.quiet_step_outputs
+        <wire_fmu.core.units.block_train.compiled_model.CompiledBlockTrain.quiet_step_outputs>`
+        when the compiled kernel runs the model's steps and no segment is commanded to
+        break. The outputs a quiet step cannot change (slack spans, broken, mode changes)
+        keep their values.
+        """
+        plan = self._quiet_plan()
+        if plan is None or self.values["break_segment"]:
+            return False
+        taken = plan.model.quiet_step_outputs(
+            time, step, self._flat_inputs(), plan, self.initial_energy
+        )
+        if taken is None:
+            return False
+        self.values.update(zip(plan.names, taken))  # noqa: B905 - as many by construction
+        self.time = time + step
+        return True
+
+    def _quiet_plan(self) -> OutputPlan | None:
+        """The outputs of a quiet step for the present model and published ports (made
+        when either changes), or None when the model's steps are not compiled."""
+        m = self.model
+        if m is None or not (m.compiled and isinstance(m.solver, CompiledFixedStep)):
+            return None
+        ports = self._interface_ports()
+        plan = self._outputs_of_quiet_steps
+        if plan is None or plan.model is not m or plan.ports != ports:
+            plan = output_plan(m, *self._output_plan(m), ports)
+            self._outputs_of_quiet_steps = plan
+        return plan
 
     def _advance(self, time: float, step: float) -> list[str]:
         """Integrate the rope (breaking a commanded segment first); its events as text."""
@@ -471,10 +507,11 @@ class BlockTrainUnit(Unit):
 
     # -------------------------------------------------------------- helpers
     def _inputs(self) -> BlockTrainInputs:
-        got = list(map(float, _TAKE_INPUTS(self.values)))
-        # each field's {port: value}, from its slice of got: built in C, every step
-        fields = map(dict, map(zip, _FIELD_PORTS, map(got.__getitem__, _FIELD_SLICES)))
-        return BlockTrainInputs(**dict(zip(_FIELD_NAMES, fields, strict=True)))
+        return BlockTrainInputs.from_flat(self._flat_inputs())
+
+    def _flat_inputs(self) -> tuple[float, ...]:
+        """The kinematic inputs' values in the order of :data:`~.model.FLAT_INPUTS`."""
+        return tuple(map(float, _TAKE_INPUTS(self.values)))
 
     def _output_plan(self, m: BlockTrainModel) -> tuple[list, list, list]:
         """Which span, body and coordinate feed each port output (built once per model)."""

@@ -1,0 +1,130 @@
+"""The block train's outputs after a quiet step, in compiled form: one vector, one call.
+
+:func:`output_vector` is what :meth:`BlockTrainUnit._update_outputs
+<wire_fmu.core.units.block_train.unit.BlockTrainUnit._update_outputs>` writes after a
+step in which no mode changed, with the same operations in the same order, so the two
+give the same numbers to the last bit: the line-end tensions, the driven bodies'
+forces, the blocks' positions and velocities, the path's end tensions and the largest
+one, the energy ledger, and each published port's interface model. The outputs a
+quiet step cannot change (the slack-span count, the broken flag, the mode changes)
+are not in it. Which value goes where is the unit's :class:`~.quiet_step.OutputPlan`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wire_fmu.core.framework.compiled import jit
+
+__all__ = ["FIXED_OUTPUTS", "output_vector"]
+
+FIXED_OUTPUTS = (
+    "path_start.tension",
+    "path_end.tension",
+    "tension_max",
+    "stored_energy",
+    "dissipated_energy",
+    "external_work",
+    "energy_balance",
+)
+"""The outputs every block train has, in the order :func:`output_vector` writes them
+after the ports' forces and the blocks' motion."""
+
+
+@jit
+def output_vector(
+    x: np.ndarray,
+    values: np.ndarray,
+    n_spans: int,
+    table: np.ndarray,
+    masses: np.ndarray,
+    line_spans: np.ndarray,
+    driver_bodies: np.ndarray,
+    block_coords: np.ndarray,
+    block_starts: np.ndarray,
+    initial_energy: float,
+):
+    """The outputs' values after a step, and whether all of them are finite.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State at the step's end ``[q, v, dissipated, external work]`` (m, m/s, J, J).
+    values : numpy.ndarray
+        :func:`.kernel.summary` at the step's end: strain energy (J), potential (J),
+        each span's tension (N), each body's force (N).
+    n_spans : int
+        The number of spans.
+    table : numpy.ndarray
+        The published ports' interface models, one row a port
+        (:func:`.kernel_interface.port_linearisations`); no rows for none.
+    masses : numpy.ndarray
+        Mass of each coordinate, kg.
+    line_spans : numpy.ndarray
+        int, per line-end output: the span whose tension it is.
+    driver_bodies : numpy.ndarray
+        int, per driven body's force output: the body's index among the bodies.
+    block_coords : numpy.ndarray
+        int, per block with a port: its coordinate.
+    block_starts : numpy.ndarray
+        Per block with a port: its position with the coordinate at 0, m.
+    initial_energy : float
+        The stored energy at the start, J (the ledger's reference).
+
+    Returns
+    -------
+    vector : numpy.ndarray
+        The line-end tensions (N), the driven bodies' forces (N), each block's position
+        (m) and velocity (m/s), the :data:`FIXED_OUTPUTS` (N, N, N, J, J, J, J), then
+        the table's rows.
+    finite : bool
+        Whether every value is finite (else the step is taken the general way, which
+        names what failed).
+    """
+    n = masses.size
+    out = np.empty(
+        line_spans.size
+        + driver_bodies.size
+        + 2 * block_coords.size
+        + len(FIXED_OUTPUTS)
+        + table.size
+    )
+    k = 0
+    for span in line_spans:
+        out[k] = values[2 + span]
+        k += 1
+    for body in driver_bodies:
+        out[k] = values[2 + n_spans + body]
+        k += 1
+    for j in range(block_coords.size):
+        out[k] = block_starts[j] + x[block_coords[j]]
+        out[k + 1] = x[n + block_coords[j]]
+        k += 2
+    largest = 0.0  # as Python's max: the first, replaced by each one larger
+    if n_spans:
+        largest = values[2]
+        for i in range(3, 2 + n_spans):
+            if values[i] > largest:
+                largest = values[i]
+    kinetic = 0.0
+    for i in range(n):
+        kinetic += masses[i] * (x[n + i] * x[n + i])
+    stored = 0.5 * kinetic + values[0] + values[1]
+    out[k] = values[2]
+    out[k + 1] = values[1 + n_spans]
+    out[k + 2] = largest
+    out[k + 3] = stored
+    out[k + 4] = x[2 * n]
+    out[k + 5] = x[2 * n + 1]
+    out[k + 6] = stored - initial_energy + x[2 * n] - x[2 * n + 1]
+    k += len(FIXED_OUTPUTS)
+    for row in range(table.shape[0]):
+        for column in range(table.shape[1]):
+            out[k] = table[row, column]
+            k += 1
+    finite = True
+    for value in out:
+        finite = finite and math.isfinite(value)
+    return out, finite
