@@ -139,6 +139,42 @@ class RefinedStepping:
         HydraulicLimitError
             At a limit (the caller restores the state and refuses the step).
         """
+        return self._advance_held(t, h, force, interface, quiet_only=False) or 0
+
+    def quiet_advance(
+        self, t: float, h: float, force: float, interface: RodInterface = NO_INTERFACE
+    ) -> bool:
+        """:meth:`advance` when the step is quiet (:meth:`_quiet_step`); else nothing changes.
+
+        A quiet step whose report is not finite counts as not quiet: the general way
+        then refuses it with the reason.
+
+        Parameters
+        ----------
+        t, h, force, interface
+            As :meth:`advance` takes them.
+
+        Returns
+        -------
+        bool
+            Whether the step was taken (then with no events).
+        """
+        kept = self.load, self.state, self.step_report, self.external_work, self.last_events
+        held_position = None if self.seal is None else self.seal.held_position
+        taken = self._advance_held(t, h, force, interface, quiet_only=True) is not None
+        if taken and all(map(math.isfinite, self.step_report[2])):
+            return True
+        (self.force, self.interface, self.time), self.state, self.step_report = kept[:3]
+        self.external_work, self.last_events = kept[3:]
+        if self.seal is not None:
+            self.seal.held_position = held_position
+        return False
+
+    def _advance_held(
+        self, t: float, h: float, force: float, interface: RodInterface, quiet_only: bool
+    ) -> int | None:
+        """:meth:`advance`; with ``quiet_only``, None (having changed the state, the load
+        and the seal's held position) when the step is not quiet."""
         self.last_events = []
         self.first_event_time = math.inf
         self.force = float(force)
@@ -151,26 +187,32 @@ class RefinedStepping:
         self.step_report = None
         start = float(self.state[0])
         if not self.interface.active:
-            events = self._step(t, t + h)
-            self.external_work += self.force * (float(self.state[0]) - start)
+            events = self._step(t, t + h, quiet_only)
+            if events is not None:
+                self.external_work += self.force * (float(self.state[0]) - start)
             return events
         self.state = np.concatenate((self.state, _NO_WORK))  # the interface model's work, J
         self.use_layout(self.interface_layout)
         try:
-            events = self._step(t, t + h)
+            events = self._step(t, t + h, quiet_only)
         finally:
             self.use_layout(self.own_layout)
             self.state, varying = self.state[:-1], float(self.state[-1])
+        if events is None:
+            return None
         if self.step_report is not None:  # the report does not depend on the work state
             self.step_report = (self.state, *self.step_report[1:])
         self.external_work += self._interface_work(start, float(self.state[0]), varying)
         return events
 
-    def _step(self, t: float, t_end: float) -> int:
-        """Integrate from ``t`` to ``t_end`` (s) in the present layout; the events located."""
+    def _step(self, t: float, t_end: float, quiet_only: bool = False) -> int | None:
+        """Integrate from ``t`` to ``t_end`` (s) in the present layout; the events located
+        (None if ``quiet_only`` and the step is not quiet: nothing integrated)."""
         try:
             if self._quiet_step(t, t_end):
                 return 0
+            if quiet_only:
+                return None
             violated, rod_force = self._limits_and_force(self.state, t)
             self._refuse_at_limit(violated, t, self.state)
             self.state = self.settle(self.state, rod_force)

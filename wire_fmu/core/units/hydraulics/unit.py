@@ -305,9 +305,31 @@ class HydraulicsUnit(Unit):
     def input_problems(self) -> list[str]:
         """Inputs the cylinder cannot step with: not finite, or a negative spring or damper
         in the interface model (each named)."""
-        return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + (
-            self.rod_interface(self.time).problems("rod")
-        )
+        return self._input_problems(self.rod_interface(self.time))
+
+    def _input_problems(self, interface: RodInterface) -> list[str]:
+        """:meth:`input_problems`, the interface model in the inputs being ``interface``."""
+        return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + interface.problems("rod")
+
+    def _take_quiet_step(self, time: float, step: float) -> bool:
+        """A step in which nothing happens in one call of the compiled kernel, without the
+        undo snapshot (:meth:`HydraulicsModel.quiet_advance
+        <wire_fmu.core.units.hydraulics.stepping.RefinedStepping.quiet_advance>`).
+
+        Implements :meth:`Unit._take_quiet_step`: inputs the cylinder cannot take, and
+        steps that are not quiet, go the general way, which names why.
+        """
+        model = self.model
+        if model is None or not model.compiled:
+            return False
+        interface = self.rod_interface(time)
+        if self._input_problems(interface):
+            return False
+        if not model.quiet_advance(time, step, float(self.values["rod.force"]), interface):
+            return False
+        self.time = time + step
+        self._update_outputs()  # finite: a quiet step's report is
+        return True
 
     def rod_interface(self, start: float) -> RodInterface:
         """The interface model of the rod force in the inputs now set, about ``start`` (s).
