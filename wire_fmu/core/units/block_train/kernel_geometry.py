@@ -57,8 +57,18 @@ def segment_lengths(y: np.ndarray, path_nodes, carriers, body_dirs):
         a sheave); the lengths are then meaningless.
     """
     n_nodes = path_nodes.shape[0]
-    xs = np.empty(n_nodes)
-    zs = np.empty(n_nodes)
+    seg = np.empty(n_nodes - 1)
+    ok = _segment_lengths_into(seg, np.empty((4, n_nodes)), y, path_nodes, carriers, body_dirs)
+    return seg, ok
+
+
+@jit
+def _segment_lengths_into(seg, work, y, path_nodes, carriers, body_dirs) -> bool:
+    """:func:`segment_lengths` written into ``seg`` (one per segment), with ``work`` (4 rows
+    of at least one per path node) as its scratch: no array made, which in a kernel that
+    evaluates the path five times an evaluation costs more than the arithmetic."""
+    n_nodes = path_nodes.shape[0]
+    xs, zs, dir_x, dir_z = work[0], work[1], work[2], work[3]
     for k in range(n_nodes):
         shift_x = 0.0
         shift_z = 0.0
@@ -71,21 +81,19 @@ def segment_lengths(y: np.ndarray, path_nodes, carriers, body_dirs):
         xs[k] = path_nodes[k, 0] + shift_x
         zs[k] = path_nodes[k, 1] + shift_z
     n_seg = n_nodes - 1
-    seg = np.empty(n_seg)
-    dir_x = np.empty(n_seg)
-    dir_z = np.empty(n_seg)
     for i in range(n_seg):
         dx = xs[i + 1] - xs[i]
         dy = zs[i + 1] - zs[i]
         k = path_nodes[i + 1, 2] - path_nodes[i, 2]
         l2 = dx * dx + dy * dy
         if math.sqrt(l2) - abs(k) <= _POS_TOL:
-            return seg, False
+            return False
         lt = math.sqrt(l2 - k * k)
         seg[i] = lt
         dir_x[i] = (lt * dx + k * dy) / l2
         dir_z[i] = (lt * dy - k * dx) / l2
-    half_arcs = np.empty(max(n_nodes - 2, 0))
+    # each inner node's half arc, kept in xs (its position is not needed any more)
+    half_arcs = xs
     for j in range(1, n_nodes - 1):
         ax, ay, bx, by = dir_x[j - 1], dir_z[j - 1], dir_x[j], dir_z[j]
         cr = ax * by - ay * bx
@@ -100,7 +108,7 @@ def segment_lengths(y: np.ndarray, path_nodes, carriers, body_dirs):
         seg[i] += half_arcs[i]
     for i in range(n_seg - 1):
         seg[i + 1] += half_arcs[i]
-    return seg, True
+    return True
 
 
 @jit
@@ -132,8 +140,10 @@ def span_geometry(y: np.ndarray, data):
     h = data[16][0]
     n_spans = data[3].size
     n_bodies = y.size
-    seg, ok = segment_lengths(y, path_nodes, carriers, body_dirs)
-    n_seg = seg.size
+    n_seg = path_nodes.shape[0] - 1
+    work = np.empty((4, n_seg + 1))  # every evaluation's scratch, made once
+    seg, plus, minus = np.empty(n_seg), np.empty(n_seg), np.empty(n_seg)
+    ok = _segment_lengths_into(seg, work, y, path_nodes, carriers, body_dirs)
     jac = np.zeros((n_seg, n_bodies))
     y_plus = np.empty(n_bodies)
     y_minus = np.empty(n_bodies)
@@ -142,8 +152,8 @@ def span_geometry(y: np.ndarray, data):
             step = h if j == b else 0.0
             y_plus[j] = y[j] + step
             y_minus[j] = y[j] - step
-        plus, ok_plus = segment_lengths(y_plus, path_nodes, carriers, body_dirs)
-        minus, ok_minus = segment_lengths(y_minus, path_nodes, carriers, body_dirs)
+        ok_plus = _segment_lengths_into(plus, work, y_plus, path_nodes, carriers, body_dirs)
+        ok_minus = _segment_lengths_into(minus, work, y_minus, path_nodes, carriers, body_dirs)
         ok = ok and ok_plus and ok_minus
         for i in range(n_seg):
             jac[i, b] = (plus[i] - minus[i]) / (2.0 * h)
