@@ -134,45 +134,40 @@ def kernel_data(model) -> tuple:
 
 
 @jit
-def _matvec(a: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``a @ v`` by loops (sizes of a few; no BLAS call for empty shapes)."""
-    out = np.zeros(a.shape[0])
+def _matvec_into(out: np.ndarray, a: np.ndarray, v: np.ndarray) -> None:
+    """``out += a @ v`` by loops (sizes of a few; no BLAS call for empty shapes): ``a @ v``
+    into ``out`` of zeros."""
     for i in range(a.shape[0]):
         for j in range(a.shape[1]):
             out[i] += a[i, j] * v[j]
-    return out
 
 
 @jit
-def _flow_matvec(columns: np.ndarray, values: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``flow @ v`` over the non-zero entries of ``flow`` (the same sums as :func:`_matvec`)."""
-    out = np.zeros(columns.shape[0])
+def _flow_matvec_into(out: np.ndarray, columns: np.ndarray, values: np.ndarray, v: np.ndarray):
+    """``out += flow @ v`` over the non-zero entries of ``flow`` (the same sums as
+    :func:`_matvec_into`)."""
     for i in range(columns.shape[0]):
         for k in range(columns.shape[1]):
             if columns[i, k] >= 0:
                 out[i] += values[i, k] * v[columns[i, k]]
-    return out
 
 
 @jit
-def _flow_vecmat(w: np.ndarray, columns: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
-    """``w @ flow`` over the non-zero entries of ``flow`` (the same sums as :func:`_vecmat`)."""
-    out = np.zeros(size)
+def _flow_vecmat_into(out: np.ndarray, w: np.ndarray, columns: np.ndarray, values: np.ndarray):
+    """``out += w @ flow`` over the non-zero entries of ``flow`` (the same sums as
+    :func:`_vecmat_into`)."""
     for i in range(columns.shape[0]):
         for k in range(columns.shape[1]):
             if columns[i, k] >= 0:
                 out[columns[i, k]] += w[i] * values[i, k]
-    return out
 
 
 @jit
-def _vecmat(v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """``v @ a`` by loops."""
-    out = np.zeros(a.shape[1])
+def _vecmat_into(out: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+    """``out += v @ a`` by loops."""
     for i in range(a.shape[0]):
         for j in range(a.shape[1]):
             out[j] += v[i] * a[i, j]
-    return out
 
 
 @jit
@@ -239,33 +234,38 @@ def evaluate(t: float, x: np.ndarray, data):
     ea, damping = rope[0], rope[1]
     n_spans = len0.size
     dt = t - held[0]
-    y = np.empty(nb + nd)
-    ydot = np.empty(nb + nd)
+    # four blocks of rows rather than a score of small arrays (each costs more to make
+    # and free than its arithmetic): per body, per rope coordinate, per span, per block
+    bodies = np.zeros((3, nb + nd))
+    y, ydot, body_force = bodies[0], bodies[1], bodies[2]
     for j in range(nb):
         y[j] = x[j]
         ydot[j] = x[n + j]
     for j in range(nd):
         y[nb + j], ydot[nb + j] = held_motion(held, j, True, nd, dt)
-    flow_q = np.empty(n + N_LINES)
-    flow_v = np.empty(n + N_LINES)
+    flows = np.zeros((3, n + N_LINES))
+    flow_q, flow_v, generalised = flows[0], flows[1], flows[2]
     for i in range(n):
         flow_q[i] = x[i]
         flow_v[i] = x[n + i]
     for i in range(N_LINES):
         flow_q[n + i], flow_v[n + i] = held_motion(held, i, False, nd, dt)
+    spans = np.zeros((11, n_spans))
+    big_l_rate, small_l, small_l_rate, stretch_of = spans[1], spans[2], spans[3], spans[4]
+    tension, trial, elastic = spans[5], spans[6], spans[7]
+    on_unstretched, energy, span_loss = spans[8], spans[9], spans[10]
     if sizes[3]:
         big_l, jac, ok = span_geometry(y, data)
     else:
-        big_l, jac, ok = len0 + _matvec(jac0, y), jac0, True
-    big_l_rate = _matvec(jac, ydot)
-    small_l = offsets + _flow_matvec(flow_columns, flow_values, flow_q)
-    small_l_rate = _flow_matvec(flow_columns, flow_values, flow_v)
-    tension = np.zeros(n_spans)
-    trial = np.empty(n_spans)
-    elastic = np.empty(n_spans)
-    on_unstretched = np.zeros(n_spans)
-    energy = np.zeros(n_spans)
-    span_loss = np.zeros(n_spans)
+        big_l, jac, ok = spans[0], jac0, True
+        _matvec_into(big_l, jac0, y)
+        for i in range(n_spans):
+            big_l[i] = len0[i] + big_l[i]
+    _matvec_into(big_l_rate, jac, ydot)
+    _flow_matvec_into(small_l, flow_columns, flow_values, flow_q)
+    for i in range(n_spans):
+        small_l[i] = offsets[i] + small_l[i]
+    _flow_matvec_into(small_l_rate, flow_columns, flow_values, flow_v)
     loss = 0.0
     for i in range(n_spans):
         if small_l[i] <= 0.0:
@@ -293,12 +293,14 @@ def evaluate(t: float, x: np.ndarray, data):
             strain_rate = t_el * big_l_rate[i] - t_el * (1.0 + 0.5 * eps) * small_l_rate[i]
             span_loss[i] = max(-strain_rate, 0.0)
             loss += span_loss[i]
-    body_force = -_vecmat(tension, jac)
-    generalised = _flow_vecmat(on_unstretched, flow_columns, flow_values, n + N_LINES)
-    forces = generalised[:n].copy()
+    _vecmat_into(body_force, tension, jac)
+    for j in range(nb + nd):
+        body_force[j] = -body_force[j]
+    _flow_vecmat_into(generalised, on_unstretched, flow_columns, flow_values)
+    forces = generalised[:n]  # the line ends' part is read as it is, below
     potential = 0.0
-    depth = np.zeros(nb)
-    trial_contact = np.zeros(nb)
+    contacts = np.zeros((2, nb))
+    depth, trial_contact = contacts[0], contacts[1]
     for j in range(nb):
         weight = blocks[j, 0]
         forces[j] += body_force[j] + weight
@@ -320,12 +322,14 @@ def evaluate(t: float, x: np.ndarray, data):
     power = -(line_force[0] * flow_v[n] + line_force[1] * flow_v[n + 1])
     for j in range(nd):
         power -= body_force[nb + j] * ydot[nb + j]
+    for i in range(n_spans):
+        stretch_of[i] = big_l[i] - small_l[i]
     return (
         forces,
         tension,
         trial,
         elastic,
-        big_l - small_l,
+        stretch_of,
         line_force,
         body_force,
         depth,
