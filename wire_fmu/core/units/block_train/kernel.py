@@ -448,9 +448,14 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
+    return _guards_of(evaluate(t, x, data), x, data)
+
+
+@jit
+def _guards_of(result, x: np.ndarray, data) -> np.ndarray:
+    """:func:`guards` from :func:`evaluate`'s ``result`` at state ``x``."""
     breaking_load = data[1][2]
     masses, blocks, taut, broken, contact = data[2], data[6], data[8], data[9], data[10]
-    result = evaluate(t, x, data)
     tension, trial, elastic, depth, trial_contact = (
         result[1],
         result[2],
@@ -653,7 +658,7 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
     after = evaluate(t0, x, new)
     if not (before[13] and after[13]):
         return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
-    g = guards(t0, x, new)
+    g = _guards_of(after, x, new)  # guards(t0, x, new), from the evaluation just made
     for i in range(n_links + data[3].size + data[0][1]):  # links, spans and floors
         if g[i] < 0.0 and (i >= n_links or data[19][i] == 0):
             return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
