@@ -21,6 +21,8 @@ from wire_fmu.core.units.block_train import kernel_outputs
 from wire_fmu.core.units.block_train.unit import BlockTrainUnit
 from wire_fmu.master.run import find_scene
 
+from .quiet_step_helpers import counted, general_way
+
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
 
 
@@ -37,25 +39,6 @@ def scene_rope(scene: str, **values) -> BlockTrainUnit:
     unit.configure()
     unit.initialize(0.0)
     return unit
-
-
-def general_way(unit: BlockTrainUnit) -> BlockTrainUnit:
-    """``unit`` made to take every step the general way."""
-    unit._take_quiet_step = lambda time, step: False
-    return unit
-
-
-def counted(unit: BlockTrainUnit) -> list[bool]:
-    """Whether each step of ``unit`` from now on was taken the quiet way."""
-    taken: list[bool] = []
-    quiet = unit._take_quiet_step
-
-    def counting(time, step):
-        taken.append(quiet(time, step))
-        return taken[-1]
-
-    unit._take_quiet_step = counting
-    return taken
 
 
 def step_both(quiet, general, inputs, steps: int, h: float) -> None:

@@ -19,27 +19,9 @@ from wire_fmu.core.units.hydraulics import stepping
 from wire_fmu.core.units.hydraulics.interface import INTERFACE_INPUTS
 
 from .hydraulics_helpers import ALL_EFFECTS, F_EQ, make_free_rod, make_unit, quiet_cylinder
+from .quiet_step_helpers import counted, general_way
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
-
-
-def general_way(unit):
-    """``unit`` made to take every step the general way."""
-    unit._take_quiet_step = lambda time, step: False
-    return unit
-
-
-def counted(unit) -> list[bool]:
-    """Whether each step of ``unit`` from now on was taken the quiet way."""
-    taken: list[bool] = []
-    quiet = unit._take_quiet_step
-
-    def counting(time, step):
-        taken.append(quiet(time, step))
-        return taken[-1]
-
-    unit._take_quiet_step = counting
-    return taken
 
 
 def step_both(quiet, general, inputs, steps: int, h: float) -> None:

@@ -33,16 +33,16 @@ from .winch_helpers import make_unit as make_winch
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
 
 
-def recorded_calls(monkeypatch, module) -> list[tuple]:
-    """The numba types of every call of ``module.quiet_step`` from now on (still called)."""
+def recorded_calls(monkeypatch, module, name: str = "quiet_step") -> list[tuple]:
+    """The numba types of every call of ``module.<name>`` from now on (still called)."""
     calls: list[tuple] = []
-    original = module.quiet_step
+    original = getattr(module, name)
 
     def recording(*args):
         calls.append(tuple(numba.typeof(a) for a in args))
         return original(*args)
 
-    monkeypatch.setattr(module, "quiet_step", recording)
+    monkeypatch.setattr(module, name, recording)
     return calls
 
 
@@ -101,14 +101,7 @@ def test_the_winch_loads_its_step_with_the_types_its_steps_use(monkeypatch):
 
 
 def test_the_cylinder_loads_its_loop_after_an_event_before_its_first_step(monkeypatch):
-    calls: list[tuple] = []
-    original = hydraulics_kernel.resume
-
-    def recording(*args):
-        calls.append(tuple(numba.typeof(a) for a in args))
-        return original(*args)
-
-    monkeypatch.setattr(hydraulics_kernel, "resume", recording)
+    calls = recorded_calls(monkeypatch, hydraulics_kernel, "resume")
     unit = make_free_rod("seal_friction", 0.05, solver="rk4")  # friction stops the rod
     assert isinstance(unit.model.solver, CompiledFixedStep)
     assert len(calls) == 1  # the preload, at initialisation
@@ -120,14 +113,7 @@ def test_the_cylinder_loads_its_loop_after_an_event_before_its_first_step(monkey
 
 
 def test_the_block_train_loads_its_quiet_steps_outputs_at_initialisation(monkeypatch):
-    calls: list[tuple] = []
-    original = block_train_kernel_outputs.output_vector
-
-    def recording(*args):
-        calls.append(tuple(numba.typeof(a) for a in args))
-        return original(*args)
-
-    monkeypatch.setattr(block_train_kernel_outputs, "output_vector", recording)
+    calls = recorded_calls(monkeypatch, block_train_kernel_outputs, "output_vector")
     unit = drawworks_rope()
     unit.initialize(0.0)
     assert len(calls) == 1  # the preload
