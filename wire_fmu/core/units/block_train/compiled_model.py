@@ -238,9 +238,13 @@ class CompiledBlockTrain:
         )
         table = plan.no_ports
         if plan.interface_rows.shape[0]:
-            after = data[:11] + (held,) + data[12:23] + (held_positions,) + data[24:]
             table = kernel_interface.port_linearisations(
-                t1, x, after, plan.interface_rows, RELATIVE_STEP, TIME_STEP
+                t1,
+                x,
+                kernel.holding(data, held, held_positions),
+                plan.interface_rows,
+                RELATIVE_STEP,
+                TIME_STEP,
             )
         out, finite = kernel_outputs.output_vector(
             x,

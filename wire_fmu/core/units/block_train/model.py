@@ -116,6 +116,13 @@ class BlockTrainInputs:
         fields = map(dict, map(zip, _FLAT_PORTS, map(list(flat).__getitem__, _FLAT_SLICES)))
         return cls(**dict(zip(_FLAT_FIELDS, fields, strict=True)))
 
+    def flat(self) -> tuple[float, ...]:
+        """The inputs' values in the order of :data:`FLAT_INPUTS` (0 at a port without one):
+        the inverse of :meth:`from_flat`."""
+        return tuple(
+            getattr(self, name).get(port, 0.0) for name, ports in FLAT_INPUTS for port in ports
+        )
+
 
 FLAT_INPUTS = (
     ("payout", LINE_PORTS),
@@ -314,18 +321,7 @@ class BlockTrainModel(
 
     def _held(self, t: float, inputs: BlockTrainInputs) -> np.ndarray:
         """The held-input vector of the kernels (see :mod:`kernel`) for ``inputs`` from ``t``."""
-        signs, drivers, none = self._line_signs, self.driver_ports, itertools.repeat(0.0)
-        return np.array(
-            [
-                t,
-                *map(operator.mul, signs, map(inputs.payout.get, LINE_PORTS, none)),
-                *map(operator.mul, signs, map(inputs.payout_rate.get, LINE_PORTS, none)),
-                *map(inputs.mover_position.get, drivers, none),
-                *map(inputs.mover_velocity.get, drivers, none),
-                *map(operator.mul, signs, map(inputs.payout_acceleration.get, LINE_PORTS, none)),
-                *map(inputs.mover_acceleration.get, drivers, none),
-            ]
-        )
+        return self._held_from_flat(t, inputs.flat())
 
     def _hold(self, t: float, inputs: BlockTrainInputs | None, vector: np.ndarray) -> None:
         """Hold ``inputs`` (and their vector ``vector``, from :meth:`_held`) from ``t`` on;
