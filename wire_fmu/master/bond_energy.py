@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .extrapolation import History
     from .scene import Bond
 
 __all__ = ["BondKeys", "step_energy"]
@@ -71,7 +70,7 @@ class BondKeys:
 
 def step_energy(
     keys: BondKeys,
-    histories: Mapping[str, History],
+    latest: Mapping[str, float],
     held: Mapping[str, float],
     new: Mapping[str, float],
     h: float,
@@ -82,9 +81,9 @@ def step_energy(
     ----------
     keys : BondKeys
         The bond's link names (:meth:`BondKeys.of`).
-    histories : mapping of str to History
-        Each source output's history (``"unit.variable"``); its latest point is
-        the value at the start of the step.
+    latest : mapping of str to float
+        Each source output's value at the start of the step, by ``"unit.variable"``,
+        in its unit.
     held : mapping of str to float
         What each input (``"unit.variable"``) held over the step; an input not
         in it held its source's latest value.
@@ -102,14 +101,14 @@ def step_energy(
         flow), W.
     """
     e_key, f_key = keys.effort, keys.flow
-    e0, e1 = histories[e_key].latest, new[e_key]
-    f_held = held.get(keys.flow_target, histories[f_key].latest)
+    e0, e1 = latest[e_key], new[e_key]
+    f_held = held.get(keys.flow_target, latest[f_key])
     e_held = held.get(keys.effort_target, e0)
     if keys.position is None:  # the flow side's displacement, by the trapezoidal rule
-        moved, jump = 0.5 * (histories[f_key].latest + new[f_key]) * h, 0.0
+        moved, jump = 0.5 * (latest[f_key] + new[f_key]) * h, 0.0
     else:  # exactly; the effort side's position input will jump by what it missed
         p_key = keys.position
-        moved = new[p_key] - histories[p_key].latest
+        moved = new[p_key] - latest[p_key]
         jump = moved - f_held * h
     power = e_held * moved / h
     # received by the flow side - given by the effort side over the step and the jump

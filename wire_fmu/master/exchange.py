@@ -36,17 +36,22 @@ class UnitExchange:
     def _build_links(self) -> None:
         self.links_into: dict[str, list[Link]] = defaultdict(list)
         self.source_keys: dict[str, list[str]] = defaultdict(list)
+        self.latest: dict[str, float] = {}
+        """The newest value of every source output (updated in place, never replaced:
+        input plans keep it)."""
         self.histories: dict[str, History] = {}
+        """The past values of the source outputs some link extrapolates from."""
         ramped = {b.name for b in self.scene.bonds if b.ramped}
         for c in self.scene.all_connections:
             slave = self.slaves[c.target.unit]
             scheme = c.extrapolation or self.run_settings.extrapolation
             key = str(c.source)
-            history = self.histories.setdefault(key, History())
             ramp = "slope" if c.role == RAMP_ROLE else ""
             if c.role == "flow" and c.bond in ramped:
                 ramp = "start"
-            link = Link(c, key, slave.vr(c.target.variable), scheme, history, ramp)
+            link = Link(c, key, slave.vr(c.target.variable), scheme, ramp=ramp)
+            if link.extrapolated:
+                link.history = self.histories.setdefault(key, History())
             self.links_into[c.target.unit].append(link)
             if key not in self.source_keys[c.source.unit]:
                 self.source_keys[c.source.unit].append(key)
@@ -68,7 +73,7 @@ class UnitExchange:
                 refs += [v.valueReference for v in variables]
             evented = name in self.events.units
             self._inputs[name] = InputPlan(
-                links, driven, refs, reals, evented, write=slave.writer(refs)
+                links, driven, refs, reals, evented, slave.writer(refs), self.latest
             )
             keys, refs = self.source_keys.get(name, []), self.source_vrs.get(name, [])
             mode = self.mode_markers.get(name)
@@ -143,13 +148,18 @@ class UnitExchange:
         self._ends.pop(unit, None)
         refs, values = [], []
         for link in self.links_into.get(unit, ()):
-            if self.histories[link.key].points:
+            if link.key in self.latest:
                 refs.append(link.target_vr)
-                values.append(self.histories[link.key].latest)
+                values.append(self.latest[link.key])
         self.slaves[unit].set_reals(refs, values)
 
     def _push(self, unit: str, t: float) -> None:
-        push_all(self.histories, self.read_sources(unit), t)
+        self._keep_sources(self.read_sources(unit), t)
+
+    def _keep_sources(self, values: dict[str, float], t: float) -> None:
+        """Make ``values`` (source outputs by ``"unit.variable"``) the newest, at ``t`` (s)."""
+        self.latest.update(values)
+        push_all(self.histories, values, t)
 
     # -- what algorithms call ------------------------------------------------------
     def read_sources(self, unit: str) -> dict[str, float]:
@@ -211,7 +221,7 @@ class UnitExchange:
         ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
         for link in plan.others:  # every history holds its latest value from initialisation on
             if link.position:
-                value = link.history.points[-1][1]  # the unit advances it with the held velocity
+                value = self.latest[link.key]  # the unit advances it with the held velocity
             elif link.ramp:
                 ramps = {} if ramps is None else ramps
                 if link.key not in ramps:

@@ -84,22 +84,26 @@ class History:
 
 
 def push_all(histories: Mapping[str, History], values: Mapping[str, float], t: float) -> None:
-    """:meth:`History.push` of each value into the history of its key, all at ``t``.
+    """:meth:`History.push` of each history's new value, all at ``t``.
 
-    The master calls this for every source at every accepted step, so the loop is
-    written out here once rather than as a method call per source.
+    The master calls this at every accepted step, so the loop is written out here
+    once rather than as a method call per source.
 
     Parameters
     ----------
     histories : mapping of str to History
         Histories by source key (``"unit.variable"``).
     values : mapping of str to float
-        The new value of each source to push, by key, in its unit.
+        New values by source key, in their units; a history whose key is not among
+        them is left as it is.
     t : float
         Time of the step end, s; a time not after a history's newest replaces it.
     """
-    for key, value in values.items():
-        points = histories[key].points
+    for key, history in histories.items():
+        value = values.get(key)
+        if value is None:
+            continue
+        points = history.points
         if points and t <= points[-1][0]:
             points[-1] = (t, value)
         else:

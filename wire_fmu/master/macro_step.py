@@ -15,7 +15,6 @@ import math
 from dataclasses import dataclass, field
 
 from .bond_energy import step_energy
-from .extrapolation import push_all
 from .run_result import SimulationStoppedError
 from .step_size import _PI, _ns, new_h
 from .unit_errors import StepRefusedError
@@ -45,9 +44,9 @@ class MacroStep:
     """Taking, judging, accepting and rolling back a macro step (a mixin of the simulation).
 
     The simulation provides ``scene``, ``run_settings``, ``slaves``, ``algorithm``,
-    ``energy``, ``histories``, ``held``, ``bond_power``, ``mode_marks``, ``mode_markers``,
-    ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``, ``_reads``, ``_ends``,
-    ``_build_plans`` and ``_mode_mark``.
+    ``energy``, ``latest``, ``histories``, ``held``, ``bond_power``, ``mode_marks``,
+    ``mode_markers``, ``source_keys``, ``time``, ``_bond_keys``, ``_error_prev``,
+    ``_reads``, ``_ends``, ``_build_plans``, ``_keep_sources`` and ``_mode_mark``.
     """
 
     def _save(self):
@@ -108,9 +107,9 @@ class MacroStep:
             The energy residual by bond name, J (positive: created).
         """
         out = {}
-        histories, held, power = self.histories, self.held, self.bond_power
+        latest, held, power = self.latest, self.held, self.bond_power
         for keys in self._bond_keys:
-            out[keys.name], power[keys.name] = step_energy(keys, histories, held, new, h)
+            out[keys.name], power[keys.name] = step_energy(keys, latest, held, new, h)
         return out
 
     def _attempt(self, t: float, h: float) -> _Attempt:
@@ -200,8 +199,7 @@ class MacroStep:
         return earliest
 
     def _accept(self, t: float, h: float, new: dict[str, float], residuals) -> None:
-        histories, end = self.histories, t + h
-        push_all(histories, new, end)
+        self._keep_sources(new, t + h)
         switched = set()
         for name, before in self.mode_marks.items():
             now = self._mode_mark(name)
@@ -209,7 +207,8 @@ class MacroStep:
                 switched.add(name)
                 self.mode_marks[name] = now
                 for key in self.source_keys.get(name, ()):
-                    histories[key].reset()
+                    if key in self.histories:
+                        self.histories[key].reset()
         across = (
             {
                 b.name

@@ -54,8 +54,10 @@ class Link:
         Value reference of the input it sets.
     scheme : str
         Its extrapolation (``"constant"``, ``"linear"``, ``"quadratic"``).
-    history : History
-        Its source's history (shared by every link from that source).
+    history : History or None
+        Its source's history (shared by every link from that source), for a link
+        that extrapolates (:attr:`extrapolated`); the others take their source's
+        newest value.
     ramp : str
         ``"start"`` for a ramped bond's flow link (set to the ramp's value at the step's
         start), ``"slope"`` for its ramp link (set to the slope), ``""`` otherwise
@@ -66,7 +68,7 @@ class Link:
     key: str
     target_vr: int
     scheme: str
-    history: History
+    history: History | None = None
     ramp: str = ""
     target: str = field(init=False)
     """The input it sets, ``"unit.variable"``."""
@@ -75,11 +77,15 @@ class Link:
     constant: bool = field(init=False)
     """Whether it is held ``constant`` (at its source's latest value, or its new one when
     the source has stepped), and is neither a position nor a ramped link."""
+    extrapolated: bool = field(init=False)
+    """Whether its held value is worked out from its source's past values: neither
+    :attr:`constant` nor a position."""
 
     def __post_init__(self) -> None:
         self.target = str(self.connection.target)
         self.position = self.connection.role == "position"
         self.constant = self.scheme == "constant" and not (self.position or self.ramp)
+        self.extrapolated = not (self.constant or self.position)
 
 
 @dataclass
@@ -103,6 +109,9 @@ class InputPlan:
     write : callable
         The set of :attr:`refs` made ready (:meth:`Slave.writer
         <wire_fmu.master.slave.Slave.writer>`).
+    latest : mapping of str to float
+        The newest value of every source output by ``"unit.variable"``, kept up to
+        date by the master (the same mapping for the whole run).
 
     Attributes
     ----------
@@ -111,8 +120,6 @@ class InputPlan:
     constant_keys, constant_targets : tuple of str
         Source and target of each of the leading links that are held ``constant``
         (:attr:`Link.constant`): set from their sources' values without a Python loop.
-    constant_points : tuple of deque
-        Their sources' histories' points.
     others : tuple of Link
         The links after them.
     """
@@ -123,6 +130,7 @@ class InputPlan:
     driven_reals: bool
     evented: bool
     write: Callable[[Sequence[float]], None]
+    latest: Mapping[str, float]
     _fired: int = field(default=-1, repr=False)
     _event_refs: list[int] = field(default_factory=list, repr=False)
     _event_values: list[float] = field(default_factory=list, repr=False)
@@ -130,7 +138,6 @@ class InputPlan:
     idle: bool = field(init=False)
     constant_keys: tuple[str, ...] = field(init=False)
     constant_targets: tuple[str, ...] = field(init=False)
-    constant_points: tuple = field(init=False)
     others: tuple[Link, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -141,7 +148,6 @@ class InputPlan:
         constant, self.others = self.links[:leading], self.links[leading:]
         self.constant_keys = tuple(link.key for link in constant)
         self.constant_targets = tuple(link.target for link in constant)
-        self.constant_points = tuple(link.history.points for link in constant)
 
     def constant_values(self, fresh: Mapping[str, float] | None) -> list[float]:
         """The values of the ``constant`` links: their sources' new values where ``fresh``
@@ -161,7 +167,7 @@ class InputPlan:
         return self._latest()
 
     def _latest(self) -> list[float]:
-        return list(map(_VALUE, map(_NEWEST, self.constant_points)))
+        return list(map(self.latest.__getitem__, self.constant_keys))
 
     def event_inputs(
         self, slave: Slave, events: ScheduledEvents
@@ -346,10 +352,6 @@ class Watch:
 _NO_OTHERS: Mapping[str, list[Any]] = MappingProxyType({})
 """The values of FMI types other than Real of a read that has only Reals (shared, read-only)."""
 _DOUBLE = Struct("d")
-_NEWEST = itemgetter(-1)
-"""A history's newest point, ``(t, value)``."""
-_VALUE = itemgetter(1)
-"""A point's value."""
 """One native double, as a C double array holds it."""
 
 
