@@ -1,13 +1,15 @@
 """The master's calls every macro step: the FMU's C functions made ready once.
 
 :meth:`Slave.reader <wire_fmu.master.slave.Slave.reader>` and
-:meth:`Slave.writer <wire_fmu.master.slave.Slave.writer>` call the C functions fmpy
-typed at load directly; an fmpy that keeps no typed functions goes through its own
-wrappers. Both ways give the same run, and a call that fails names the unit.
+:meth:`Slave.writer <wire_fmu.master.slave.Slave.writer>` call the C functions of the
+library fmpy loaded directly, untyped, with C values made once; an fmpy that does not
+keep its library as expected goes through its own wrappers. Both ways give the same
+run, and a call that fails names the unit.
 """
 
 from __future__ import annotations
 
+import ctypes
 from pathlib import Path
 
 import pytest
@@ -46,6 +48,28 @@ def test_direct_calls_and_fmpys_wrappers_give_the_same_run(tmp_path, fmu_dir, mo
         assert calls["doStep"] == round(STOP / 0.004)
         assert calls["setReal"] >= calls["doStep"]
         assert calls["getReal"] >= calls["doStep"]
+
+
+class _HotCallsSeen(Observer):
+    """Keeps each unit's hot calls as the run makes them."""
+
+    def __init__(self) -> None:
+        self.seen: dict[str, object] = {}
+
+    def on_step(self, sim) -> None:
+        self.seen = {name: unit._hot for name, unit in sim.slaves.items()}
+
+
+def test_the_hot_calls_are_the_libraries_own_functions_called_untyped(tmp_path, fmu_dir):
+    seen = _HotCallsSeen()
+    _run("riser_tensioner", tmp_path / "seen", fmu_dir, observers=[seen])
+    assert set(seen.seen) == {"rope", "cylinder"}
+    for hot in seen.seen.values():
+        assert isinstance(hot.component, ctypes.c_void_p) and hot.component.value
+        assert set(hot.functions) == set(slave_module._HOT_FUNCTIONS)
+        for function in hot.functions.values():  # no from_param conversion per argument
+            assert function.argtypes is None
+            assert function.restype is ctypes.c_int
 
 
 class _Probe(Observer):

@@ -22,6 +22,7 @@ __all__ = ["MODE_OUTPUT", "UnitExchange"]
 
 MODE_OUTPUT = "mode_changes"
 """The output whose change marks a unit's mode event (a rope break, a stick/slip switch)."""
+_FLOAT = frozenset((float,))
 
 
 class UnitExchange:
@@ -244,7 +245,7 @@ class UnitExchange:
             driven = self.drivers.step_values(unit, t, h)
             if not plan.driven_reals:
                 by_name = dict(zip(plan.driven, driven, strict=True))  # set by name, checked
-            elif all(type(v) is float for v in driven):
+            elif _FLOAT.issuperset(map(type, driven)):  # every value a float, no subclass
                 values += driven
             else:  # checked as a set by name would, then sent as floats
                 slave.typed_values(dict(zip(plan.driven, driven, strict=True)))

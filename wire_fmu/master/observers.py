@@ -29,6 +29,7 @@ import logging
 import math
 import sys
 import time
+from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -74,6 +75,9 @@ LEDGER_CHANNEL = "energy.units_balance"
 
 _WHOLE_NUMBERS = ("Integer", "Enumeration")
 """FMI types whose values the file writes as their digits."""
+_CREATED, _CARRIED = attrgetter("created"), attrgetter("carried")
+"""A bond's energy created and carried so far (:class:`~.energy_guard.BondEnergy`)."""
+_clock = time.perf_counter
 
 FLUSH_EVERY = 0.1
 """Longest wall-clock time recorded rows wait before they are written to the file, s.
@@ -191,10 +195,10 @@ class CsvRecorder:
 
         Parameters as in :meth:`Observer.on_step`.
         """
-        if self._due(sim.time):
-            started = time.perf_counter()
+        if sim.time >= self._due_from:  # self._due(sim.time), after every step
+            started = _clock()
             self._row(sim)
-            self.stepping_seconds += time.perf_counter() - started
+            self.stepping_seconds += _clock() - started
 
     def _due(self, t: float) -> bool:
         """Whether a row is recorded after a step ending at ``t`` (s)."""
@@ -264,12 +268,14 @@ class CsvRecorder:
         changed once made) and the bonds' energies (which change with every step).
         """
         taken = sim.watched_snapshots(self._watch, self._read_units)
-        bonds, power = self._bonds, sim.bond_power
-        cells = [bond.created for bond in bonds]  # the bonds' channels, in BOND_CHANNELS order
-        cells += [bond.carried for bond in bonds]
-        cells += [power[b] for b in self._bond_names]
+        bonds = self._bonds
+        cells = [  # the bonds' channels, in BOND_CHANNELS order
+            *map(_CREATED, bonds),
+            *map(_CARRIED, bonds),
+            *map(sim.bond_power.__getitem__, self._bond_names),
+        ]
         self._rows.append((sim.time, taken, cells))
-        if time.perf_counter() - self._written >= self.flush_every:
+        if _clock() - self._written >= self.flush_every:
             self._write_rows()
         if self.interval is not None:
             # the first multiple of the interval after now (in one step, however small the

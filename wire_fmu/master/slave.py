@@ -62,7 +62,9 @@ _COPY_LIST = itemgetter(slice(None))
 _clock = time.perf_counter
 
 _HOT_FUNCTIONS = ("fmi2SetReal", "fmi2GetReal", "fmi2GetInteger", "fmi2DoStep")
-"""The C functions every macro step calls, taken from fmpy once per instantiation."""
+"""The C functions every macro step calls, taken from fmpy's library once per instantiation."""
+_TRUE = ctypes.c_int(1)
+"""``fmi2True``, as an ``fmi2Boolean`` argument of an untyped call."""
 _KEEP_ALIVE: list[object] = []
 _ROUTES: dict[str, _Messages] = {}
 
@@ -321,6 +323,7 @@ class Slave(NamedValues):
         """
         fn, native, n = f"get{kind}", f"fmi2Get{kind}", len(refs)
         vrs, values = (fmi2ValueReference * n)(*refs), (_C_TYPES[kind] * n)()
+        count = ctypes.c_size_t(n)
         seconds, calls = self.seconds, self.calls
 
         def read() -> Any:
@@ -328,7 +331,7 @@ class Slave(NamedValues):
             if hot is None:  # not instantiated (raises), or an fmpy without C functions
                 return through_fmpy(self._call(fn, list(refs)))
             start = _clock()
-            status = hot.functions[native](hot.component, vrs, n, values)
+            status = hot.functions[native](hot.component, vrs, count, values)
             seconds[fn] += _clock() - start
             calls[fn] += 1
             if status > 1:  # worse than fmi2Warning
@@ -357,6 +360,7 @@ class Slave(NamedValues):
         if not n:
             return lambda values: None
         vrs, array = (fmi2ValueReference * n)(*refs), (fmi2Real * n)()
+        count = ctypes.c_size_t(n)
         seconds, calls = self.seconds, self.calls
 
         def write(values: Sequence[float]) -> None:
@@ -366,7 +370,7 @@ class Slave(NamedValues):
                 return
             array[:] = values  # the FMU copies them during the call
             start = _clock()
-            status = hot.functions["fmi2SetReal"](hot.component, vrs, n, array)
+            status = hot.functions["fmi2SetReal"](hot.component, vrs, count, array)
             seconds["setReal"] += _clock() - start
             calls["setReal"] += 1
             if status > 1:
@@ -451,7 +455,8 @@ class Slave(NamedValues):
             self._step_through_fmpy(t, h)
             return
         start = _clock()  # currentCommunicationPoint, communicationStepSize, noSetFMUState...
-        status = hot.functions["fmi2DoStep"](hot.component, t, h, 1)
+        hot.start.value, hot.size.value = t, h
+        status = hot.functions["fmi2DoStep"](hot.component, hot.start, hot.size, _TRUE)
         self.seconds["doStep"] += _clock() - start
         self.calls["doStep"] += 1
         if status > 1:
@@ -537,25 +542,49 @@ class Slave(NamedValues):
 
 @dataclass(frozen=True)
 class _HotCalls:
-    """An instance's component and the C functions every macro step calls.
+    """An instance's component and the C functions every macro step calls, untyped.
 
     fmpy's wrapper around each call (a method, its ``_call`` and the optional call
     logger, which the master does not use) costs about as much as the call itself
     for the calls every macro step makes per unit: ``fmi2SetReal``, ``fmi2DoStep``
-    and ``fmi2Get{Real,Integer}``. The C functions, with the argument and result
-    types fmpy gave them when it loaded the binary, are called directly.
+    and ``fmi2Get{Real,Integer}``. So these C functions are called directly, and
+    without declared argument types: ctypes converts each argument of a function
+    that declares them through the type's ``from_param``, an ``isinstance`` check
+    through ``__instancecheck__`` and a conversion, which cost more than the rest of
+    the crossing. Called untyped, a function takes C values as they are, so every
+    argument is one: the component (:attr:`component`), the value references and
+    values as C arrays and their count as a ``size_t``, each made once per prepared
+    get or set, and a step's times as C doubles made once per instance
+    (:attr:`start`, :attr:`size`), their values set before each step. The result is
+    an ``int``, the ``fmi2Status``.
+
+    The C signatures are FMI 2.0's (``fmi2Functions.h``): ``fmi2SetReal(c, vr[], nvr,
+    value[])``, the gets alike, and ``fmi2DoStep(c, t, h, noSetFMUStatePriorToCurrentPoint)``.
     """
 
-    component: Any
+    component: ctypes.c_void_p
     functions: dict[str, Any]
+    start: ctypes.c_double = field(default_factory=ctypes.c_double)
+    """A step's ``currentCommunicationPoint``, s."""
+    size: ctypes.c_double = field(default_factory=ctypes.c_double)
+    """A step's ``communicationStepSize``, s."""
 
     @classmethod
     def of(cls, fmu: FMU2Slave) -> _HotCalls | None:
-        """The hot calls of an instantiated ``fmu``; None if fmpy keeps no typed C functions."""
-        c_functions = getattr(fmu, "_functions", None)
-        if not isinstance(c_functions, dict) or not all(f in c_functions for f in _HOT_FUNCTIONS):
+        """The hot calls of an instantiated ``fmu``; None if fmpy's loaded library or the
+        instance is not at hand as this fmpy version keeps them."""
+        library, component = getattr(fmu, "dll", None), getattr(fmu, "component", None)
+        if not isinstance(library, ctypes.CDLL) or not isinstance(component, int):
             return None
-        return cls(fmu.component, {f: c_functions[f] for f in _HOT_FUNCTIONS})
+        functions = {}
+        for name in _HOT_FUNCTIONS:
+            try:
+                function = library[name]  # a function object of its own: no argument types
+            except AttributeError:
+                return None
+            function.restype = ctypes.c_int  # fmi2Status
+            functions[name] = function
+        return cls(ctypes.c_void_p(component), functions)
 
 
 def _listed(items: Sequence[Any]) -> list[Any]:
