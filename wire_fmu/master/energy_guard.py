@@ -175,7 +175,10 @@ class EnergyGuard:
         """Whether every bond's error is within its limit (a NaN is not); after every step."""
         share, floor = self.share, self.floor
         for bond in self.bonds.values():
-            if not bond.error <= max(share * bond.carried, floor):
+            limit = share * bond.carried  # max(limit, floor), as the builtin (a NaN stays)
+            if floor > limit:
+                limit = floor
+            if not bond.error <= limit:
                 return False
         return True
 

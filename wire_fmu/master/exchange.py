@@ -218,7 +218,8 @@ class UnitExchange:
         held, values = self.held, []
         if plan.constant_keys:  # most links
             values = plan.constant_values(fresh)
-            held.update(zip(plan.constant_targets, values, strict=True))
+            # as many values as targets by construction; strict= costs a keyword parse
+            held.update(zip(plan.constant_targets, values))  # noqa: B905
         ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
         for link in plan.others:  # every history holds its latest value from initialisation on
             if link.position:

@@ -67,8 +67,12 @@ class _Values:
         self._last = self._before = (math.nan, 0.0)  # (time, value) pairs; NaN equals no time
         self._ahead: dict[float, float] = {}
 
-    def __call__(self, t: float) -> float:
-        """The driver's value at ``t`` (s), in the driven input's unit."""
+    def at(self, t: float) -> float:
+        """The driver's value at ``t`` (s), in the driven input's unit.
+
+        A method, not ``__call__``: calling an instance goes through the type's call slot,
+        some thousand machine instructions more than a method call, every step.
+        """
         last = self._last
         if t == last[0]:
             return last[1]
@@ -89,7 +93,7 @@ class _Values:
             times = [end, *starts, *(a + b for a, b in zip(starts, lengths, strict=True))]
             times = list(dict.fromkeys(times))  # a step's start is mostly the last one's end
             self._ahead = dict(zip(times, self._values_at(times), strict=True))
-        return self(end)
+        return self.at(end)
 
     def midpoint(self, t: float, h: float) -> float:
         """The value at the middle of the step ``[t, t + h]`` (s); the next steps' ones ahead."""
@@ -98,7 +102,7 @@ class _Values:
             starts, lengths = _next_steps(t, h, AHEAD - 1)
             times = [mid, *(a + 0.5 * b for a, b in zip(starts, lengths, strict=True))]
             self._ahead = dict(zip(times, self._values_at(times), strict=True))
-        return self(mid)
+        return self.at(mid)
 
 
 @dataclass(frozen=True)
@@ -201,7 +205,7 @@ class DriverSet:
             if d.rate is None:
                 out.append(d.value.midpoint(t, h))
             else:
-                start = d.value(t)
+                start = d.value.at(t)
                 out.append(start)
                 out.append((d.value.step_end(t, h) - start) / h)
         return out

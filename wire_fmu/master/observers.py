@@ -280,9 +280,13 @@ class CsvRecorder:
         if self.interval is not None:
             # the first multiple of the interval after now (in one step, however small the
             # interval: a loop adding it could run for ever once it is below the round-off)
-            reached = math.floor((sim.time + 1e-9 * max(1.0, sim.time)) / self.interval)
-            self._next = max(self._next, (reached + 1) * self.interval)
-            self._due_from = self._next - 1e-9 * max(1.0, self._next)
+            # (max() written out: the builtin parses keywords, a cost every row)
+            now = sim.time
+            reached = math.floor((now + 1e-9 * (now if now > 1.0 else 1.0)) / self.interval)
+            following = (reached + 1) * self.interval
+            if following > self._next:
+                self._next = following
+            self._due_from = self._next - 1e-9 * (self._next if self._next > 1.0 else 1.0)
 
     def _values(self, row: tuple) -> list[Any]:
         """The cells of a recorded row: time, recorded variables, bond channels, ledger."""

@@ -266,7 +266,11 @@ class Simulation(UnitExchange, MacroStep):
         resume_h = None  # the step to go on with after one shortened to a mode change
         planned_ns = None  # where that shortened step was to end: the rest is stepped first
         while now_ns < stop_ns:
-            next_ns = min(now_ns + max(1, _ns(h)), stop_ns)
+            # min(now + max(1, step), stop), written out: the builtins parse keywords
+            step_ns = _ns(h)
+            next_ns = now_ns + (step_ns if step_ns > 0 else 1)
+            if next_ns > stop_ns:
+                next_ns = stop_ns
             upcoming = self.events.next_time
             if upcoming is not None and now_ns < _ns(upcoming) < next_ns:
                 next_ns = _ns(upcoming)
