@@ -49,7 +49,8 @@ class CouplingAlgorithm(ABC):
         ----------
         sim : Simulation
             The simulation whose units are stepped (through its
-            ``set_inputs``, ``step_unit`` and ``add_sources``).
+            ``set_inputs`` and ``step_unit``, which puts a unit's new source
+            outputs into the dict it is given).
         t : float
             Start of the macro step, s.
         h : float
@@ -77,8 +78,7 @@ class Jacobi(CouplingAlgorithm):
             sim.set_inputs(unit, t, h, fresh)
         new: dict[str, float] = {}
         for unit in self.order:
-            sim.step_unit(unit, t, h)
-            sim.add_sources(unit, new)
+            sim.step_unit(unit, t, h, new)
         return new
 
 
@@ -92,8 +92,7 @@ class GaussSeidel(CouplingAlgorithm):
         new = dict(fresh or {})
         for unit in self.order:
             sim.set_inputs(unit, t, h, new)
-            sim.step_unit(unit, t, h)
-            sim.add_sources(unit, new)  # every unit steps: all of new is now of t + h
+            sim.step_unit(unit, t, h, new)  # every unit steps: all of new is now of t + h
         return new
 
 

@@ -264,7 +264,7 @@ class UnitExchange:
         if others:
             slave.set_typed(others)
 
-    def step_unit(self, unit: str, t: float, h: float) -> None:
+    def step_unit(self, unit: str, t: float, h: float, sources: dict | None = None) -> None:
         """Step one unit (errors propagate as StepRefusedError / UnitFailedError).
 
         Parameters
@@ -273,13 +273,17 @@ class UnitExchange:
             Instance name of the unit in the scene.
         t, h : float
             Start and length of the macro step, s.
+        sources : dict of str to float, optional
+            Where to put the unit's source outputs at the step's end, by
+            ``"unit.variable"`` (what :meth:`add_sources` puts there, read once).
         """
         self._ends.pop(unit, None)
         slave = self.slaves[unit]
         slave.do_step(t, h)
         plain, watched = self._reads[unit]
-        plan = watched if self._watching else plain
-        self._ends[unit] = plan.read()
+        end = self._ends[unit] = (watched if self._watching else plain).read()
+        if sources is not None:
+            end.add_sources(sources)
 
     def _mode_mark(self, unit: str) -> float | int:
         """The unit's mode marker now (see ``mode_markers``; from its end-of-step read if valid)."""

@@ -211,16 +211,19 @@ def ramp(
     slope : float
         Its rate of change over the step, in the source's unit per second.
     """
-    average = held_value(history, t, step, scheme, fresh)
-    latest = history.points[-1] if history.points else None
-    if scheme == "linear" and latest is not None and latest[0] == t:  # the common case
+    points = history.points
+    if scheme == "linear" and points and points[-1][0] == t:  # the common case, every step:
+        t1, y1 = points[-1]  # held_value's line through the same points, written out here
         if fresh is not None:
-            slope = (fresh - latest[1]) / step
+            slope = (fresh - y1) / step
+            average = _line(t1, y1, t + step, fresh, t + 0.5 * step)
             return average - 0.5 * slope * step, slope
-        if len(history.points) > 1 and t - history.points[-2][0] >= MIN_SPACING * step:
-            t0, y0 = history.points[-2]
-            slope = (latest[1] - y0) / (t - t0)
+        if len(points) > 1 and t - points[-2][0] >= MIN_SPACING * step:
+            t0, y0 = points[-2]
+            slope = (y1 - y0) / (t - t0)
+            average = _line(t0, y0, t1, y1, t + 0.5 * step)
             return average - 0.5 * slope * step, slope
+    average = held_value(history, t, step, scheme, fresh)
     points = _polynomial(history, t, step, scheme, fresh)
     if len(points) < 2 or step <= 0.0:
         return average, 0.0
