@@ -194,6 +194,7 @@ def test_kernel_functions_match_in_every_mode(monkeypatch, effects):
             fast = (model.rhs(0.0, x), model.guards(0.0, x), kernel.project(x.copy(), data))
             model.state = x
             fast_report = model.report()
+            assert len(model.report_values()) == len(kernel.REPORT)  # the unit zips them
             with model.python_kernel():
                 python = (model.rhs(0.0, x), model.guards(0.0, x), model.project(x.copy()))
                 python_report = model.report()

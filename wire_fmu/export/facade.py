@@ -379,7 +379,8 @@ class CoreFacade(FacadeState, Fmi2Slave):
             and len(values) == len(names)
             and all(map(math.isfinite, values))
         ):
-            self.unit.values.update(zip(names, map(float, values), strict=True))
+            # as many values as names, checked above; strict= costs a keyword parse per call
+            self.unit.values.update(zip(names, map(float, values)))  # noqa: B905
             self._initial_outputs_stale = True
             self._inputs_changed = True
             return
@@ -469,9 +470,10 @@ class CoreFacade(FacadeState, Fmi2Slave):
     def _check_step(self, current_time: float, step_size: float) -> None:
         if not (math.isfinite(step_size) and step_size > 0.0):
             raise FacadeError(f"communication step {step_size!r} s: must be finite and positive")
+        scale = abs(self._time)  # max(1, |t|), written out: the builtin parses keywords
         if not math.isfinite(current_time) or abs(
             current_time - self._time
-        ) > STEP_TIME_TOLERANCE * max(1.0, abs(self._time)):
+        ) > STEP_TIME_TOLERANCE * (scale if scale > 1.0 else 1.0):
             raise FacadeError(
                 f"communication point {current_time!r} s: the unit is at t = {self._time!r} s "
                 "(a step starts where the last one ended, or at a restored state's time)"

@@ -348,7 +348,8 @@ class CompiledFixedStep(FixedStepSolver):
 
     def internal_count(self, t0: float, t1: float) -> int:
         """The number of equal internal steps the loop takes over ``[t0, t1]`` (s)."""
-        return max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
+        count = math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9)
+        return count if count > 1 else 1  # max(1, count), without the builtin's keyword parse
 
     def advance(
         self, system, t0: float, x0: np.ndarray, t1: float, first: tuple | None = None

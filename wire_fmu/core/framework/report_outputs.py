@@ -113,7 +113,8 @@ class ReportOutputs:
         FloatingPointError
             If an output named in :attr:`finite` is not finite (all are written first).
         """
-        values.update(zip(self._names, self._take(report), strict=True))
+        # one value per name by construction (_take gets the fields _names are copied from)
+        values.update(zip(self._names, self._take(report)))  # noqa: B905
         values["stored_energy"] = report.stored_energy
         values["dissipated_energy"] = report.dissipated_energy
         values["external_work"] = report.external_work

@@ -262,11 +262,12 @@ class RefinedStepping:
             return False
         if self.seal is not None:
             self.seal.held_position = float(self.state[0])  # as settling would
+        count = math.ceil(count - 1e-9)  # the grid of CompiledFixedStep: max(1, count)
         taken, x, values = kernel.quiet_step(
             method,
             t,
             t_end,
-            max(1, math.ceil(count - 1e-9)),  # the grid of CompiledFixedStep
+            count if count > 1 else 1,
             self.state,
             self._directions,
             self.kernel_data(),

@@ -455,7 +455,9 @@ class HydraulicsUnit(Unit):
         m = self._require_model()
         values = m.report_values()
         out = self.values
-        out.update(zip(_REPORTED_OUTPUTS, values, strict=True))
+        # one value per name (tests/test_hydraulics_kernel.py holds it); strict= costs a
+        # keyword parse every step
+        out.update(zip(_REPORTED_OUTPUTS, values))  # noqa: B905
         position = out["rod.position"]
         out["rod.displacement"] = position - m.initial_position
         out["stroke_used"] = position / m.cyl.stroke

@@ -98,7 +98,8 @@ class DrumBrakeModes:
         """
         if not (self.compiled and isinstance(self.solver, CompiledFixedStep)):
             return None
-        if min(self.capacities) <= 0.0:
+        plus, minus = self.capacities
+        if (minus if minus < plus else plus) <= 0.0:  # min(), without its keyword parse
             return None if self.engaged else (False, True)
         if not self.engaged:
             return None
