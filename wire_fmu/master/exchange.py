@@ -23,6 +23,7 @@ __all__ = ["MODE_OUTPUT", "UnitExchange"]
 MODE_OUTPUT = "mode_changes"
 """The output whose change marks a unit's mode event (a rope break, a stick/slip switch)."""
 _FLOAT = frozenset((float,))
+"""The type of driven values sent as they are (``{float} >= set(map(type, values))``)."""
 
 
 class UnitExchange:
