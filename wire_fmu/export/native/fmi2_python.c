@@ -141,9 +141,23 @@ static void logf_component(Component *c, fmi2Status status, const char *format, 
 }
 
 /* Forward the facade's queued messages (pythonfmu LogMsg: status, category, msg). */
+/* obj.<name>, a new reference or NULL. The name is interned first: the class's attribute
+ * cache knows a name by its object, so the fresh string PyObject_GetAttrString makes
+ * misses it on every call and the lookup walks the whole class hierarchy (counted, some
+ * 500 machine instructions more per lookup; every call makes two). */
+static PyObject *attribute(PyObject *obj, const char *name)
+{
+    PyObject *key = PyUnicode_InternFromString(name);
+    if (key == NULL)
+        return NULL;
+    PyObject *value = PyObject_GetAttr(obj, key);
+    Py_DECREF(key);
+    return value;
+}
+
 static void drain_log_queue(Component *c)
 {
-    PyObject *queue = PyObject_GetAttrString(c->instance, "log_queue");
+    PyObject *queue = attribute(c->instance, "log_queue");
     if (queue == NULL || !PyList_Check(queue)) {
         Py_XDECREF(queue);
         PyErr_Clear();
@@ -207,7 +221,7 @@ static PyObject *call(Component *c, const char *method, PyObject *args)
     c->reported = 0;
     PyObject *result = NULL;
     if (args != NULL) {
-        PyObject *bound = PyObject_GetAttrString(c->instance, method);
+        PyObject *bound = attribute(c->instance, method);
         if (bound != NULL) {
             result = PyObject_CallObject(bound, args);
             Py_DECREF(bound);
