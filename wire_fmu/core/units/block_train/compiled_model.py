@@ -17,7 +17,7 @@ import numpy as np
 from wire_fmu.core.framework import bordered_band
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON
 from wire_fmu.core.framework.step_limits import IntegrationError
-from wire_fmu.core.units.block_train import kernel, kernel_interface, kernel_outputs
+from wire_fmu.core.units.block_train import kernel, kernel_outputs
 from wire_fmu.core.units.block_train.interface import RELATIVE_STEP, TIME_STEP
 from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian, jacobian_structure
 
@@ -215,49 +215,14 @@ class CompiledBlockTrain:
             count = solver.internal_count(t, t1)
         except IntegrationError:  # a step too long: refused the general way, with the reason
             return None
-        held, data = self._held_from_flat(t, flat), self.kernel_data()
-        result = kernel.quiet_step(
-            solver.method,
-            t,
-            t1,
-            count,
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            data,
-            held,
-            0,
-            t,
-            False,
-        )
-        if result[0] != STATUS_DONE:
-            return None
-        x, values = result[1], result[8]
-        held_positions = (
-            self.state[: self.n_coords].copy() if self.friction.links else self._held_positions
-        )
-        table = plan.no_ports
-        if plan.interface_rows.shape[0]:
-            table = kernel_interface.port_linearisations(
-                t1,
-                x,
-                kernel.holding(data, held, held_positions),
-                plan.interface_rows,
-                RELATIVE_STEP,
-                TIME_STEP,
+        held = self._held_from_flat(t, flat)
+        status, x, steps, rhs_calls, values, held_positions, out, finite = (
+            kernel_outputs.quiet_step_outputs(
+                *self._quiet_arguments(t, t1, count, held, plan, initial_energy)
             )
-        out, finite = kernel_outputs.output_vector(
-            x,
-            values,
-            len(self.spans),
-            table,
-            self.masses,
-            plan.line_spans,
-            plan.driver_bodies,
-            plan.block_coords,
-            plan.block_starts,
-            initial_energy,
         )
+        if status != STATUS_DONE:
+            return None
         if not finite:
             return None
         self.last_events = []
@@ -267,13 +232,52 @@ class CompiledBlockTrain:
         self._held_positions = held_positions
         self.state = x
         self._step_summary = (t1, x, values)
-        solver.steps += result[5]
-        solver.rhs_calls += result[6]
+        solver.steps += steps
+        solver.rhs_calls += rhs_calls
         return out.tolist()
 
+    def _quiet_arguments(
+        self,
+        t: float,
+        t1: float,
+        count: int,
+        held: np.ndarray,
+        plan: OutputPlan,
+        initial_energy: float = 0.0,
+        preload: bool = False,
+    ) -> tuple:
+        """The arguments of :func:`.kernel_outputs.quiet_step_outputs` for a step from
+        ``t`` to ``t1`` (s) in ``count`` internal steps, with the inputs ``held``."""
+        return (
+            self.solver.method,
+            t,
+            t1,
+            count,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            self.kernel_data(),
+            held,
+            self._held_positions,
+            bool(self.friction.links),
+            plan.interface_rows,
+            RELATIVE_STEP,
+            TIME_STEP,
+            plan.no_ports,
+            len(self.spans),
+            self.masses,
+            plan.line_spans,
+            plan.driver_bodies,
+            plan.block_coords,
+            plan.block_starts,
+            initial_energy,
+            preload,
+        )
+
     def preload_quiet_outputs(self, t: float, plan: OutputPlan) -> None:
-        """Load :func:`.kernel_outputs.output_vector` from the compiled-code cache now, by a
-        call whose answer is dropped, so that the first quiet step does not pay for it.
+        """Load :func:`.kernel_outputs.quiet_step_outputs` (and what it calls) from the
+        compiled-code cache now, by a call that does nothing else, so that the first quiet
+        step does not pay for it.
 
         Parameters
         ----------
@@ -282,18 +286,8 @@ class CompiledBlockTrain:
         plan : OutputPlan
             The unit's plan of its quiet steps' outputs.
         """
-        kernel_outputs.output_vector(
-            self.state,
-            kernel.summary(t, self.state, self.kernel_data()),
-            len(self.spans),
-            plan.no_ports,
-            self.masses,
-            plan.line_spans,
-            plan.driver_bodies,
-            plan.block_coords,
-            plan.block_starts,
-            0.0,
-        )
+        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, preload=True)
+        kernel_outputs.quiet_step_outputs(*arguments)
 
     def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
         """What the outputs need at ``(t, x)``.

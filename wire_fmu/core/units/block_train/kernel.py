@@ -84,7 +84,6 @@ __all__ = [
     "factor",
     "guards",
     "held_motion",
-    "holding",
     "kernel_data",
     "linearise",
     "project",
@@ -132,13 +131,6 @@ def kernel_data(model) -> tuple:
         model.kernel_flow_columns,
         model.kernel_flow_values,
     )
-
-
-def holding(data: tuple, held: np.ndarray, held_positions: np.ndarray) -> tuple:
-    """``data`` (:func:`kernel_data`) with the held inputs ``held`` (index 11) and the stuck
-    coordinates' held positions ``held_positions`` (index 23): what :func:`kernel_data`
-    gives once the model holds them (:func:`quiet_step` builds the same tuple inside)."""
-    return data[:11] + (held,) + data[12:23] + (held_positions,) + data[24:]
 
 
 @jit
@@ -659,7 +651,8 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
         return status, x, t, k, fired, steps, calls, h, np.zeros(0)
     n_coords, n_links = data[0][0], data[17].shape[0]
     # the held inputs from t0 on, and a stuck coordinate held where the step starts
-    new = data[:11] + (held,) + data[12:23] + (x[:n_coords].copy(),) + data[24:]  # holding()
+    # data as the model holds it after the step's start: held inputs (11), held positions (23)
+    new = data[:11] + (held,) + data[12:23] + (x[:n_coords].copy(),) + data[24:]
     no_fire = np.zeros(directions.size, dtype=np.bool_)
     no_summary = np.zeros(0)
     before = evaluate(t0, x, data)

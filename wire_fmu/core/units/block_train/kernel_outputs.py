@@ -17,8 +17,11 @@ import math
 import numpy as np
 
 from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON
+from wire_fmu.core.units.block_train.kernel import quiet_step
+from wire_fmu.core.units.block_train.kernel_interface import port_linearisations
 
-__all__ = ["FIXED_OUTPUTS", "output_vector"]
+__all__ = ["FIXED_OUTPUTS", "output_vector", "quiet_step_outputs"]
 
 FIXED_OUTPUTS = (
     "path_start.tension",
@@ -128,3 +131,93 @@ def output_vector(
     for value in out:
         finite = finite and math.isfinite(value)
     return out, finite
+
+
+@jit
+def quiet_step_outputs(
+    method,
+    t0,
+    t1,
+    n,
+    tol,
+    x,
+    directions,
+    data,
+    held,
+    held_positions,
+    hold_start,
+    interface_rows,
+    relative_step,
+    time_step,
+    no_ports,
+    n_spans,
+    masses,
+    line_spans,
+    driver_bodies,
+    block_coords,
+    block_starts,
+    initial_energy,
+    preload,
+):
+    """A quiet step and its outputs in one call: :func:`.kernel.quiet_step`, then the
+    ports' interface models (:func:`.kernel_interface.port_linearisations`) and
+    :func:`output_vector`, the three calls
+    :meth:`~wire_fmu.core.units.block_train.compiled_model.CompiledBlockTrain.quiet_step_outputs`
+    would otherwise make from Python, each with numba's dispatch on a tuple of some
+    thirty arrays. The same calls in the same order, so the same numbers to the bit.
+
+    Parameters
+    ----------
+    method, t0, t1, n, tol, x, directions, data, held
+        As :func:`.kernel.quiet_step` takes them (``k = 0``, ``t = t0``, no resume).
+    held_positions : numpy.ndarray
+        The stuck coordinates' held positions the model holds now.
+    hold_start : bool
+        Whether the step holds them where it starts (the unit has friction links)
+        rather than at ``held_positions``.
+    interface_rows, relative_step, time_step
+        As :func:`.kernel_interface.port_linearisations` takes them (``slots``); no
+        rows, no interface models.
+    no_ports : numpy.ndarray
+        The table of no ports (shape ``(0, 5)``), the table when there are no rows.
+    n_spans, masses, line_spans, driver_bodies, block_coords, block_starts, initial_energy
+        As :func:`output_vector` takes them.
+    preload : bool
+        Only load this function (its callees with it) and answer at once, nothing done.
+
+    Returns
+    -------
+    tuple
+        ``(status, x, steps, rhs_calls, values, held_positions, outputs, finite)``:
+        the loop's status (:data:`STATUS_DONE` when the step was taken without an
+        event, else nothing after it is meaningful), the state at ``t1``, the internal
+        steps and right-hand sides it took, :func:`.kernel.summary` at ``t1``, the held
+        positions the model holds from now on, :func:`output_vector`'s vector and
+        whether it is finite.
+    """
+    nothing = np.zeros(0)
+    if preload:
+        return STATUS_PYTHON, x, 0, 0, nothing, held_positions, nothing, False
+    result = quiet_step(method, t0, t1, n, tol, x, directions, data, held, 0, t0, False)
+    if result[0] != STATUS_DONE:
+        return result[0], x, 0, 0, nothing, held_positions, nothing, False
+    end, values = result[1], result[8]
+    positions = x[: data[0][0]].copy() if hold_start else held_positions
+    table = no_ports
+    if interface_rows.shape[0]:
+        # data as the model holds it after the step: held inputs (11), held positions (23)
+        holding = data[:11] + (held,) + data[12:23] + (positions,) + data[24:]
+        table = port_linearisations(t1, end, holding, interface_rows, relative_step, time_step)
+    out, finite = output_vector(
+        end,
+        values,
+        n_spans,
+        table,
+        masses,
+        line_spans,
+        driver_bodies,
+        block_coords,
+        block_starts,
+        initial_energy,
+    )
+    return STATUS_DONE, end, result[5], result[6], values, positions, out, finite
