@@ -39,7 +39,7 @@ from wire_fmu.core.framework.fixed_step import RK4, ROS2, FixedStepSolver
 from wire_fmu.core.framework.step_limits import (
     MAX_EVENTS_PER_STEP,
     IntegrationError,
-    internal_steps,
+    internal_step_count,
 )
 
 if TYPE_CHECKING:
@@ -348,8 +348,7 @@ class CompiledFixedStep(FixedStepSolver):
 
     def internal_count(self, t0: float, t1: float) -> int:
         """The number of equal internal steps the loop takes over ``[t0, t1]`` (s)."""
-        count = math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9)
-        return count if count > 1 else 1  # max(1, count), without the builtin's keyword parse
+        return internal_step_count(t0, t1, self.settings.max_step)
 
     def advance(
         self, system, t0: float, x0: np.ndarray, t1: float, first: tuple | None = None

@@ -17,7 +17,7 @@ import numpy as np
 from wire_fmu.core.framework.step_limits import (
     MAX_EVENTS_PER_STEP,
     IntegrationError,
-    internal_steps,
+    internal_step_count,
 )
 
 if TYPE_CHECKING:
@@ -73,7 +73,7 @@ class FixedStepSolver:
         t1 : float
             End time, s.
         """
-        n = max(1, math.ceil(internal_steps(t0, t1, self.settings.max_step) - 1e-9))
+        n = internal_step_count(t0, t1, self.settings.max_step)
         t, x = t0, np.array(x0, dtype=float)
         events = 0
         self._on_new_interval(system, t, x)

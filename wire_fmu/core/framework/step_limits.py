@@ -7,7 +7,15 @@ message that says why (:class:`IntegrationError`).
 
 from __future__ import annotations
 
-__all__ = ["IntegrationError", "MAX_INTERNAL_STEPS", "MAX_EVENTS_PER_STEP", "internal_steps"]
+import math
+
+__all__ = [
+    "IntegrationError",
+    "MAX_INTERNAL_STEPS",
+    "MAX_EVENTS_PER_STEP",
+    "internal_step_count",
+    "internal_steps",
+]
 
 
 class IntegrationError(RuntimeError):
@@ -45,3 +53,19 @@ def internal_steps(t0: float, t1: float, max_step: float) -> float:
             f"take communication steps of at most {MAX_INTERNAL_STEPS * max_step:.6g} s"
         )
     return count
+
+
+def internal_step_count(t0: float, t1: float, max_step: float) -> int:
+    """How many equal internal steps a fixed-step loop takes over ``[t0, t1]`` (s).
+
+    :func:`internal_steps` rounded up to a whole number (a count a hair above one, by
+    round-off, is that one), at least 1. Called every communication step: ``max()``
+    is written out (the builtin parses keywords on every call).
+
+    Raises
+    ------
+    IntegrationError
+        As :func:`internal_steps`.
+    """
+    count = math.ceil(internal_steps(t0, t1, max_step) - 1e-9)
+    return count if count > 1 else 1

@@ -140,7 +140,6 @@ static void logf_component(Component *c, fmi2Status status, const char *format, 
     log_to_host(&c->callbacks, c->name, c->logging_on, status, NULL, message);
 }
 
-/* Forward the facade's queued messages (pythonfmu LogMsg: status, category, msg). */
 /* obj.<name>, a new reference or NULL. The name is interned first: the class's attribute
  * cache knows a name by its object, so the fresh string PyObject_GetAttrString makes
  * misses it on every call and the lookup walks the whole class hierarchy (counted, some
@@ -155,6 +154,7 @@ static PyObject *attribute(PyObject *obj, const char *name)
     return value;
 }
 
+/* Forward the facade's queued messages (pythonfmu LogMsg: status, category, msg). */
 static void drain_log_queue(Component *c)
 {
     PyObject *queue = attribute(c->instance, "log_queue");

@@ -221,9 +221,7 @@ class CompiledBlockTrain:
                 *self._quiet_arguments(t, t1, count, held, plan, initial_energy)
             )
         )
-        if status != STATUS_DONE:
-            return None
-        if not finite:
+        if status != STATUS_DONE or not finite:
             return None
         self.last_events = []
         self.first_event_time = math.inf
@@ -243,7 +241,7 @@ class CompiledBlockTrain:
         count: int,
         held: np.ndarray,
         plan: OutputPlan,
-        initial_energy: float = 0.0,
+        initial_energy: float,
         preload: bool = False,
     ) -> tuple:
         """The arguments of :func:`.kernel_outputs.quiet_step_outputs` for a step from
@@ -286,7 +284,7 @@ class CompiledBlockTrain:
         plan : OutputPlan
             The unit's plan of its quiet steps' outputs.
         """
-        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, preload=True)
+        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, 0.0, preload=True)
         kernel_outputs.quiet_step_outputs(*arguments)
 
     def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:

@@ -32,7 +32,7 @@ import numpy as np
 
 from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
 from wire_fmu.core.framework.hybrid import SolverSettings
-from wire_fmu.core.framework.step_limits import IntegrationError, internal_steps
+from wire_fmu.core.framework.step_limits import IntegrationError, internal_step_count
 from wire_fmu.core.units.hydraulics import kernel
 from wire_fmu.core.units.hydraulics.interface import NO_INTERFACE, RodInterface
 
@@ -257,17 +257,16 @@ class RefinedStepping:
         if self.stops is not None and self._resolution(t, self.state) != "coarse":
             return False
         try:
-            count = internal_steps(t, t_end, settings.max_step)
+            count = internal_step_count(t, t_end, settings.max_step)  # CompiledFixedStep's grid
         except IntegrationError:
             return False
         if self.seal is not None:
             self.seal.held_position = float(self.state[0])  # as settling would
-        count = math.ceil(count - 1e-9)  # the grid of CompiledFixedStep: max(1, count)
         taken, x, values = kernel.quiet_step(
             method,
             t,
             t_end,
-            count if count > 1 else 1,
+            count,
             self.state,
             self._directions,
             self.kernel_data(),
