@@ -244,6 +244,19 @@ class Unit(ABC):
         """
         if self._take_quiet_step(time, step):
             return STEP_TAKEN
+        return self._advance_checked(time, step)
+
+    def _advance_checked(self, time: float, step: float) -> StepResult:
+        """:meth:`advance` the general way: the inputs checked, the state saved to undo a
+        refused step, the model integrated, the outputs filled.
+
+        Parameters
+        ----------
+        time : float
+            Start of the step, s.
+        step : float
+            Its length, s.
+        """
         bad = self.input_problems()
         if bad:
             refused = f"{self.who} at t = {time:.6g} s: step refused: "
@@ -431,9 +444,10 @@ class HeldInputsUnit(Unit):
     _step_inputs: Any = None
     """The inputs object of the step under way (see :meth:`advance`), else None."""
 
-    def advance(self, time: float, step: float) -> StepResult:
-        """:meth:`Unit.advance`, the inputs object built once for the step: the check of
-        the inputs and the integration take the same one.
+    def _advance_checked(self, time: float, step: float) -> StepResult:
+        """:meth:`Unit._advance_checked`, the inputs object built once for the step: the
+        check of the inputs and the integration take the same one (a quiet step, taken
+        before, builds none).
 
         Parameters
         ----------
@@ -444,7 +458,7 @@ class HeldInputsUnit(Unit):
         """
         self._step_inputs = self._inputs()
         try:
-            return super().advance(time, step)
+            return super()._advance_checked(time, step)
         finally:
             self._step_inputs = None
 

@@ -194,13 +194,19 @@ class _WinchBase:
         inputs : WinchInputs
             Inputs held from now on.
         """
-        lever_force = self.inputs.lever_force
+        self._caps = self._capacities_for(inputs.lever_force)
         self.inputs = inputs
         self._step_summary = None  # outputs a compiled step computed are for other inputs
-        if self.brake is not None and (
-            inputs.lever_force != lever_force or self._caps is _NO_CAPACITY
-        ):  # a new array, never changed in place: snapshots and kernel data keep the old one
-            self._caps = np.array([self.brake.capacities(inputs.lever_force)])
+
+    def _capacities_for(self, lever_force: float) -> np.ndarray:
+        """The brake's capacities for ``lever_force`` (N), shape (1, 2), N m: the array
+        held now while the lever force is the same; else a new one, never changed in place
+        (snapshots and kernel data keep the old one)."""
+        if self.brake is None or (
+            lever_force == self.inputs.lever_force and self._caps is not _NO_CAPACITY
+        ):
+            return self._caps
+        return np.array([self.brake.capacities(lever_force)])
 
     @property
     def capacities(self) -> tuple[float, float]:

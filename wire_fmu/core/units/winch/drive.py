@@ -8,21 +8,46 @@ and restoring the state in :mod:`~wire_fmu.core.units.winch.drive_snapshots`.
 from __future__ import annotations
 
 import math
+from dataclasses import astuple
 
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.framework.compiled import use_compiled
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, STATUS_PYTHON, KernelModel
+from wire_fmu.core.framework.compiled_step import (
+    COMPILED_METHODS,
+    STATUS_DONE,
+    STATUS_PYTHON,
+    KernelModel,
+)
 from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS, make_energy_solver
 from wire_fmu.core.framework.hybrid import SolverSettings
+from wire_fmu.core.framework.interface_model import EffortModel
 from wire_fmu.core.framework.machine_unit import MachineUnit, StepWork
+from wire_fmu.core.framework.step_limits import IntegrationError
 from wire_fmu.core.units.winch import kernel
-from wire_fmu.core.units.winch.base import WinchConfig, WinchInputs, WinchReport, _WinchBase
+from wire_fmu.core.units.winch.base import (
+    NO_ROPE_MODEL,
+    ROPE_MODEL_INPUTS,
+    WinchConfig,
+    WinchInputs,
+    WinchReport,
+    _WinchBase,
+)
 from wire_fmu.core.units.winch.drive_brake_modes import DrumBrakeModes
 from wire_fmu.core.units.winch.drive_snapshots import DriveSnapshots
 
-__all__ = ["WinchModel"]
+__all__ = ["FLAT_INPUTS", "WinchModel"]
+
+FLAT_INPUTS = (
+    "rope.tension",
+    "brake.lever_force",
+    "motor.command",
+    "drum.speed_command",
+    *ROPE_MODEL_INPUTS,
+)
+"""The unit's inputs :meth:`WinchModel.quiet_step_outputs` takes, in order."""
+_NO_ROPE_FIELDS = astuple(NO_ROPE_MODEL)
 
 
 class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
@@ -57,10 +82,17 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.masses = self.friction.masses  # the drum's entry follows I(phi)
         self.characteristic = "motor_characteristic" in config.effects
         self.motor_b = config.motor_slope * self.motor_ratio**2 if self.characteristic else 0.0
+        self.kernel_constants = (
+            self.motor_ratio,
+            config.motor_slope if self.characteristic else math.nan,
+            1.0 if self.drum.layer_guard_count else 0.0,
+        )
+        """The motor ratio and slope (NaN without the characteristic) and whether the drum
+        is layered, as the kernel's ``held`` array ends (:data:`kernel.HELD`)."""
         self.engaged = False
         self.state = np.zeros(2 * self.n + 2)
         self._held_angle = 0.0
-        self._step_summary: tuple[np.ndarray, np.ndarray] | None = None  # (x, its summary)
+        self._step_summary: tuple[np.ndarray, np.ndarray] | None = None  # (x, kernel.OUTPUTS there)
         self._kernel_layer: tuple | None = None  # (layer, its constants), by kernel_data
         self._kernel_modes: tuple | None = None  # (brake modes, their array), by kernel_data
         self._n_brake_guards = 2 * len(brake)
@@ -365,7 +397,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         self.last_events = []
         self.first_event_time = math.inf
         self.set_inputs(inputs)
-        kept = self._kept_brake_mode()
+        kept = self._kept_brake_mode(self._caps)
         if kept is not None and self._quiet_step(t, h, *kept):
             self.time = t + h
             return self._quiet_events
@@ -394,6 +426,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             0,
             t,
             False,
+            0.0,  # the ledger's start: only the brake torque and stored energy are read
         )
         if result[0] == STATUS_PYTHON:
             return False
@@ -406,6 +439,82 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         if values is None:  # after an event; else the outputs come from the kernel's summary
             self._forces(x, t1)
         return True
+
+    def quiet_step_outputs(
+        self, t: float, h: float, flat: tuple[float, ...], initial_energy: float
+    ) -> list[float] | None:
+        """A step in which nothing happens, with its outputs, in one compiled call.
+
+        What :meth:`advance` and then the unit's outputs do for such a step, with the same
+        arithmetic, to the last bit (:func:`kernel.quiet_step`), without the Python
+        between. When anything happens in the step -- inputs the winch cannot take, a
+        brake mode to settle, an event, an output that is not finite -- it changes nothing
+        and answers None: the step is then taken the general way, which names what
+        happened.
+
+        Parameters
+        ----------
+        t, h : float
+            Start and length of the step, s.
+        flat : tuple of float
+            The inputs at ``t``, in the order of :data:`FLAT_INPUTS`.
+        initial_energy : float
+            Stored energy at the start of the ledger, J.
+
+        Returns
+        -------
+        list of float or None
+            The values of :data:`kernel.OUTPUTS`, in their units; None if the step was
+            not taken.
+        """
+        tension, lever_force, command, speed_command, stiffness, damping, rate, *reference = flat
+        if not (all(map(math.isfinite, flat)) and stiffness >= 0.0 and damping >= 0.0):
+            return None  # WinchInputs.problems names them
+        capacities = self._capacities_for(lever_force)
+        kept = self._kept_brake_mode(capacities)
+        if kept is None:
+            return None
+        solver, t1 = self.solver, t + h
+        try:
+            count = solver.internal_count(t, t1)
+        except IntegrationError:  # a step too long: refused the general way, with the reason
+            return None
+        active = stiffness != 0.0 or damping != 0.0 or rate != 0.0
+        rope = (stiffness, damping, rate, *reference, self.time) if active else _NO_ROPE_FIELDS
+        held = kernel.held_array(self, command, tension, lever_force, capacities, rope)
+        data = (kernel._modes(self), self.base_inertia, self.stiffness, self.damping, held)
+        check_stick, hold_angle = kept
+        status, x, _, _, _, steps, rhs_calls, _, values, finite = kernel.quiet_step(
+            solver.method,
+            t,
+            t1,
+            count,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            data,
+            check_stick,
+            hold_angle,
+            0,
+            t,
+            False,
+            initial_energy,
+        )
+        if status != STATUS_DONE or not finite:
+            return None
+        rope_model = EffortModel(*rope) if active else NO_ROPE_MODEL
+        self.inputs = WinchInputs(tension, lever_force, command, speed_command, rope_model)
+        self._caps = capacities
+        self.last_events = []
+        self.first_event_time = math.inf
+        if hold_angle:
+            self._held_angle = float(self.state[self.n - 1])
+        self.state = x
+        self.time = t1
+        self._step_summary = (x, values)
+        solver.steps += steps
+        solver.rhs_calls += rhs_calls
+        return values.tolist()
 
     # ---------------------------------------------------------- outputs
     def stored_energy(self, x: np.ndarray | None = None) -> float:
@@ -430,10 +539,11 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         n = self.n
         if self.compiled:
             done = self._step_summary
-            values = done[1] if done is not None and done[0] is x else None
-            if values is None:
-                values = kernel.summary(self.time, x, self.kernel_data())
-            brake, stored = values.tolist()
+            if done is not None and done[0] is x:  # the outputs the step's kernel computed
+                brake = float(done[1][kernel.BRAKE_TORQUE])
+                stored = float(done[1][kernel.STORED_ENERGY])
+            else:
+                brake, stored = kernel.summary(self.time, x, self.kernel_data()).tolist()
         else:
             brake = float(self._dynamics(x, self.time)[1][0]) if self.engaged else 0.0
             stored = None

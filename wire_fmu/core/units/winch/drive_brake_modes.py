@@ -88,17 +88,22 @@ class DrumBrakeModes:
             direction = 1.0 if omega > 0.0 else -1.0
         return (torque - direction * (plus if direction > 0 else minus)) / inertia
 
-    def _kept_brake_mode(self) -> tuple[bool, bool] | None:
+    def _kept_brake_mode(self, capacities: np.ndarray) -> tuple[bool, bool] | None:
         """How :func:`kernel.quiet_step` may keep the brake's mode, or None if it may not.
 
         ``(check_stick, hold_angle)``: a brake released without capacity (or no
         brake at all), or engaged and sliding, keeps its mode; one
         that holds the drum keeps it while it can (the kernel checks); anything
         else is settled by :meth:`_settle_modes`, in Python.
+
+        Parameters
+        ----------
+        capacities : numpy.ndarray
+            The brake's capacities for the step's lever force, shape (1, 2), N m.
         """
         if not (self.compiled and isinstance(self.solver, CompiledFixedStep)):
             return None
-        plus, minus = self.capacities
+        plus, minus = capacities[0]
         if (minus if minus < plus else plus) <= 0.0:  # min(), without its keyword parse
             return None if self.engaged else (False, True)
         if not self.engaged:

@@ -30,9 +30,12 @@ from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, ad
 
 __all__ = [
     "HELD",
+    "OUTPUTS",
     "advance",
     "guards",
+    "held_array",
     "kernel_data",
+    "outputs",
     "project",
     "quiet_step",
     "resume",
@@ -62,11 +65,37 @@ HELD = (
     "rope model: reference payout rate (m/s)",
     "rope model: the time it is about (s)",
     "rope paid out at drum angle 0 on the layer (m)",
+    "motor command at the motor shaft (N m)",
+    "motor ratio (motor speed per drum speed)",
+    "motor slope at the motor shaft with the motor characteristic (N m s/rad), else NaN",
+    "layered drum: 1, plain drum: 0",
 )
 """What the ``held`` array holds, in order: inputs and the present layer's constants."""
 _HELD_ANGLE = 11
 _ROPE_MODEL = 12  # K, D, R, reference payout, reference rate, start: six entries from here
 _PAYOUT_OFFSET = 18
+_MOTOR_COMMAND = 19  # the command, the ratio, the slope (NaN: no characteristic), layered
+
+OUTPUTS = (
+    "rope.payout",
+    "rope.payout_rate",
+    "drum.speed",
+    "drum.angle",
+    "motor.speed",
+    "motor.torque",
+    "brake.torque",
+    "brake.capacity",
+    "stored_energy",
+    "dissipated_energy",
+    "external_work",
+    "energy_balance",
+)
+"""The outputs :func:`quiet_step` computes at the end of a step, in order: all the winch's
+outputs that can change in a step in which no mode changes (not the layer, its radius,
+the brake's state or the count of mode changes)."""
+_OUTPUT_COUNT = len(OUTPUTS)
+BRAKE_TORQUE = OUTPUTS.index("brake.torque")
+STORED_ENERGY = OUTPUTS.index("stored_energy")
 
 
 def kernel_data(model) -> tuple:
@@ -78,32 +107,79 @@ def kernel_data(model) -> tuple:
         A winch with drum inertia.
     """
     inputs = model.inputs
-    radius, offset, slope, low, high, paid = _layer_constants(model)
     rope = inputs.rope_model
-    held = np.array(
-        [
-            model.motor_ratio * inputs.motor_command,
-            model.motor_b,
-            inputs.tension,
-            inputs.lever_force,
-            radius,
-            offset,
-            slope,
-            model._caps[0, 0],
-            model._caps[0, 1],
-            low,
-            high,
-            model._held_angle,
+    held = held_array(
+        model,
+        inputs.motor_command,
+        inputs.tension,
+        inputs.lever_force,
+        model._caps,
+        (
             rope.stiffness,
             rope.damping,
             rope.effort_rate,
             rope.reference_position,
             rope.reference_velocity,
             rope.start,
-            paid,
-        ]
+        ),
     )
     return _modes(model), model.base_inertia, model.stiffness, model.damping, held
+
+
+def held_array(
+    model,
+    motor_command: float,
+    tension: float,
+    lever_force: float,
+    capacities: np.ndarray,
+    rope_model: tuple[float, ...],
+) -> np.ndarray:
+    """The ``held`` array (:data:`HELD`) for these inputs and ``model``'s present layer.
+
+    Parameters
+    ----------
+    model : WinchModel
+        A winch with drum inertia.
+    motor_command : float
+        Motor torque, or its zero-speed torque with the characteristic, N m at the motor
+        shaft.
+    tension : float
+        Rope tension, or ``E0`` of the rope's interface model, N.
+    lever_force : float
+        Brake lever force, N.
+    capacities : numpy.ndarray
+        The brake's capacities for ``lever_force``, shape (1, 2), N m.
+    rope_model : tuple of float
+        The rope's interface model: K (N/m), D (N s/m), R (N/s), reference payout (m) and
+        rate (m/s), the time it is about (s); all 0 without one.
+    """
+    radius, offset, slope, low, high, paid = _layer_constants(model)
+    stiffness, damping, rate, position, velocity, start = rope_model
+    return np.array(
+        [
+            model.motor_ratio * motor_command,
+            model.motor_b,
+            tension,
+            lever_force,
+            radius,
+            offset,
+            slope,
+            capacities[0, 0],
+            capacities[0, 1],
+            low,
+            high,
+            model._held_angle,
+            stiffness,
+            damping,
+            rate,
+            position,
+            velocity,
+            start,
+            paid,
+            motor_command,
+            *model.kernel_constants,
+        ]
+    )
 
 
 def _layer_constants(model) -> tuple[float, float, float, float, float, float]:
@@ -304,6 +380,45 @@ def summary(t: float, x: np.ndarray, data) -> np.ndarray:
 
 
 @jit
+def outputs(t: float, x: np.ndarray, data, initial_energy: float) -> np.ndarray:
+    """The values of :data:`OUTPUTS` at ``(t, x)``, in their units.
+
+    What :meth:`WinchModel.report <wire_fmu.core.units.winch.drive.WinchModel.report>` and
+    the unit's ledger make of the state, with the same operations in the same order.
+
+    Parameters
+    ----------
+    t, x, data
+        Time (s), state and kernel data, as :func:`rhs` takes them.
+    initial_energy : float
+        Stored energy at the start of the ledger, J.
+    """
+    modes, inertia, _, _, held = data
+    n = inertia.size
+    values = summary(t, x, data)
+    brake, stored = values[0], values[1]
+    phi, w, radius = x[n - 1], x[2 * n - 1], held[4]
+    motor_speed = held[_MOTOR_COMMAND + 1] * x[n]
+    slope = held[_MOTOR_COMMAND + 2]
+    command = held[_MOTOR_COMMAND]
+    dissipated, external = x[2 * n], x[2 * n + 1]
+    out = np.empty(_OUTPUT_COUNT)
+    out[0] = held[_PAYOUT_OFFSET] + radius * phi if held[_MOTOR_COMMAND + 3] else radius * phi
+    out[1] = radius * w
+    out[2] = w
+    out[3] = phi
+    out[4] = motor_speed
+    out[5] = command if np.isnan(slope) else command - slope * motor_speed
+    out[6] = brake + 0.0 if modes[1] == 1 else 0.0
+    out[7] = held[7]
+    out[8] = stored
+    out[9] = dissipated
+    out[10] = external
+    out[11] = stored - initial_energy + dissipated - external
+    return out
+
+
+@jit
 def project(x: np.ndarray, data) -> np.ndarray:
     """A held drum stays exactly where it stuck, at rest.
 
@@ -335,17 +450,19 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
 
 
 @jit
-def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle, k, t, resume):
+def quiet_step(
+    method, t0, t1, n, tol, x, directions, data, check_stick, hold_angle, k, t, resume, energy
+):
     """A whole communication step in one call, when the new inputs switch no brake mode.
 
     What :meth:`WinchModel.advance <wire_fmu.core.units.winch.drive.WinchModel.advance>`
     does once its inputs are set, in the same order and with the same arithmetic: the
     brake's mode kept (a held drum keeps its angle and rests), the loop of
-    :func:`advance` to the end of the step or its first event, the :func:`summary` at
+    :func:`advance` to the end of the step or its first event, the :func:`outputs` at
     the end. It changes nothing it was given.
 
     With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead, without the
-    summary (:func:`resume`, after an event Python switched): the one entry point
+    outputs (:func:`resume`, after an event Python switched): the one entry point
     Python calls for both, so that one compiled function is loaded from the cache,
     not two.
 
@@ -367,24 +484,26 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
         With ``resume``: the time the loop goes on from, s (else ``t0``).
     resume : bool
         Go on with :func:`advance` from ``(k, t, x)``, nothing else.
+    energy : float
+        Stored energy at the start of the ledger, J (for the output ``energy_balance``).
 
     Returns
     -------
     tuple
-        The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)`` and the
-        :func:`summary` at the end (empty unless the status is ``STATUS_DONE``); the
-        status is :data:`STATUS_PYTHON`, and nothing else meaningful, when Python must
-        settle the brake first.
+        The loop's ``(status, x, t, k, fired, steps, rhs_calls, h)``, the values of
+        :data:`OUTPUTS` at the end (empty unless the status is ``STATUS_DONE``) and
+        whether all of them are finite; the status is :data:`STATUS_PYTHON`, and nothing
+        else meaningful, when Python must settle the brake first.
     """
-    no_summary = np.zeros(0)
+    no_outputs = np.zeros(0)
     if resume:
         status, x, t, k, fired, steps, calls, h = advance_to_event(
             rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data
         )
-        return status, x, t, k, fired, steps, calls, h, no_summary
+        return status, x, t, k, fired, steps, calls, h, no_outputs, False
     if check_stick and guards(t0, x, data)[0] < 0.0:
         no_fire = np.zeros(directions.size, dtype=np.bool_)
-        return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_summary
+        return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, no_outputs, False
     x = x.copy()
     if hold_angle:
         modes, inertia, stiffness, damping, held = data
@@ -395,9 +514,14 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, check_stick, hold_an
     status, x, t, k, fired, steps, calls, h = advance_to_event(
         rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
     )
-    if status == STATUS_DONE:
-        return status, x, t, k, fired, steps, calls, h, summary(t, x, data)
-    return status, x, t, k, fired, steps, calls, h, no_summary
+    if status != STATUS_DONE:
+        return status, x, t, k, fired, steps, calls, h, no_outputs, False
+    values = outputs(t, x, data, energy)
+    finite = True
+    for value in values:
+        if not np.isfinite(value):
+            finite = False
+    return status, x, t, k, fired, steps, calls, h, values, finite
 
 
 def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
@@ -408,4 +532,5 @@ def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return quiet_step(method, t0, t1, n, tol, x, directions, data, False, False, k, t, True)[:8]
+    step = quiet_step(method, t0, t1, n, tol, x, directions, data, False, False, k, t, True, 0.0)
+    return step[:8]

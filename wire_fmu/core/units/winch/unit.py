@@ -53,6 +53,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -71,6 +72,7 @@ from wire_fmu.core.framework.unit import (
     ModelOdeView,
     OdeView,
 )
+from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import (
     NO_ROPE_MODEL,
     ROPE_MODEL_INPUTS,
@@ -78,7 +80,7 @@ from wire_fmu.core.units.winch.base import (
     WinchInputs,
 )
 from wire_fmu.core.units.winch.brake import BandBrake
-from wire_fmu.core.units.winch.drive import WinchModel
+from wire_fmu.core.units.winch.drive import FLAT_INPUTS, WinchModel
 from wire_fmu.core.units.winch.kinetostatic import KinetostaticWinch
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS, build_winch, fastest_rate
 from wire_fmu.core.units.winch.variables import winch_inputs, winch_outputs, winch_parameters
@@ -97,6 +99,7 @@ _REPORTED = ReportOutputs.of(
     ),
 )
 """The outputs copied from the model's report, and those that must be finite."""
+_read_flat_inputs = itemgetter(*FLAT_INPUTS)
 
 
 class WinchUnit(HeldInputsUnit):
@@ -175,6 +178,25 @@ class WinchUnit(HeldInputsUnit):
                 "to integrate it against the rope's interface model"
             )
         return problems
+
+    def _take_quiet_step(self, time: float, step: float) -> bool:
+        """A step in which nothing happens, outputs included, in one compiled call.
+
+        Implements :meth:`Unit._take_quiet_step` with :meth:`WinchModel.quiet_step_outputs
+        <wire_fmu.core.units.winch.drive.WinchModel.quiet_step_outputs>` when the compiled
+        kernel runs the model's steps. The outputs a quiet step cannot change (the layer,
+        its radius, the brake's state, the mode changes) keep their values.
+        """
+        model = self.model
+        if not (isinstance(model, WinchModel) and model.compiled):
+            return False
+        flat = tuple(map(float, _read_flat_inputs(self.values)))
+        taken = model.quiet_step_outputs(time, step, flat, self.initial_energy)
+        if taken is None:
+            return False
+        self.values.update(zip(kernel.OUTPUTS, taken))  # noqa: B905 - as many by construction
+        self.time = time + step
+        return True
 
     def evaluate_outputs(self) -> None:
         """Feedthrough outputs for the inputs now set; the state is untouched."""
