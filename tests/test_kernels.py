@@ -267,3 +267,39 @@ def test_every_copy_of_the_sources_shares_one_cache(tmp_path, monkeypatch):
     own = copies[0] / sources[0]
     own.write_text(own.read_text() + "\n# changed\n")
     assert cache_of(copies[0]) not in (first, cache_of(copies[1]))
+
+
+def test_a_kernel_modules_decorators_key_its_functions_once_and_as_the_locator_would(
+    monkeypatch, tmp_path
+):
+    """``kernel_decorators`` computes the module's cache key once for all its functions, and
+    the cache folder a function so keyed gets is the one the key computed afresh gives."""
+    import wire_fmu.core.units.winch.kernel as kernel
+
+    if not compiled.numba_available():
+        pytest.skip("numba is not installed")
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "cache"))
+    digests = []
+    computed = compiled.source_digest
+    monkeypatch.setattr(compiled, "source_digest", lambda f: digests.append(f) or computed(f))
+    jit, jit_inline = compiled.kernel_decorators(kernel.__file__)
+
+    @jit
+    def add_one(x):
+        return x + 1.0
+
+    @jit
+    def add_two(x):
+        return x + 2.0
+
+    @jit_inline
+    def same(x):
+        return x
+
+    assert digests == [kernel.__file__]
+    assert (add_one(1.0), add_two(1.0), same(1.0)) == (2.0, 3.0, 1.0)
+    locate = compiled._ContentCacheLocator.from_function
+    keyed = locate(kernel.rhs.py_func, kernel.__file__).get_cache_path()
+    assert len(digests) == 1  # the kernel's functions carry their module's key
+    fresh = locate(lambda x: x, kernel.__file__).get_cache_path()  # no key: computed afresh
+    assert len(digests) == 2 and keyed == fresh

@@ -42,7 +42,9 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = ["PIVOT_FLOOR", "empty_factors", "empty_jacobian", "factor", "solve", "to_dense"]
 

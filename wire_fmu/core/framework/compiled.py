@@ -30,7 +30,7 @@ import re
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from wire_fmu.core.errors import ConfigurationError
 
@@ -38,11 +38,14 @@ __all__ = [
     "KERNEL_ENV",
     "CACHE_ENV",
     "KernelChoiceError",
+    "KernelDecorators",
     "cache_directory",
     "cache_problem",
     "jit",
     "jit_inline",
     "kernel_choice",
+    "kernel_decorators",
+    "source_digest",
     "numba_available",
     "use_compiled",
 ]
@@ -198,6 +201,26 @@ def _kernel_sources(py_file: str) -> list[Path]:
     return sources
 
 
+def source_digest(py_file: str) -> str:
+    """The key of ``py_file``'s compiled code in the cache: a digest of its package-relative
+    path and of the text of :func:`_kernel_sources` (hex, 16 characters).
+
+    Parameters
+    ----------
+    py_file : str
+        A kernel module's source file.
+    """
+    relative = _package_relative(py_file) or Path(py_file).name
+    digest = hashlib.sha256(relative.encode())
+    for source in _kernel_sources(py_file):
+        digest.update(b"\0" + source.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+_DIGEST_ATTRIBUTE = "_wire_fmu_source_digest"
+"""The attribute of a kernel function that carries ``(its file, source_digest(file))``."""
+
+
 if _numba_caching is not None:
 
     class _ContentCacheLocator(
@@ -213,10 +236,8 @@ if _numba_caching is not None:
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
             relative = _package_relative(py_file) or Path(py_file).name
-            digest = hashlib.sha256(relative.encode())
-            for source in _kernel_sources(py_file):
-                digest.update(b"\0" + source.read_bytes())
-            digest = digest.hexdigest()[:16]
+            kept = getattr(py_func, _DIGEST_ATTRIBUTE, None)  # (file, digest) of its module's
+            digest = kept[1] if kept is not None and kept[0] == py_file else source_digest(py_file)
             folder = relative.replace("/", "_").removesuffix(".py")
             self._cache_path = str(cache_directory() / f"{folder}-{digest}")
 
@@ -232,6 +253,41 @@ if _numba_caching is not None:
     _locators = _numba_caching.CacheImpl._locator_classes
     if not any(c.__name__ == _ContentCacheLocator.__name__ for c in _locators):
         _locators.insert(0, _ContentCacheLocator)
+
+
+class KernelDecorators(NamedTuple):
+    """:func:`jit` and :func:`jit_inline` for one kernel module (:func:`kernel_decorators`)."""
+
+    jit: Callable[[Callable[..., Any]], Callable[..., Any]]
+    jit_inline: Callable[[Callable[..., Any]], Callable[..., Any]]
+
+
+def kernel_decorators(py_file: str) -> KernelDecorators:
+    """:func:`jit` and :func:`jit_inline` for the functions of the kernel module ``py_file``,
+    its cache key (:func:`source_digest`) computed once for all of them.
+
+    The key follows the module's imports through the package's sources; computed for
+    every function anew, that was a tenth of a second of every start. A kernel module
+    takes its decorators with ``jit, jit_inline = kernel_decorators(__file__)``.
+
+    Parameters
+    ----------
+    py_file : str
+        The kernel module's source file (its ``__file__``).
+    """
+    if numba is None or _package_relative(py_file) is None or not os.path.exists(py_file):
+        return KernelDecorators(jit, jit_inline)
+    kept = (py_file, source_digest(py_file))
+
+    def keyed(decorate: Callable[[Callable[..., Any]], Callable[..., Any]]):
+        def decorator(function: Callable[..., Any]) -> Callable[..., Any]:
+            setattr(function, _DIGEST_ATTRIBUTE, kept)
+            return decorate(function)
+
+        decorator.__doc__ = decorate.__doc__
+        return decorator
+
+    return KernelDecorators(keyed(jit), keyed(jit_inline))
 
 
 def jit(function: Callable[..., Any]) -> Callable[..., Any]:

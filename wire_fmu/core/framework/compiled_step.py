@@ -34,13 +34,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit, jit_inline
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.fixed_step import RK4, ROS2, FixedStepSolver
 from wire_fmu.core.framework.step_limits import (
     MAX_EVENTS_PER_STEP,
     IntegrationError,
     internal_step_count,
 )
+
+jit, jit_inline = kernel_decorators(__file__)
 
 if TYPE_CHECKING:
     from wire_fmu.core.framework.hybrid import SolverSettings

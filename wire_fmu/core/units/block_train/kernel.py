@@ -65,7 +65,7 @@ import math
 import numpy as np
 
 from wire_fmu.core.framework import bordered_band
-from wire_fmu.core.framework.compiled import jit, jit_inline
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_structured
 from wire_fmu.core.units.block_train.kernel_friction import (
     accelerations,
@@ -77,6 +77,8 @@ from wire_fmu.core.units.block_train.kernel_friction import (
 )
 from wire_fmu.core.units.block_train.kernel_geometry import segment_lengths, span_geometry
 from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian
+
+jit, jit_inline = kernel_decorators(__file__)
 
 __all__ = [
     "advance",

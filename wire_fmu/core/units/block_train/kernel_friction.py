@@ -33,7 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = [
     "accelerations",

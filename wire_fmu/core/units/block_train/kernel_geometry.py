@@ -17,7 +17,9 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = ["segment_lengths", "span_geometry"]
 

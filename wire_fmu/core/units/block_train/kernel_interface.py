@@ -26,8 +26,10 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.units.block_train.kernel import summary
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = ["port_linearisations"]
 

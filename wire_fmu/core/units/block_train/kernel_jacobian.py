@@ -32,8 +32,10 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.components.friction import GROUND
-from wire_fmu.core.framework.compiled import jit_inline
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.sparse_pattern import BandStructure
+
+jit_inline = kernel_decorators(__file__).jit_inline
 
 __all__ = ["coloured_jacobian", "jacobian_structure"]
 

@@ -16,10 +16,12 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON
 from wire_fmu.core.units.block_train.kernel import quiet_step
 from wire_fmu.core.units.block_train.kernel_interface import port_linearisations
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = ["FIXED_OUTPUTS", "output_vector", "quiet_step_outputs"]
 

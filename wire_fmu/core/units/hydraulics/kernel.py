@@ -28,7 +28,7 @@ Python.
 
 from __future__ import annotations
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import advance_to_event
 from wire_fmu.core.units.hydraulics.kernel_arrays import (
     REPORT,
@@ -45,6 +45,8 @@ from wire_fmu.core.units.hydraulics.kernel_hybrid import (
     rhs,
 )
 from wire_fmu.core.units.hydraulics.kernel_quiet_step import quiet_step
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = [
     "REPORT",

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from wire_fmu.core.components.end_stops import EXTENDED, RETRACTED
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.units.hydraulics.kernel_arrays import L_CUSHIONS, L_SEAL, L_STOPS, REPORT
 from wire_fmu.core.units.hydraulics.kernel_physics import (
     Cylinder,
@@ -38,6 +38,8 @@ from wire_fmu.core.units.hydraulics.kernel_physics import (
     seal_stuck,
     stored_energy,
 )
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = [
     "breaks_away",

@@ -18,7 +18,7 @@ from collections import namedtuple
 import numpy as np
 
 from wire_fmu.core.components.end_stops import EXTENDED, RETRACTED
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.units.hydraulics.kernel_arrays import (
     H_COMPLIANCE,
     H_CONTACT,
@@ -73,6 +73,8 @@ from wire_fmu.core.units.hydraulics.oil_side import (
     OIL_ONE_NODE,
     OIL_RIGID,
 )
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = [
     "Cylinder",

@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
 from wire_fmu.core.framework.fixed_step import ROS2
 from wire_fmu.core.units.hydraulics.kernel_arrays import REPORT
@@ -57,6 +57,8 @@ from wire_fmu.core.units.hydraulics.kernel_physics import (
     evaluate,
     seal_stuck,
 )
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = ["quiet_step"]
 

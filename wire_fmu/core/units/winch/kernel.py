@@ -25,8 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from wire_fmu.core.framework.compiled import jit
+from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_to_event
+
+jit = kernel_decorators(__file__).jit
 
 __all__ = [
     "HELD",
