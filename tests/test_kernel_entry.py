@@ -118,10 +118,44 @@ def test_the_block_train_loads_its_quiet_steps_outputs_at_initialisation(monkeyp
     calls = recorded_calls(monkeypatch, block_train_kernel_outputs, "quiet_step_outputs")
     unit = drawworks_rope()
     unit.initialize(0.0)
-    assert len(calls) == 1  # the preload
+    assert len(calls) == 1  # the start's evaluation, which loads it
     for k in range(20):
         unit.values["line_a.payout"] = 0.01 * k * 0.002
         unit.values["line_a.payout_rate"] = 0.01
         assert unit.advance(k * 0.002, 0.002).success
     assert len(calls) > 10  # the quiet steps
     assert set(calls) == {calls[0]}
+
+
+def riser_rope(**values) -> BlockTrainUnit:
+    """The riser scene's block train, with ``values``, not initialised."""
+    scene = tomllib.loads(find_scene("riser_tensioner").read_text())["units"]["rope"]
+    unit = BlockTrainUnit("rope")
+    unit.values["reeving"] = json.dumps(scene["parameters"]["reeving"])
+    unit.values["effects"] = ",".join(scene["effects"])
+    for name, value in scene["parameters"].items():
+        if name != "reeving":
+            unit.values[name] = value
+    unit.values.update(values)
+    unit.configure()
+    return unit
+
+
+def test_the_block_trains_start_is_evaluated_by_its_quiet_steps_entry_alone(monkeypatch):
+    # the start's summary and interface models come from the call that loads the quiet
+    # step's entry point: no other compiled function is loaded for them
+    from wire_fmu.core.units.block_train import kernel_interface
+
+    own = {"summary": recorded_calls(monkeypatch, block_train_kernel, "summary")}
+    own["interface"] = recorded_calls(monkeypatch, kernel_interface, "port_linearisations")
+    unit = riser_rope(**{"mover_a.interface_model": True})
+    unit.initialize(0.0)
+    assert own == {"summary": [], "interface": []}
+    # the same outputs, to the bit, as evaluated by those functions themselves
+    unit.model.start_table = None
+    unit.model._step_summary = None
+    kept = dict(unit.values)
+    unit._update_outputs()
+    assert len(own["summary"]) > 0 and len(own["interface"]) == 1
+    assert unit.values == kept
+    assert unit.initial_energy == unit.model.stored_energy(0.0)

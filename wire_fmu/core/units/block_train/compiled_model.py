@@ -242,7 +242,7 @@ class CompiledBlockTrain:
         held: np.ndarray,
         plan: OutputPlan,
         initial_energy: float,
-        preload: bool = False,
+        evaluate_only: bool = False,
     ) -> tuple:
         """The arguments of :func:`.kernel_outputs.quiet_step_outputs` for a step from
         ``t`` to ``t1`` (s) in ``count`` internal steps, with the inputs ``held``."""
@@ -269,13 +269,17 @@ class CompiledBlockTrain:
             plan.block_coords,
             plan.block_starts,
             initial_energy,
-            preload,
+            evaluate_only,
         )
 
-    def preload_quiet_outputs(self, t: float, plan: OutputPlan) -> None:
-        """Load :func:`.kernel_outputs.quiet_step_outputs` (and what it calls) from the
-        compiled-code cache now, by a call that does nothing else, so that the first quiet
-        step does not pay for it.
+    def evaluate_start(self, t: float, plan: OutputPlan) -> None:
+        """The start's summary and ports' interface models, evaluated at ``(t, state)`` by
+        :func:`.kernel_outputs.quiet_step_outputs` and kept for the start's outputs.
+
+        The one call also loads that function (its callees with it) from the compiled-code
+        cache, so that neither the start's outputs nor the first quiet step load a function
+        of their own. Values that are not finite are not kept: the outputs are then
+        evaluated the general way, which names the failure.
 
         Parameters
         ----------
@@ -284,8 +288,11 @@ class CompiledBlockTrain:
         plan : OutputPlan
             The unit's plan of its quiet steps' outputs.
         """
-        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, 0.0, preload=True)
-        kernel_outputs.quiet_step_outputs(*arguments)
+        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, 0.0, evaluate_only=True)
+        _, _, _, _, values, _, table, finite = kernel_outputs.quiet_step_outputs(*arguments)
+        if finite:
+            self._step_summary = (t, self.state, values)
+            self.start_table = (t, self.state, plan.interface_rows, table)
 
     def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
         """What the outputs need at ``(t, x)``.

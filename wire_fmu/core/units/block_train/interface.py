@@ -261,6 +261,14 @@ def linearisation_table(model, plan: InterfacePlan, t: float, x: np.ndarray) -> 
         :class:`PortLinearisation`).
     """
     if model.compiled:
+        kept = model.start_table  # the start's, evaluated with the first step's entry point
+        if (
+            kept is not None
+            and kept[0] == t
+            and kept[1] is x
+            and np.array_equal(kept[2], plan.rows)
+        ):
+            return kept[3].reshape(len(plan.rows), 5)
         table = kernel_interface.port_linearisations(
             t, x, kernel_data(model), plan.rows, RELATIVE_STEP, TIME_STEP
         )

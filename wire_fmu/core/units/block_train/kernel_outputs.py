@@ -18,7 +18,7 @@ import numpy as np
 
 from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON
-from wire_fmu.core.units.block_train.kernel import quiet_step
+from wire_fmu.core.units.block_train.kernel import quiet_step, summary
 from wire_fmu.core.units.block_train.kernel_interface import port_linearisations
 
 jit = kernel_decorators(__file__).jit
@@ -159,7 +159,7 @@ def quiet_step_outputs(
     block_coords,
     block_starts,
     initial_energy,
-    preload,
+    evaluate_only,
 ):
     """A quiet step and its outputs in one call: :func:`.kernel.quiet_step`, then the
     ports' interface models (:func:`.kernel_interface.port_linearisations`) and
@@ -184,8 +184,12 @@ def quiet_step_outputs(
         The table of no ports (shape ``(0, 5)``), the table when there are no rows.
     n_spans, masses, line_spans, driver_bodies, block_coords, block_starts, initial_energy
         As :func:`output_vector` takes them.
-    preload : bool
-        Only load this function (its callees with it) and answer at once, nothing done.
+    evaluate_only : bool
+        Take no step: only evaluate at ``(t0, x)`` with ``data`` as the model holds it,
+        :func:`.kernel.summary` as the values and the ports' interface models, a row of
+        five after another, as the outputs. The start's outputs come from this call,
+        which is also what loads this function (its callees with it) from the cache
+        before the first step.
 
     Returns
     -------
@@ -198,8 +202,17 @@ def quiet_step_outputs(
         whether it is finite.
     """
     nothing = np.zeros(0)
-    if preload:
-        return STATUS_PYTHON, x, 0, 0, nothing, held_positions, nothing, False
+    if evaluate_only:
+        values = summary(t0, x, data)
+        table = no_ports
+        if interface_rows.shape[0]:
+            table = port_linearisations(t0, x, data, interface_rows, relative_step, time_step)
+        finite = True
+        for value in values:
+            finite = finite and math.isfinite(value)
+        for value in table.ravel():
+            finite = finite and math.isfinite(value)
+        return STATUS_PYTHON, x, 0, 0, values, held_positions, table.ravel(), finite
     result = quiet_step(method, t0, t1, n, tol, x, directions, data, held, 0, t0, False)
     if result[0] != STATUS_DONE:
         return result[0], x, 0, 0, nothing, held_positions, nothing, False

@@ -329,6 +329,7 @@ class BlockTrainModel(
         self._inputs = inputs
         self._t_step = t
         self._step_summary = None
+        self.start_table: tuple | None = None  # (t, x, rows, table) of evaluate_start
         self.held_vector = vector
         nl, nd = len(LINE_PORTS), len(self.driver_ports)
         lines, movers, ramps = 1 + nl, 1 + 2 * nl, 1 + 2 * nl + 2 * nd

@@ -346,11 +346,11 @@ class BlockTrainUnit(Unit):
         except ConfigurationError as err:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
         self.time = start_time
-        self.initial_energy = model.stored_energy(start_time)
-        self._update_outputs()
         plan = self._quiet_plan()
         if plan is not None:
-            model.preload_quiet_outputs(start_time, plan)
+            model.evaluate_start(start_time, plan)
+        self.initial_energy = model.stored_energy(start_time)
+        self._update_outputs()
 
     def _stability_problems(self) -> list[str]:
         """An rk4 step the stiffest mode of the initial state cannot be stable with."""
