@@ -1,10 +1,12 @@
 """One compiled entry point per kernel, loaded when the unit is initialised (issue 16).
 
 A compiled function is loaded from the on-disk cache at its first call with given
-argument types. The block train's and the winch's loops after an event go through
-their quiet step's own function (``resume``), and initialisation calls it once with a
-step of nothing, so that no loading falls inside the stepping; the cylinder's quiet
-step and its loop after an event are two functions, and initialisation loads both.
+argument types. The block train has one entry point for all it does from Python (the
+start's evaluation, its quiet steps, the general way's step and the loop after an
+event); the winch's loop after an event goes through its quiet step's own function
+(``resume``); initialisation calls each with a step of nothing, so that no loading
+falls inside the stepping. The cylinder's quiet step and its loop after an event are
+two functions, and initialisation loads both.
 These tests check that that call takes the very argument types of the steps that
 follow (else it would load a specialisation no step uses) and that it changes nothing.
 """
@@ -57,21 +59,32 @@ def drawworks_rope() -> BlockTrainUnit:
     return unit
 
 
-def test_the_block_train_loads_its_step_with_the_types_its_steps_use(monkeypatch):
-    # the general way's step and its resume after events (the quiet way's entry, which
-    # calls the step in compiled code: the last test of this file)
-    calls = recorded_calls(monkeypatch, block_train_kernel)
+def test_the_block_train_loads_one_entry_with_the_types_all_its_modes_use(monkeypatch):
+    # the start's evaluation, the quiet steps, the general way's step and its resume
+    # after events: one compiled function, called with the same argument types
+    entry = block_train_kernel_outputs.quiet_step_outputs
+    calls, modes = [], []
+
+    def recording(*args):
+        calls.append(tuple(numba.typeof(a) for a in args))
+        modes.append(args[22])
+        return entry(*args)
+
+    monkeypatch.setattr(block_train_kernel_outputs, "quiet_step_outputs", recording)
+    direct = recorded_calls(monkeypatch, block_train_kernel)  # the step's own function
     unit = drawworks_rope()
     assert unit.model.compiled and isinstance(unit.model.solver, CompiledFixedStep)
     unit.initialize(0.0)
-    assert calls  # the preload, at initialisation
+    assert calls  # at initialisation: the preload, the start's evaluation
     unit.values["line_a.payout_rate"] = -1.0  # lowering: the bearings break loose
     for k in range(50):
         unit.values["line_a.payout"] = -1.0 * k * 0.002
         assert unit.advance(k * 0.002, 0.002).success
     assert unit.model.mode_changes > 0  # events: the loop went on through ``resume``
-    assert len(calls) > 5  # the steps with events
+    kinds = block_train_kernel_outputs
+    assert set(modes) == {kinds.EVALUATE, kinds.STEP_WITH_OUTPUTS, kinds.STEP, kinds.RESUME}
     assert set(calls) == {calls[0]}
+    assert direct == []  # never called from Python: not loaded on its own
 
 
 def test_the_preload_changes_nothing():
@@ -115,10 +128,10 @@ def test_the_cylinder_loads_its_loop_after_an_event_before_its_first_step(monkey
 
 
 def test_the_block_train_loads_its_quiet_steps_outputs_at_initialisation(monkeypatch):
-    calls = recorded_calls(monkeypatch, block_train_kernel_outputs, "quiet_step_outputs")
     unit = drawworks_rope()
+    calls = recorded_calls(monkeypatch, block_train_kernel_outputs, "quiet_step_outputs")
     unit.initialize(0.0)
-    assert len(calls) == 1  # the start's evaluation, which loads it
+    assert len(calls) == 2  # the loop's preload and the start's evaluation
     for k in range(20):
         unit.values["line_a.payout"] = 0.01 * k * 0.002
         unit.values["line_a.payout_rate"] = 0.01

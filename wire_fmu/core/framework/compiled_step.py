@@ -507,6 +507,12 @@ class KernelModel:
         finally:
             self.compiled = compiled
 
+    def resume_entry(self) -> Callable[..., tuple]:
+        """What :class:`CompiledFixedStep` calls to go on after an event: the kernel's
+        ``resume`` (a model whose kernel has one entry point for all it does passes
+        through that instead)."""
+        return self.KERNEL.resume
+
     def kernel_solver(self, settings: SolverSettings):
         """The compiled fixed-step loop over the kernel when compiled and the method has one,
         else the Python solver.
@@ -519,5 +525,5 @@ class KernelModel:
         from wire_fmu.core.framework.hybrid import make_solver
 
         if self.compiled and settings.method in COMPILED_METHODS:
-            return CompiledFixedStep(settings, self.KERNEL.resume)
+            return CompiledFixedStep(settings, self.resume_entry())
         return make_solver(settings)

@@ -20,10 +20,16 @@ from wire_fmu.core.framework.step_limits import IntegrationError
 from wire_fmu.core.units.block_train import kernel, kernel_outputs
 from wire_fmu.core.units.block_train.interface import RELATIVE_STEP, TIME_STEP
 from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian, jacobian_structure
+from wire_fmu.core.units.block_train.kernel_outputs import (
+    EVALUATE,
+    RESUME,
+    STEP,
+    STEP_WITH_OUTPUTS,
+)
+from wire_fmu.core.units.block_train.quiet_outputs import OutputPlan, output_plan
 
 if TYPE_CHECKING:
     from wire_fmu.core.units.block_train.model import BlockTrainInputs
-    from wire_fmu.core.units.block_train.quiet_outputs import OutputPlan
 
 __all__ = ["BandedLinearAlgebra", "CompiledBlockTrain"]
 
@@ -147,7 +153,8 @@ class CompiledBlockTrain:
         }
 
     def _quiet_step(self, t: float, h: float, inputs: BlockTrainInputs) -> bool:
-        """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's.
+        """The step in one compiled call (:func:`kernel.quiet_step`, through the entry point
+        :func:`.kernel_outputs.quiet_step_outputs`); False if it is Python's.
 
         Events inside the step are switched by :meth:`handle_events` as in any step:
         the compiled loop goes on from the first one.
@@ -156,20 +163,8 @@ class CompiledBlockTrain:
         solver = self.solver
         t1 = t + h
         n = solver.internal_count(t, t1)
-        result = kernel.quiet_step(
-            solver.method,
-            t,
-            t1,
-            n,
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            self.kernel_data(),
-            held,
-            0,
-            t,
-            False,
-        )
+        arguments = self._quiet_arguments(t, t1, n, held, self._no_outputs(), 0.0, STEP)
+        result = kernel_outputs.quiet_step_outputs(*arguments)
         if result[0] == STATUS_PYTHON:
             return False
         self._hold(t, inputs, held)
@@ -216,10 +211,9 @@ class CompiledBlockTrain:
         except IntegrationError:  # a step too long: refused the general way, with the reason
             return None
         held = self._held_from_flat(t, flat)
-        status, x, steps, rhs_calls, values, held_positions, out, finite = (
-            kernel_outputs.quiet_step_outputs(
-                *self._quiet_arguments(t, t1, count, held, plan, initial_energy)
-            )
+        arguments = self._quiet_arguments(t, t1, count, held, plan, initial_energy)
+        status, x, _, _, _, steps, rhs_calls, _, values, held_positions, out, finite = (
+            kernel_outputs.quiet_step_outputs(*arguments)
         )
         if status != STATUS_DONE or not finite:
             return None
@@ -242,20 +236,25 @@ class CompiledBlockTrain:
         held: np.ndarray,
         plan: OutputPlan,
         initial_energy: float,
-        evaluate_only: bool = False,
+        mode: int = STEP_WITH_OUTPUTS,
+        k: int = 0,
+        t_from: float | None = None,
     ) -> tuple:
         """The arguments of :func:`.kernel_outputs.quiet_step_outputs` for a step from
-        ``t`` to ``t1`` (s) in ``count`` internal steps, with the inputs ``held``."""
+        ``t`` to ``t1`` (s) in ``count`` internal steps, with the inputs ``held``; the
+        ``mode``'s, and with :data:`.kernel_outputs.RESUME` the interval ``k`` and time
+        ``t_from`` (s) it goes on from."""
+        tol = self.settings.event_time_tolerance
+        step = (self.solver.method, t, t1, count, tol, self.state, self._guard_dirs)
+        t_from = t if t_from is None else t_from
+        rest = self._plan_arguments(plan, initial_energy, mode, k, t_from)
+        return (*step, self.kernel_data(), held, *rest)
+
+    def _plan_arguments(
+        self, plan: OutputPlan, initial_energy: float, mode: int, k: int, t: float
+    ) -> tuple:
+        """The arguments of :func:`.kernel_outputs.quiet_step_outputs` after ``held``."""
         return (
-            self.solver.method,
-            t,
-            t1,
-            count,
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            self.kernel_data(),
-            held,
             self._held_positions,
             bool(self.friction.links),
             plan.interface_rows,
@@ -269,7 +268,9 @@ class CompiledBlockTrain:
             plan.block_coords,
             plan.block_starts,
             initial_energy,
-            evaluate_only,
+            mode,
+            k,
+            t,
         )
 
     def evaluate_start(self, t: float, plan: OutputPlan) -> None:
@@ -288,11 +289,33 @@ class CompiledBlockTrain:
         plan : OutputPlan
             The unit's plan of its quiet steps' outputs.
         """
-        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, 0.0, evaluate_only=True)
-        _, _, _, _, values, _, table, finite = kernel_outputs.quiet_step_outputs(*arguments)
+        arguments = self._quiet_arguments(t, t, 1, self.held_vector, plan, 0.0, EVALUATE)
+        result = kernel_outputs.quiet_step_outputs(*arguments)
+        values, table, finite = result[8], result[10], result[11]
         if finite:
             self._step_summary = (t, self.state, values)
             self.start_table = (t, self.state, plan.interface_rows, table)
+
+    def resume(self, method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
+        """The loop after an event (:class:`CompiledFixedStep`'s entry point), through the
+        block train's one compiled entry point (:data:`.kernel_outputs.RESUME`).
+
+        Parameters
+        ----------
+        method, t0, t1, n, k, t, x, directions, tol, data
+            As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
+        """
+        rest = self._plan_arguments(self._no_outputs(), 0.0, RESUME, k, t)
+        step = (method, t0, t1, n, tol, x, directions, data, data[11])
+        return kernel_outputs.quiet_step_outputs(*step, *rest)[:8]
+
+    def _no_outputs(self) -> OutputPlan:
+        """A plan of no outputs but the fixed ones (for the modes that write none): the
+        same argument types as every plan."""
+        plan = getattr(self, "_plan_of_no_outputs", None)
+        if plan is None or plan.model is not self:
+            plan = self._plan_of_no_outputs = output_plan(self, [], [], [], ())
+        return plan
 
     def summary(self, t: float, x: np.ndarray) -> tuple[float, float, np.ndarray, np.ndarray]:
         """What the outputs need at ``(t, x)``.

@@ -90,7 +90,6 @@ __all__ = [
     "linearise",
     "project",
     "quiet_step",
-    "resume",
     "rhs",
     "rhs_parts",
     "solve",
@@ -616,8 +615,9 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
 
     With ``resume`` it is :func:`advance` from ``(k, t, x)`` instead, without the
     summary (the loop going on after an event Python switched, ``data`` as the model
-    holds it, ``held`` unused): the one entry point Python calls for both, so that one
-    compiled function is loaded from the cache, not two.
+    holds it, ``held`` unused). Python calls it for both through the block train's one
+    entry point, :func:`.kernel_outputs.quiet_step_outputs`, so that one compiled
+    function is loaded from the cache, not two.
 
     Parameters
     ----------
@@ -674,14 +674,3 @@ def quiet_step(method, t0, t1, n, tol, x, directions, data, held, k, t, resume):
     if status == STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, summary(t1, x, new)
     return status, x, t, k, fired, steps, calls, h, no_summary
-
-
-def resume(method, t0, t1, n, k, t, x, directions, tol, data) -> tuple:
-    """:func:`advance` through :func:`quiet_step` (the entry point the solver calls).
-
-    Parameters
-    ----------
-    method, t0, t1, n, k, t, x, directions, tol, data
-        As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
-    """
-    return quiet_step(method, t0, t1, n, tol, x, directions, data, data[11], k, t, True)[:8]

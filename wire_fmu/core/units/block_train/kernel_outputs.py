@@ -23,7 +23,27 @@ from wire_fmu.core.units.block_train.kernel_interface import port_linearisations
 
 jit = kernel_decorators(__file__).jit
 
-__all__ = ["FIXED_OUTPUTS", "output_vector", "quiet_step_outputs"]
+__all__ = [
+    "EVALUATE",
+    "FIXED_OUTPUTS",
+    "RESUME",
+    "STEP",
+    "STEP_WITH_OUTPUTS",
+    "output_vector",
+    "quiet_step_outputs",
+]
+
+STEP_WITH_OUTPUTS = 0
+"""What :func:`quiet_step_outputs` does: a quiet step and its outputs."""
+EVALUATE = 1
+"""What :func:`quiet_step_outputs` does: the summary and the ports' interface models at the
+start of the interval, no step."""
+STEP = 2
+"""What :func:`quiet_step_outputs` does: :func:`.kernel.quiet_step` alone (the general way's
+attempt, which Python goes on from after an event)."""
+RESUME = 3
+"""What :func:`quiet_step_outputs` does: the loop after an event Python switched
+(:func:`.kernel.quiet_step` with ``resume``)."""
 
 FIXED_OUTPUTS = (
     "path_start.tension",
@@ -159,7 +179,9 @@ def quiet_step_outputs(
     block_coords,
     block_starts,
     initial_energy,
-    evaluate_only,
+    mode,
+    k,
+    t,
 ):
     """A quiet step and its outputs in one call: :func:`.kernel.quiet_step`, then the
     ports' interface models (:func:`.kernel_interface.port_linearisations`) and
@@ -167,6 +189,12 @@ def quiet_step_outputs(
     :meth:`~wire_fmu.core.units.block_train.compiled_model.CompiledBlockTrain.quiet_step_outputs`
     would otherwise make from Python, each with numba's dispatch on a tuple of some
     thirty arrays. The same calls in the same order, so the same numbers to the bit.
+
+    The block train's one compiled entry point: with another ``mode`` it evaluates the
+    start (:data:`EVALUATE`), takes the general way's step (:data:`STEP`) or goes on after
+    an event (:data:`RESUME`), so that one compiled function is loaded from the cache,
+    not two. Every mode takes arguments of the same types (those it does not use too),
+    so that one specialisation serves them all.
 
     Parameters
     ----------
@@ -184,25 +212,35 @@ def quiet_step_outputs(
         The table of no ports (shape ``(0, 5)``), the table when there are no rows.
     n_spans, masses, line_spans, driver_bodies, block_coords, block_starts, initial_energy
         As :func:`output_vector` takes them.
-    evaluate_only : bool
-        Take no step: only evaluate at ``(t0, x)`` with ``data`` as the model holds it,
-        :func:`.kernel.summary` as the values and the ports' interface models, a row of
-        five after another, as the outputs. The start's outputs come from this call,
-        which is also what loads this function (its callees with it) from the cache
-        before the first step.
+    mode : int
+        :data:`STEP_WITH_OUTPUTS`; :data:`EVALUATE`: take no step, only evaluate at
+        ``(t0, x)`` with ``data`` as the model holds it, :func:`.kernel.summary` as the
+        values and the ports' interface models, a row of five after another, as the
+        outputs (the start's outputs come from this call, which is also what loads this
+        function before the first step); :data:`STEP` or :data:`RESUME`:
+        :func:`.kernel.quiet_step` without or with ``resume``, its values the summary.
+    k, t
+        With :data:`RESUME`: the interval ``t`` (s) lies in, as
+        :func:`.kernel.quiet_step` takes them; else unused.
 
     Returns
     -------
     tuple
-        ``(status, x, steps, rhs_calls, values, held_positions, outputs, finite)``:
-        the loop's status (:data:`STATUS_DONE` when the step was taken without an
-        event, else nothing after it is meaningful), the state at ``t1``, the internal
-        steps and right-hand sides it took, :func:`.kernel.summary` at ``t1``, the held
-        positions the model holds from now on, :func:`output_vector`'s vector and
-        whether it is finite.
+        ``(status, x, t, k, fired, steps, rhs_calls, h, values, held_positions,
+        outputs, finite)``: the loop's ``(status, x, t, k, fired, steps, rhs_calls, h)``
+        (:data:`STATUS_DONE` when the step was taken without an event), the summary at
+        ``t1``, the held positions the model holds from now on, :func:`output_vector`'s
+        vector and whether it is finite; with :data:`STEP_WITH_OUTPUTS`, nothing after
+        the status is meaningful unless it is :data:`STATUS_DONE`.
     """
     nothing = np.zeros(0)
-    if evaluate_only:
+    if mode == STEP or mode == RESUME:
+        status, x, t, k, fired, steps, calls, h, values = quiet_step(
+            method, t0, t1, n, tol, x, directions, data, held, k, t, mode == RESUME
+        )
+        return status, x, t, k, fired, steps, calls, h, values, held_positions, nothing, False
+    no_fire = np.zeros(directions.size, dtype=np.bool_)
+    if mode == EVALUATE:
         values = summary(t0, x, data)
         table = no_ports
         if interface_rows.shape[0]:
@@ -212,10 +250,11 @@ def quiet_step_outputs(
             finite = finite and math.isfinite(value)
         for value in table.ravel():
             finite = finite and math.isfinite(value)
-        return STATUS_PYTHON, x, 0, 0, values, held_positions, table.ravel(), finite
+        flat = table.ravel()
+        return STATUS_PYTHON, x, t0, 0, no_fire, 0, 0, 0.0, values, held_positions, flat, finite
     result = quiet_step(method, t0, t1, n, tol, x, directions, data, held, 0, t0, False)
     if result[0] != STATUS_DONE:
-        return result[0], x, 0, 0, nothing, held_positions, nothing, False
+        return result[0], x, t0, 0, no_fire, 0, 0, 0.0, nothing, held_positions, nothing, False
     end, values = result[1], result[8]
     positions = x[: data[0][0]].copy() if hold_start else held_positions
     table = no_ports
@@ -235,4 +274,5 @@ def quiet_step_outputs(
         block_starts,
         initial_energy,
     )
-    return STATUS_DONE, end, result[5], result[6], values, positions, out, finite
+    t, k, fired, steps, calls, h = result[2], result[3], result[4], result[5], result[6], result[7]
+    return STATUS_DONE, end, t, k, fired, steps, calls, h, values, positions, out, finite

@@ -198,6 +198,11 @@ class BlockTrainModel(
         self.compiled = self.kernel_applies() and use_compiled("block train")
         self.solver = self.kernel_solver(self._internal_solver(solver))
 
+    def resume_entry(self):
+        """:meth:`KernelModel.resume_entry`: through the block train's one compiled entry
+        point (:meth:`CompiledBlockTrain.resume`)."""
+        return self.resume
+
     def _internal_solver(self, settings: SolverSettings) -> SolverSettings:
         """``settings``, with one internal step a communication step when nothing is dynamic.
 
