@@ -239,22 +239,25 @@ class CompiledBlockTrain:
         mode: int = STEP_WITH_OUTPUTS,
         k: int = 0,
         t_from: float | None = None,
+        *,
+        x: np.ndarray | None = None,
+        data: tuple | None = None,
     ) -> tuple:
         """The arguments of :func:`.kernel_outputs.quiet_step_outputs` for a step from
         ``t`` to ``t1`` (s) in ``count`` internal steps, with the inputs ``held``; the
         ``mode``'s, and with :data:`.kernel_outputs.RESUME` the interval ``k`` and time
-        ``t_from`` (s) it goes on from."""
-        tol = self.settings.event_time_tolerance
-        step = (self.solver.method, t, t1, count, tol, self.state, self._guard_dirs)
-        t_from = t if t_from is None else t_from
-        rest = self._plan_arguments(plan, initial_energy, mode, k, t_from)
-        return (*step, self.kernel_data(), held, *rest)
-
-    def _plan_arguments(
-        self, plan: OutputPlan, initial_energy: float, mode: int, k: int, t: float
-    ) -> tuple:
-        """The arguments of :func:`.kernel_outputs.quiet_step_outputs` after ``held``."""
+        ``t_from`` (s) it goes on from, the state ``x`` and the kernel's ``data`` (by
+        default the model's)."""
         return (
+            self.solver.method,
+            t,
+            t1,
+            count,
+            self.settings.event_time_tolerance,
+            self.state if x is None else x,
+            self._guard_dirs,
+            self.kernel_data() if data is None else data,
+            held,
             self._held_positions,
             bool(self.friction.links),
             plan.interface_rows,
@@ -270,7 +273,7 @@ class CompiledBlockTrain:
             initial_energy,
             mode,
             k,
-            t,
+            t if t_from is None else t_from,
         )
 
     def evaluate_start(self, t: float, plan: OutputPlan) -> None:
@@ -305,9 +308,11 @@ class CompiledBlockTrain:
         method, t0, t1, n, k, t, x, directions, tol, data
             As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
         """
-        rest = self._plan_arguments(self._no_outputs(), 0.0, RESUME, k, t)
-        step = (method, t0, t1, n, tol, x, directions, data, data[11])
-        return kernel_outputs.quiet_step_outputs(*step, *rest)[:8]
+        plan = self._no_outputs()  # the solver's method, tolerance and directions: the model's
+        arguments = self._quiet_arguments(
+            t0, t1, n, data[11], plan, 0.0, RESUME, k, t, x=x, data=data
+        )
+        return kernel_outputs.quiet_step_outputs(*arguments)[:8]
 
     def _no_outputs(self) -> OutputPlan:
         """A plan of no outputs but the fixed ones (for the modes that write none): the
