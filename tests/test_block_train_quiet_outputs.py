@@ -10,47 +10,16 @@ whole state at the end.
 
 from __future__ import annotations
 
-import json
 import math
-import tomllib
 
 import pytest
 
 from wire_fmu.core.framework import compiled
 from wire_fmu.core.units.block_train import kernel_outputs
-from wire_fmu.core.units.block_train.unit import BlockTrainUnit
-from wire_fmu.master.run import find_scene
 
-from .quiet_step_helpers import counted, general_way
+from .quiet_step_helpers import counted, general_way, scene_rope, step_both
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
-
-
-def scene_rope(scene: str, **values) -> BlockTrainUnit:
-    """The block train of a shipped scene, with its parameters and ``values``, initialised."""
-    spec = tomllib.loads(find_scene(scene).read_text())["units"]["rope"]
-    unit = BlockTrainUnit("rope")
-    unit.values["reeving"] = json.dumps(spec["parameters"]["reeving"])
-    unit.values["effects"] = ",".join(spec["effects"])
-    for name, value in spec["parameters"].items():
-        if name != "reeving":
-            unit.values[name] = value
-    unit.values.update(values)
-    unit.configure()
-    unit.initialize(0.0)
-    return unit
-
-
-def step_both(quiet, general, inputs, steps: int, h: float) -> None:
-    """Step both units with ``inputs(t)`` set before each step; their outputs must agree
-    to the last bit after every step."""
-    for k in range(steps):
-        t = k * h
-        for unit in (quiet, general):
-            unit.values.update(inputs(t))
-            result = unit.advance(t, h)
-            assert result.success, result.message
-        assert quiet.values == general.values, f"outputs differ after the step from t = {t}"
 
 
 def riser_motion(amplitude: float, w2: float = 0.6):

@@ -30,6 +30,7 @@ from wire_fmu.core.units.winch import kernel as winch_kernel
 from wire_fmu.master.run import find_scene
 
 from .hydraulics_helpers import make_free_rod
+from .quiet_step_helpers import scene_rope
 from .winch_helpers import make_unit as make_winch
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
@@ -140,20 +141,6 @@ def test_the_block_train_loads_its_quiet_steps_outputs_at_initialisation(monkeyp
     assert set(calls) == {calls[0]}
 
 
-def riser_rope(**values) -> BlockTrainUnit:
-    """The riser scene's block train, with ``values``, not initialised."""
-    scene = tomllib.loads(find_scene("riser_tensioner").read_text())["units"]["rope"]
-    unit = BlockTrainUnit("rope")
-    unit.values["reeving"] = json.dumps(scene["parameters"]["reeving"])
-    unit.values["effects"] = ",".join(scene["effects"])
-    for name, value in scene["parameters"].items():
-        if name != "reeving":
-            unit.values[name] = value
-    unit.values.update(values)
-    unit.configure()
-    return unit
-
-
 def test_the_block_trains_start_is_evaluated_by_its_quiet_steps_entry_alone(monkeypatch):
     # the start's summary and interface models come from the call that loads the quiet
     # step's entry point: no other compiled function is loaded for them
@@ -161,8 +148,7 @@ def test_the_block_trains_start_is_evaluated_by_its_quiet_steps_entry_alone(monk
 
     own = {"summary": recorded_calls(monkeypatch, block_train_kernel, "summary")}
     own["interface"] = recorded_calls(monkeypatch, kernel_interface, "port_linearisations")
-    unit = riser_rope(**{"mover_a.interface_model": True})
-    unit.initialize(0.0)
+    unit = scene_rope("riser_tensioner", **{"mover_a.interface_model": True})
     assert own == {"summary": [], "interface": []}
     # the same outputs, to the bit, as evaluated by those functions themselves
     unit.model.start_table = None

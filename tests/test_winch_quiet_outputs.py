@@ -21,7 +21,7 @@ from wire_fmu.core.units.winch.drive import FLAT_INPUTS
 from wire_fmu.core.units.winch.unit import WinchUnit
 from wire_fmu.core.units.winch.variables import winch_inputs, winch_outputs
 
-from .quiet_step_helpers import counted, general_way
+from .quiet_step_helpers import counted, general_way, step_both
 from .winch_helpers import BRAKE, make_unit, two_mass
 
 pytestmark = pytest.mark.skipif(not compiled.numba_available(), reason="numba is not installed")
@@ -36,18 +36,6 @@ def pair(effects: str, **params) -> tuple[WinchUnit, WinchUnit, list[bool]]:
     quiet = make_unit(effects, **params)
     general = general_way(make_unit(effects, **params))
     return quiet, general, counted(quiet)
-
-
-def step_both(quiet: WinchUnit, general: WinchUnit, inputs, steps: int, h: float) -> None:
-    """Step both units with ``inputs(t)`` set before each step; their outputs must agree
-    to the last bit after every step."""
-    for k in range(steps):
-        t = k * h
-        for unit in (quiet, general):
-            unit.values.update(inputs(t))
-            result = unit.advance(t, h)
-            assert result.success, result.message
-        assert quiet.values == general.values, f"outputs differ after the step from t = {t}"
 
 
 def lower_then_brake(t: float) -> dict[str, float]:
