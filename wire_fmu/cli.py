@@ -13,6 +13,7 @@
     wire-fmu report RESULTS_DIR [-o FILE]
                                     a run's results as one HTML page (run writes it too)
     wire-fmu build [-o DIR]         build our FMUs
+    wire-fmu cache [--prune]        what the compiled-code cache holds; prune other versions'
     wire-fmu study accuracy SCENE [--quick] [-o DIR]
                                     work-precision study: error against cost per configuration
     wire-fmu study effects SCENE [--quick] [-o DIR]
@@ -42,6 +43,7 @@ import threading
 from collections.abc import Sequence
 from pathlib import Path
 
+from wire_fmu.cli_cache import add_cache_parser
 from wire_fmu.cli_commands import (
     EXIT_BROKEN_PIPE,
     EXIT_INTERRUPTED,
@@ -259,6 +261,7 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")
     p.set_defaults(func=cmd_build)
+    add_cache_parser(sub)
     _study_parser(sub)
     add_info_parser(sub)
     return parser

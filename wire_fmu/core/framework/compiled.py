@@ -40,6 +40,7 @@ __all__ = [
     "KernelChoiceError",
     "KernelDecorators",
     "cache_directory",
+    "cache_folder_name",
     "cache_problem",
     "jit",
     "jit_inline",
@@ -217,6 +218,22 @@ def source_digest(py_file: str) -> str:
     return digest.hexdigest()[:16]
 
 
+def cache_folder_name(py_file: str, digest: str) -> str:
+    """The name of the folder that holds the compiled code of the kernel module ``py_file``
+    with the cache key ``digest`` (:func:`source_digest`): its package-relative path with
+    ``_`` for ``/``, then the key (``wire_fmu_core_units_winch_kernel-<16 hex digits>``).
+
+    Parameters
+    ----------
+    py_file : str
+        A kernel module's source file.
+    digest : str
+        Its cache key.
+    """
+    relative = _package_relative(py_file) or Path(py_file).name
+    return f"{relative.replace('/', '_').removesuffix('.py')}-{digest}"
+
+
 _DIGEST_ATTRIBUTE = "_wire_fmu_source_digest"
 """The attribute of a kernel function that carries ``(its file, source_digest(file))``."""
 
@@ -235,11 +252,9 @@ if _numba_caching is not None:
         def __init__(self, py_func: Callable[..., Any], py_file: str) -> None:
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
-            relative = _package_relative(py_file) or Path(py_file).name
             kept = getattr(py_func, _DIGEST_ATTRIBUTE, None)  # (file, digest) of its module's
             digest = kept[1] if kept is not None and kept[0] == py_file else source_digest(py_file)
-            folder = relative.replace("/", "_").removesuffix(".py")
-            self._cache_path = str(cache_directory() / f"{folder}-{digest}")
+            self._cache_path = str(cache_directory() / cache_folder_name(py_file, digest))
 
         def get_cache_path(self) -> str:
             return self._cache_path
