@@ -108,3 +108,13 @@ def test_a_folder_that_cannot_be_removed_is_named(cache, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "error: cannot remove" in out and "0123456789abcdef" in out
     assert "Permission denied" in out and "Traceback" not in out
+
+
+def test_a_cache_that_cannot_be_read_is_named(cache, monkeypatch, capsys):
+    def refuse(self):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr("pathlib.Path.iterdir", refuse)
+    assert main(["cache"]) == 1
+    out = capsys.readouterr().out
+    assert f"error: cannot read the cache {cache}: Permission denied" in out

@@ -43,10 +43,14 @@ def cmd_cache(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        Exit status: 0; 1 if a folder could not be removed (named).
+        Exit status: 0; 1 if the cache could not be read or a folder removed (named).
     """
     directory = cache_directory()
-    folders = cache_folders(directory)
+    try:
+        folders = cache_folders(directory)
+    except OSError as err:
+        _print(f"error: cannot read the cache {err.filename or directory}: {err.strerror or err}")
+        return 1
     current = [f for f in folders if f.current]
     others = [f for f in folders if not f.current]
     _print(f"compiled-code cache: {directory}")
