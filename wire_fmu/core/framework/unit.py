@@ -442,7 +442,7 @@ class HeldInputsUnit(Unit):
         self._update_outputs()
 
     _step_inputs: Any = None
-    """The inputs object of the step under way (see :meth:`advance`), else None."""
+    """The inputs object of the step under way (see :meth:`_advance_checked`), else None."""
 
     def _advance_checked(self, time: float, step: float) -> StepResult:
         """:meth:`Unit._advance_checked`, the inputs object built once for the step: the

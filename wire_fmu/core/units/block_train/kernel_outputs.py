@@ -220,8 +220,8 @@ def quiet_step_outputs(
         function before the first step); :data:`STEP` or :data:`RESUME`:
         :func:`.kernel.quiet_step` without or with ``resume``, its values the summary.
     k, t
-        With :data:`RESUME`: the interval ``t`` (s) lies in, as
-        :func:`.kernel.quiet_step` takes them; else unused.
+        With :data:`RESUME`: the interval the loop goes on in and the time (s) it goes
+        on from, as :func:`.kernel.quiet_step` takes them; else unused.
 
     Returns
     -------
