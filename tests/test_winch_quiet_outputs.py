@@ -17,7 +17,7 @@ import pytest
 
 from wire_fmu.core.framework import compiled
 from wire_fmu.core.units.winch import kernel
-from wire_fmu.core.units.winch.drive import FLAT_INPUTS
+from wire_fmu.core.units.winch.base import FLAT_INPUTS
 from wire_fmu.core.units.winch.unit import WinchUnit
 from wire_fmu.core.units.winch.variables import winch_inputs, winch_outputs
 

@@ -317,8 +317,8 @@ class CompiledBlockTrain:
     def _no_outputs(self) -> OutputPlan:
         """A plan of no outputs but the fixed ones (for the modes that write none): the
         same argument types as every plan."""
-        plan = getattr(self, "_plan_of_no_outputs", None)
-        if plan is None or plan.model is not self:
+        plan = getattr(self, "_plan_of_no_outputs", None)  # made at the first call
+        if plan is None:
             plan = self._plan_of_no_outputs = output_plan(self, [], [], [], ())
         return plan
 

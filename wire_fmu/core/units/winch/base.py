@@ -17,12 +17,29 @@ from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.interface_model import EffortModel, interface_input_names
 from wire_fmu.core.units.winch.brake import BandBrake
 
-__all__ = ["NO_ROPE_MODEL", "ROPE_MODEL_INPUTS", "WinchInputs", "WinchConfig", "WinchReport"]
+__all__ = [
+    "FLAT_INPUTS",
+    "NO_ROPE_MODEL",
+    "ROPE_MODEL_INPUTS",
+    "WinchConfig",
+    "WinchInputs",
+    "WinchReport",
+    "inputs_taken",
+]
 
 ROPE_MODEL_INPUTS = interface_input_names("rope")
 """The unit's inputs of the rope's interface model, in :class:`EffortModel`'s order."""
 NO_ROPE_MODEL = EffortModel()
 """The held tension: no interface model."""
+FLAT_INPUTS = (
+    "rope.tension",
+    "brake.lever_force",
+    "motor.command",
+    "drum.speed_command",
+    *ROPE_MODEL_INPUTS,
+)
+"""The unit's inputs, in the order :func:`inputs_taken` and the compiled quiet step
+(:meth:`~wire_fmu.core.units.winch.drive.WinchModel.quiet_step_outputs`) take them."""
 
 logger = logging.getLogger(__name__)
 
@@ -93,21 +110,28 @@ class WinchInputs:
             rope.reference_position,
             rope.reference_velocity,
         )
-        if all(map(math.isfinite, values)) and rope.stiffness >= 0.0 and rope.damping >= 0.0:
+        if inputs_taken(values):
             return []
-        names = (
-            "rope.tension",
-            "brake.lever_force",
-            "motor.command",
-            "drum.speed_command",
-            *ROPE_MODEL_INPUTS,
-        )
         out = [
             f"input {n!r} is not finite ({v})"
-            for n, v in zip(names, values, strict=True)
+            for n, v in zip(FLAT_INPUTS, values, strict=True)
             if not math.isfinite(v)
         ]
         return out + rope.problems("rope")
+
+
+def inputs_taken(values: tuple[float, ...]) -> bool:
+    """Whether the winch takes these inputs: all finite, the rope model's spring and damper
+    not negative.
+
+    Parameters
+    ----------
+    values : tuple of float
+        The values of :data:`FLAT_INPUTS`: tension (N), lever force (N), motor command
+        (N m), speed command (rad/s), then the rope model's K (N/m), D (N s/m), R (N/s),
+        reference payout (m) and rate (m/s).
+    """
+    return all(map(math.isfinite, values)) and values[4] >= 0.0 and values[5] >= 0.0
 
 
 @dataclass(frozen=True)

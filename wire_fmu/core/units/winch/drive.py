@@ -28,25 +28,17 @@ from wire_fmu.core.framework.step_limits import IntegrationError
 from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import (
     NO_ROPE_MODEL,
-    ROPE_MODEL_INPUTS,
     WinchConfig,
     WinchInputs,
     WinchReport,
     _WinchBase,
+    inputs_taken,
 )
 from wire_fmu.core.units.winch.drive_brake_modes import DrumBrakeModes
 from wire_fmu.core.units.winch.drive_snapshots import DriveSnapshots
 
-__all__ = ["FLAT_INPUTS", "WinchModel"]
+__all__ = ["WinchModel"]
 
-FLAT_INPUTS = (
-    "rope.tension",
-    "brake.lever_force",
-    "motor.command",
-    "drum.speed_command",
-    *ROPE_MODEL_INPUTS,
-)
-"""The unit's inputs :meth:`WinchModel.quiet_step_outputs` takes, in order."""
 _NO_ROPE_FIELDS = astuple(NO_ROPE_MODEL)
 
 
@@ -412,22 +404,9 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         """The step in one compiled call (:func:`kernel.quiet_step`); False if it is Python's."""
         solver = self.solver
         t1 = t + h
-        result = kernel.quiet_step(
-            solver.method,
-            t,
-            t1,
-            solver.internal_count(t, t1),
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            self.kernel_data(),
-            check_stick,
-            hold_angle,
-            0,
-            t,
-            False,
-            0.0,  # the ledger's start: only the brake torque and stored energy are read
-        )
+        count = solver.internal_count(t, t1)
+        # the ledger's start 0: only the brake torque and stored energy are read
+        result = self._kernel_quiet_step(t, t1, count, self.kernel_data(), hold_angle, check_stick)
         if result[0] == STATUS_PYTHON:
             return False
         if hold_angle:
@@ -457,7 +436,7 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         t, h : float
             Start and length of the step, s.
         flat : tuple of float
-            The inputs at ``t``, in the order of :data:`FLAT_INPUTS`.
+            The inputs at ``t``, in the order of :data:`~.base.FLAT_INPUTS`.
         initial_energy : float
             Stored energy at the start of the ledger, J.
 
@@ -467,9 +446,9 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
             The values of :data:`kernel.OUTPUTS`, in their units; None if the step was
             not taken.
         """
-        tension, lever_force, command, speed_command, stiffness, damping, rate, *reference = flat
-        if not (all(map(math.isfinite, flat)) and stiffness >= 0.0 and damping >= 0.0):
+        if not inputs_taken(flat):
             return None  # WinchInputs.problems names them
+        tension, lever_force, command, speed_command, stiffness, damping, rate, *reference = flat
         capacities = self._capacities_for(lever_force)
         kept = self._kept_brake_mode(capacities)
         if kept is None:
@@ -484,21 +463,8 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         held = kernel.held_array(self, command, tension, lever_force, capacities, rope)
         data = (kernel._modes(self), self.base_inertia, self.stiffness, self.damping, held)
         check_stick, hold_angle = kept
-        status, x, _, _, _, steps, rhs_calls, _, values, finite = kernel.quiet_step(
-            solver.method,
-            t,
-            t1,
-            count,
-            self.settings.event_time_tolerance,
-            self.state,
-            self._guard_dirs,
-            data,
-            check_stick,
-            hold_angle,
-            0,
-            t,
-            False,
-            initial_energy,
+        status, x, _, _, _, steps, rhs_calls, _, values, finite = self._kernel_quiet_step(
+            t, t1, count, data, hold_angle, check_stick, initial_energy
         )
         if status != STATUS_DONE or not finite:
             return None
@@ -515,6 +481,37 @@ class WinchModel(KernelModel, DrumBrakeModes, DriveSnapshots, _WinchBase):
         solver.steps += steps
         solver.rhs_calls += rhs_calls
         return values.tolist()
+
+    def _kernel_quiet_step(
+        self,
+        t: float,
+        t1: float,
+        count: int,
+        data: tuple,
+        hold_angle: bool,
+        check_stick: bool,
+        initial_energy: float = 0.0,
+    ) -> tuple:
+        """:func:`kernel.quiet_step` from the present state over ``[t, t1]`` (s) in
+        ``count`` internal steps, with the kernel ``data`` of the step's inputs, the
+        brake's mode kept as :meth:`_kept_brake_mode` says, the ledger from
+        ``initial_energy`` (J)."""
+        return kernel.quiet_step(
+            self.solver.method,
+            t,
+            t1,
+            count,
+            self.settings.event_time_tolerance,
+            self.state,
+            self._guard_dirs,
+            data,
+            check_stick,
+            hold_angle,
+            0,
+            t,
+            False,
+            initial_energy,
+        )
 
     # ---------------------------------------------------------- outputs
     def stored_energy(self, x: np.ndarray | None = None) -> float:

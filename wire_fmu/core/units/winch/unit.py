@@ -74,13 +74,14 @@ from wire_fmu.core.framework.unit import (
 )
 from wire_fmu.core.units.winch import kernel
 from wire_fmu.core.units.winch.base import (
+    FLAT_INPUTS,
     NO_ROPE_MODEL,
     ROPE_MODEL_INPUTS,
     WinchConfig,
     WinchInputs,
 )
 from wire_fmu.core.units.winch.brake import BandBrake
-from wire_fmu.core.units.winch.drive import FLAT_INPUTS, WinchModel
+from wire_fmu.core.units.winch.drive import WinchModel
 from wire_fmu.core.units.winch.kinetostatic import KinetostaticWinch
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS, build_winch, fastest_rate
 from wire_fmu.core.units.winch.variables import winch_inputs, winch_outputs, winch_parameters
