@@ -109,14 +109,14 @@ def test_a_report_that_is_not_finite_changes_nothing_and_is_refused_the_general_
     taken = counted(quiet)
     step_both(quiet, general, lambda t: {}, 5, 0.004)
     before = quiet.get_state()
-    computed = stepping.kernel.quiet_step
+    computed = stepping.kernel.quiet_step_outputs
 
     def spoiled(*args):
-        steps, x, values = computed(*args)
+        taken, x, values, _ = computed(*args)
         values[0] = math.nan
-        return steps, x, values
+        return taken, x, values, False
 
-    monkeypatch.setattr(stepping.kernel, "quiet_step", spoiled)
+    monkeypatch.setattr(stepping.kernel, "quiet_step_outputs", spoiled)
     for unit in (quiet, general):
         result = unit.advance(0.02, 0.004)
         assert not result.success and "non-finite" in result.message

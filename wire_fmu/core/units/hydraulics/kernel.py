@@ -22,8 +22,8 @@ What Python calls, all here: :func:`rhs` and :func:`guards` (the hybrid protocol
 the SciPy solvers and a monolithic model), :func:`limits_and_force` (at the start of a
 step), :func:`report` (the outputs), :func:`advance` (the entry point of
 :class:`~wire_fmu.core.framework.compiled_step.CompiledFixedStep`) and
-:func:`quiet_step`. Events, their words and the reasons of refused steps stay in
-Python.
+:func:`quiet_step_outputs` (a quiet step, :func:`quiet_step`, with the outputs it
+changes). Events, their words and the reasons of refused steps stay in Python.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from __future__ import annotations
 from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import advance_to_event
 from wire_fmu.core.units.hydraulics.kernel_arrays import (
+    QUIET_OUTPUTS,
     REPORT,
     kernel_data,
     kernel_layout,
@@ -44,11 +45,12 @@ from wire_fmu.core.units.hydraulics.kernel_hybrid import (
     report,
     rhs,
 )
-from wire_fmu.core.units.hydraulics.kernel_quiet_step import quiet_step
+from wire_fmu.core.units.hydraulics.kernel_quiet_step import quiet_step, quiet_step_outputs
 
 jit = kernel_decorators(__file__).jit
 
 __all__ = [
+    "QUIET_OUTPUTS",
     "REPORT",
     "advance",
     "guard_count",
@@ -59,6 +61,7 @@ __all__ = [
     "limits_and_force",
     "project",
     "quiet_step",
+    "quiet_step_outputs",
     "resume",
     "report",
     "rhs",

@@ -33,7 +33,7 @@ from wire_fmu.core.components.end_stops import EXTENDED, RETRACTED
 if TYPE_CHECKING:
     from wire_fmu.core.units.hydraulics.model import HydraulicsModel, Layout
 
-__all__ = ["REPORT", "kernel_data", "kernel_layout", "kernel_parameters"]
+__all__ = ["QUIET_OUTPUTS", "REPORT", "kernel_data", "kernel_layout", "kernel_parameters"]
 
 # ------------------------------------------------------------ parameters (fixed)
 P_SA = 0  # signed working area s A, m^2
@@ -108,6 +108,18 @@ REPORT = (
 )
 """What the kernel's ``report`` gives, in order (the keys of ``HydraulicsModel.report``)."""
 
+QUIET_OUTPUTS = (
+    *REPORT,
+    "displacement",
+    "stroke_used",
+    "dissipated_energy",
+    "external_work",
+    "energy_balance",
+)
+"""What ``kernel_quiet_step.quiet_step_outputs`` gives, in order: the report, then the
+rod's displacement since the start (m), the share of the stroke used (1), the energy
+dissipated (J), the work done on the rod (J) and the ledger's balance (J)."""
+
 
 def kernel_parameters(model: HydraulicsModel) -> np.ndarray:
     """The fixed parameters (``P_*``) of ``model``, built once.
@@ -170,7 +182,9 @@ def kernel_layout(model: HydraulicsModel, lay: Layout) -> np.ndarray:
     return out
 
 
-def kernel_data(model: HydraulicsModel, time: float | None = None) -> tuple:
+def kernel_data(
+    model: HydraulicsModel, time: float | None = None, layout: np.ndarray | None = None
+) -> tuple:
     """The tuple of arrays the kernel functions take, from ``model``'s present values.
 
     Parameters
@@ -179,6 +193,9 @@ def kernel_data(model: HydraulicsModel, time: float | None = None) -> tuple:
         The cylinder (see the module docstring).
     time : float or None
         Time the report and the limits are evaluated at, s; None: the model's ``time``.
+    layout : numpy.ndarray or None
+        The layout array (:func:`kernel_layout`) of the states given with the data; None:
+        the model's present one.
 
     Returns
     -------
@@ -209,7 +226,8 @@ def kernel_data(model: HydraulicsModel, time: float | None = None) -> tuple:
         interface.start,
         model.time if time is None else time,
     )
-    return model.kernel_parameters, model.kernel_layout, np.array(held, dtype=np.float64)
+    layout = model.kernel_layout if layout is None else layout
+    return model.kernel_parameters, layout, np.array(held, dtype=np.float64)
 
 
 _NO_STOPS = ((False, False), (False, False))

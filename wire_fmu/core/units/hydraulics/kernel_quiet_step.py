@@ -40,7 +40,16 @@ import numpy as np
 from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
 from wire_fmu.core.framework.fixed_step import ROS2
-from wire_fmu.core.units.hydraulics.kernel_arrays import REPORT
+from wire_fmu.core.units.hydraulics.kernel_arrays import (
+    H_FORCE,
+    H_REFERENCE_EXTENSION,
+    H_STIFFNESS,
+    L_DISSIPATED,
+    L_INTERFACE_WORK,
+    P_STROKE,
+    QUIET_OUTPUTS,
+    REPORT,
+)
 from wire_fmu.core.units.hydraulics.kernel_hybrid import (
     breaks_away,
     derivative_into,
@@ -60,7 +69,7 @@ from wire_fmu.core.units.hydraulics.kernel_physics import (
 
 jit = kernel_decorators(__file__).jit
 
-__all__ = ["quiet_step"]
+__all__ = ["quiet_step", "quiet_step_outputs"]
 
 _ROS2 = COMPILED_METHODS["ros2"]
 _GAMMA = ROS2.GAMMA
@@ -262,3 +271,66 @@ def quiet_step(method, t0, t1, n, x, directions, data):
     out = np.empty(len(REPORT))
     report_into(out, point, acc, link, c)
     return True, state.copy(), out
+
+
+@jit
+def quiet_step_outputs(
+    method, t0, t1, n, x, directions, data, external_work, initial_energy, initial_position
+):
+    """:func:`quiet_step` from the model's own state, with the rod's work and every output
+    a step without events changes (:data:`~.kernel_arrays.QUIET_OUTPUTS`).
+
+    With the interface model (``data``'s layout has its work state) the work state is
+    appended at 0 J, integrated with the rest and taken off again; the work through the
+    rod is then ``E0 (x1 - x0)``, the spring's exactly and the damper's and rate's as
+    integrated (``RefinedStepping._interface_work``), else ``E0 (x1 - x0)``: the
+    operations of the Python model, in its order.
+
+    Parameters
+    ----------
+    method, t0, t1, n, directions, data
+        As :func:`quiet_step` takes them.
+    x : numpy.ndarray
+        The model's own state at ``t0`` (not changed).
+    external_work : float
+        Work done on the rod since the start, before the step, J.
+    initial_energy : float
+        Stored energy at the start of the ledger, J.
+    initial_position : float
+        The rod's extension at the start, where its displacement is 0, m.
+
+    Returns
+    -------
+    tuple
+        ``(taken, state at t1, outputs, finite)``: ``outputs`` in the order of
+        ``QUIET_OUTPUTS``, ``finite`` whether all are; ``(False, x, empty, False)`` when
+        the step is not quiet (see :func:`quiet_step`).
+    """
+    parameters, layout, held = data
+    work = layout[L_INTERFACE_WORK]
+    start = x
+    if work >= 0:  # the interface model's work, J, starts at 0
+        start = np.zeros(x.size + 1)
+        start[: x.size] = x
+    taken, state, report = quiet_step(method, t0, t1, n, start, directions, data)
+    if not taken:
+        return False, x, report, False
+    x0, x1 = x[0], state[0]
+    if work >= 0:
+        varying = state[work]
+        state = state[:work].copy()
+        x_ref = held[H_REFERENCE_EXTENSION]
+        elastic = -0.5 * held[H_STIFFNESS] * (x1 - x0) * ((x1 - x_ref) + (x0 - x_ref))
+        external_work += held[H_FORCE] * (x1 - x0) + elastic + varying
+    else:
+        external_work += held[H_FORCE] * (x1 - x0)
+    size = len(REPORT)
+    out = np.empty(len(QUIET_OUTPUTS))
+    out[:size] = report
+    position, stored, dissipated = report[0], report[size - 1], state[layout[L_DISSIPATED]]
+    out[size] = position - initial_position
+    out[size + 1] = position / parameters[P_STROKE]
+    out[size + 2] = dissipated
+    out[size + 3] = external_work
+    out[size + 4] = stored - initial_energy + dissipated - external_work
+    return True, state, out, _finite(out)

@@ -164,10 +164,12 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
         )
         self.compiled = use_compiled("hydraulic cylinder")  # the kernel covers every effect set
         self.kernel_parameters = kernel.kernel_parameters(self)
-        self._kernel_layouts = {
-            lay: kernel.kernel_layout(self, lay) for lay in (self.own_layout, self.interface_layout)
-        }
-        self.kernel_layout = self._kernel_layouts[self.layout]
+        self.own_kernel_layout = kernel.kernel_layout(self, self.own_layout)
+        """The kernel's layout array of :attr:`own_layout`."""
+        self.interface_kernel_layout = kernel.kernel_layout(self, self.interface_layout)
+        """The kernel's layout array of :attr:`interface_layout`."""
+        self.kernel_layout = self.own_kernel_layout
+        """The kernel's layout array of :attr:`layout`."""
         self.step_report: tuple | None = None
         """``(state, load, report values)`` of the state a quiet step ended in, or None."""
         self.solver = self.kernel_solver(solver)
@@ -234,7 +236,8 @@ class HydraulicsModel(KernelModel, OilSide, ReferencePhysics, InitialState, Refi
             One of the model's two layouts.
         """
         self.layout = lay
-        self.kernel_layout = self._kernel_layouts[lay]
+        own = lay == self.own_layout
+        self.kernel_layout = self.own_kernel_layout if own else self.interface_kernel_layout
 
     # ------------------------------------------------ HybridSystem protocol
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:

@@ -72,6 +72,9 @@ CUSHION_CHUNK_STEPS = 8
 """In a cushion the step is re-chosen (and the Jacobian refreshed) every this many steps."""
 
 _FIXED_STEP = ("rk4", "ros2")
+_REPORTED = len(kernel.REPORT)
+"""How many of the quiet step's outputs are the model's report."""
+_EXTERNAL_WORK = kernel.QUIET_OUTPUTS.index("external_work")
 _NO_WORK = np.zeros(1)
 """The interface model's work at a step's start, J (read only: copied into the state)."""
 _NO_WORK.flags.writeable = False
@@ -81,7 +84,8 @@ class RefinedStepping:
     """Advance, settle and the refined integration of a cylinder model (a mixin).
 
     The model provides ``state``, ``force``, ``interface``, ``time``, ``initial_position``,
-    ``own_layout``, ``interface_layout``, ``use_layout``, ``load``, ``settings``,
+    ``own_layout``, ``interface_layout``, ``own_kernel_layout``, ``interface_kernel_layout``,
+    ``use_layout``, ``load``, ``settings``,
     ``solver``, ``stops``, ``seal``, ``mass``, ``spec``, ``compiled``, ``step_report``,
     ``kernel_data``, ``project``, ``_directions``, ``_limits_and_force``,
     ``_refuse_at_limit`` and ``_settle_friction``.
@@ -114,7 +118,8 @@ class RefinedStepping:
 
         The rod force is ``force`` held, or with ``interface`` the local model
         ``F(x, v, t)`` about ``t`` (:mod:`.interface`); its work is added to
-        :attr:`external_work`.
+        :attr:`external_work`. A step in which nothing happens is taken in one call of
+        the compiled kernel (:meth:`_quiet_step`), any other the general way.
 
         Parameters
         ----------
@@ -139,42 +144,50 @@ class RefinedStepping:
         HydraulicLimitError
             At a limit (the caller restores the state and refuses the step).
         """
-        return self._advance_held(t, h, force, interface, quiet_only=False) or 0
+        self._take_load(t, force, interface)
+        if self._quiet_step(t, t + h) is not None:
+            return 0
+        return self._integrate_step(t, t + h)
 
-    def quiet_advance(
-        self, t: float, h: float, force: float, interface: RodInterface = NO_INTERFACE
-    ) -> bool:
-        """:meth:`advance` when the step is quiet (:meth:`_quiet_step`); else nothing changes.
+    def quiet_step_outputs(
+        self, t: float, h: float, force: float, interface: RodInterface, initial_energy: float
+    ) -> list[float] | None:
+        """:meth:`advance` for a step in which nothing happens, with the outputs it changes,
+        in one compiled call; None (nothing changed) for any other step.
 
-        A quiet step whose report is not finite counts as not quiet: the general way
-        then refuses it with the reason.
+        A step whose outputs are not all finite counts as not quiet: the general way then
+        refuses it with the reason.
 
         Parameters
         ----------
         t, h, force, interface
-            As :meth:`advance` takes them.
+            As :meth:`advance` takes them (``interface`` active only if it is, its
+            ``start`` ``t``).
+        initial_energy : float
+            Stored energy at the start of the ledger, J.
 
         Returns
         -------
-        bool
-            Whether the step was taken (then with no events).
+        list of float or None
+            The values of :data:`kernel.QUIET_OUTPUTS
+            <wire_fmu.core.units.hydraulics.kernel_arrays.QUIET_OUTPUTS>`; None if the
+            step was not taken.
         """
-        kept = self.load, self.state, self.step_report, self.external_work, self.last_events
+        load = self.load
         held_position = None if self.seal is None else self.seal.held_position
-        taken = self._advance_held(t, h, force, interface, quiet_only=True) is not None
-        if taken and all(map(math.isfinite, self.step_report[2])):
-            return True
-        (self.force, self.interface, self.time), self.state, self.step_report = kept[:3]
-        self.external_work, self.last_events = kept[3:]
-        if self.seal is not None:
-            self.seal.held_position = held_position
-        return False
+        self.force, self.interface, self.time = force, interface, t
+        outputs = self._quiet_step(t, t + h, initial_energy, finite_only=True)
+        if outputs is None:
+            self.force, self.interface, self.time = load
+            if self.seal is not None:
+                self.seal.held_position = held_position
+            return None
+        self.last_events = []
+        self.first_event_time = math.inf
+        return outputs
 
-    def _advance_held(
-        self, t: float, h: float, force: float, interface: RodInterface, quiet_only: bool
-    ) -> int | None:
-        """:meth:`advance`; with ``quiet_only``, None (having changed the state, the load
-        and the seal's held position) when the step is not quiet."""
+    def _take_load(self, t: float, force: float, interface: RodInterface) -> None:
+        """The rod force and its interface model for the step from ``t`` (s); no events yet."""
         self.last_events = []
         self.first_event_time = math.inf
         self.force = float(force)
@@ -185,34 +198,28 @@ class RefinedStepping:
         self.interface = interface
         self.time = t
         self.step_report = None
+
+    def _integrate_step(self, t: float, t_end: float) -> int:
+        """The general way of :meth:`advance` from ``t`` to ``t_end`` (s), the load taken:
+        limits, settling, the refined integration and the rod's work; the events."""
         start = float(self.state[0])
         if not self.interface.active:
-            events = self._step(t, t + h, quiet_only)
-            if events is not None:
-                self.external_work += self.force * (float(self.state[0]) - start)
+            events = self._step(t, t_end)
+            self.external_work += self.force * (float(self.state[0]) - start)
             return events
         self.state = np.concatenate((self.state, _NO_WORK))  # the interface model's work, J
         self.use_layout(self.interface_layout)
         try:
-            events = self._step(t, t + h, quiet_only)
+            events = self._step(t, t_end)
         finally:
             self.use_layout(self.own_layout)
             self.state, varying = self.state[:-1], float(self.state[-1])
-        if events is None:
-            return None
-        if self.step_report is not None:  # the report does not depend on the work state
-            self.step_report = (self.state, *self.step_report[1:])
         self.external_work += self._interface_work(start, float(self.state[0]), varying)
         return events
 
-    def _step(self, t: float, t_end: float, quiet_only: bool = False) -> int | None:
-        """Integrate from ``t`` to ``t_end`` (s) in the present layout; the events located
-        (None if ``quiet_only`` and the step is not quiet: nothing integrated)."""
+    def _step(self, t: float, t_end: float) -> int:
+        """Integrate from ``t`` to ``t_end`` (s) in the present layout; the events located."""
         try:
-            if self._quiet_step(t, t_end):
-                return 0
-            if quiet_only:
-                return None
             violated, rod_force = self._limits_and_force(self.state, t)
             self._refuse_at_limit(violated, t, self.state)
             self.state = self.settle(self.state, rod_force)
@@ -231,50 +238,79 @@ class RefinedStepping:
         return self.force * (x1 - x0) + self.interface.elastic_work(x0, x1, x_ref) + varying
 
     def _preload_quiet_step(self) -> None:
-        """Load :func:`kernel.quiet_step` and the loop after an event (:func:`kernel.advance`,
-        :meth:`preload_kernel`) from the compiled-code cache now, by calls that take no
-        step, so that neither the first step nor the first event pays for it."""
+        """Load :func:`kernel.quiet_step_outputs` and the loop after an event
+        (:func:`kernel.advance`, :meth:`preload_kernel`) from the compiled-code cache now,
+        by calls that take no step, so that neither the first step nor the first event
+        pays for it."""
         method = COMPILED_METHODS.get(self.settings.method) if self.compiled else None
         if method is not None:
             t = self.time
-            kernel.quiet_step(method, t, t, 0, self.state, self._directions, self.kernel_data())
+            kernel.quiet_step_outputs(
+                method,
+                t,
+                t,
+                0,
+                self.state,
+                self._directions,
+                self.kernel_data(),
+                self.external_work,
+                0.0,
+                self.initial_position,
+            )
             self.preload_kernel(t)
 
-    def _quiet_step(self, t: float, t_end: float) -> bool:
+    def _quiet_step(
+        self, t: float, t_end: float, initial_energy: float = 0.0, finite_only: bool = False
+    ) -> list[float] | None:
         """Take a step in which nothing happens in one call of the compiled kernel.
 
         Nothing happens when no limit is reached, the seal keeps its mode, no guard
         fires and the step needs no refinement. The kernel then does what
-        :meth:`advance` would (limits, settle, :class:`CompiledFixedStep` on its grid)
-        and reports the end state (kept in :attr:`step_report` for the outputs). If
-        anything happens, it returns False and leaves the state alone: the step is
-        then taken the general way, from the start.
+        :meth:`advance` would (limits, settle, :class:`CompiledFixedStep` on its grid,
+        the rod's work) from the load taken, and reports the end state (kept in
+        :attr:`step_report` for the outputs). If anything happens (or, with
+        ``finite_only``, an output is not finite), it answers None and leaves the state
+        alone, but for the seal's held position: the step is then taken the general way,
+        from the start.
+
+        Returns
+        -------
+        list of float or None
+            The values of ``kernel.QUIET_OUTPUTS`` (the ledger's balance from
+            ``initial_energy``, J), or None.
         """
         settings = self.settings
         method = COMPILED_METHODS.get(settings.method) if self.compiled else None
         if method is None or t >= t_end - settings.event_time_tolerance:
-            return False
+            return None
         if self.stops is not None and self._resolution(t, self.state) != "coarse":
-            return False
+            return None
         try:
             count = internal_step_count(t, t_end, settings.max_step)  # CompiledFixedStep's grid
         except IntegrationError:
-            return False
+            return None
         if self.seal is not None:
             self.seal.held_position = float(self.state[0])  # as settling would
-        taken, x, values = kernel.quiet_step(
+        active = self.interface.active  # the kernel appends the interface model's work state
+        layout = self.interface_kernel_layout if active else self.own_kernel_layout
+        taken, x, values, finite = kernel.quiet_step_outputs(
             method,
             t,
             t_end,
             count,
             self.state,
             self._directions,
-            self.kernel_data(),
+            kernel.kernel_data(self, layout=layout),
+            self.external_work,
+            initial_energy,
+            self.initial_position,
         )
-        if taken:
-            self.state = x
-            self.step_report = (x, (self.force, self.interface, t_end), values.tolist())
-        return taken
+        if not taken or (finite_only and not finite):
+            return None
+        outputs = values.tolist()
+        self.state, self.time, self.external_work = x, t_end, outputs[_EXTERNAL_WORK]
+        self.step_report = (x, self.load, outputs[:_REPORTED])
+        return outputs
 
     def settle(self, x: np.ndarray, force: float | None = None) -> np.ndarray:
         """Seal mode consistent with the rod force now (it may have jumped); the new state.

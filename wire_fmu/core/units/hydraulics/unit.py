@@ -113,6 +113,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Mapping
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -128,7 +129,7 @@ from wire_fmu.core.units.hydraulics.interface import (
     NO_INTERFACE,
     RodInterface,
 )
-from wire_fmu.core.units.hydraulics.kernel import REPORT
+from wire_fmu.core.units.hydraulics.kernel import QUIET_OUTPUTS, REPORT
 from wire_fmu.core.units.hydraulics.model import (
     HYDRAULICS_EFFECTS,
     AccumulatorSpec,
@@ -160,8 +161,26 @@ _OUTPUT_OF = {  # the model's report quantity: the output that shows it
     "friction_force": "seal.friction_force",
     "stored_energy": "stored_energy",
 }
+_QUIET_OUTPUT_OF = {  # the kernel's quiet step's other quantities: their outputs
+    "displacement": "rod.displacement",
+    "stroke_used": "stroke_used",
+    "dissipated_energy": "dissipated_energy",
+    "external_work": "external_work",
+    "energy_balance": "energy_balance",
+}
 _REPORTED_OUTPUTS = tuple(_OUTPUT_OF[name] for name in REPORT)
 """The outputs that show the model's report, in the order of its values."""
+_QUIET_OUTPUTS = tuple(_OUTPUT_OF.get(name) or _QUIET_OUTPUT_OF[name] for name in QUIET_OUTPUTS)
+"""The outputs a quiet step writes, in the order of its values: every one but the modes'
+(``seal.stuck``, ``end_stop.contact``, ``mode_changes``), which such a step keeps."""
+_read_flat_inputs = itemgetter("rod.force", *INTERFACE_INPUTS)
+
+
+def _inputs_taken(flat: tuple[float, ...]) -> bool:
+    """Whether the cylinder can step with ``flat`` (the rod force, then the interface
+    model's inputs): all finite, the spring and the damper not negative
+    (:meth:`HydraulicsUnit._input_problems` names what is not)."""
+    return all(map(math.isfinite, flat)) and flat[1] >= 0.0 and flat[2] >= 0.0
 
 
 class HydraulicsUnit(Unit):
@@ -312,9 +331,9 @@ class HydraulicsUnit(Unit):
         return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + interface.problems("rod")
 
     def _take_quiet_step(self, time: float, step: float) -> bool:
-        """A step in which nothing happens in one call of the compiled kernel, without the
-        undo snapshot (:meth:`HydraulicsModel.quiet_advance
-        <wire_fmu.core.units.hydraulics.stepping.RefinedStepping.quiet_advance>`).
+        """A step in which nothing happens, outputs included, in one compiled call
+        (:meth:`HydraulicsModel.quiet_step_outputs
+        <wire_fmu.core.units.hydraulics.stepping.RefinedStepping.quiet_step_outputs>`).
 
         Implements :meth:`Unit._take_quiet_step`: inputs the cylinder cannot take, and
         steps that are not quiet, go the general way, which names why.
@@ -322,13 +341,19 @@ class HydraulicsUnit(Unit):
         model = self.model
         if model is None or not model.compiled:
             return False
-        interface = self.rod_interface(time)
-        if self._input_problems(interface):
+        flat = tuple(map(float, _read_flat_inputs(self.values)))
+        if not _inputs_taken(flat):
             return False
-        if not model.quiet_advance(time, step, float(self.values["rod.force"]), interface):
+        force, stiffness, damping, rate, *reference = flat
+        if stiffness != 0.0 or damping != 0.0 or rate != 0.0:
+            interface = RodInterface(stiffness, damping, rate, *reference, start=float(time))
+        else:
+            interface = NO_INTERFACE
+        outputs = model.quiet_step_outputs(time, step, force, interface, self.initial_energy)
+        if outputs is None:
             return False
+        self.values.update(zip(_QUIET_OUTPUTS, outputs))  # noqa: B905 - as many by construction
         self.time = time + step
-        self._update_outputs()  # finite: a quiet step's report is
         return True
 
     def rod_interface(self, start: float) -> RodInterface:
