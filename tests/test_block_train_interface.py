@@ -55,7 +55,9 @@ def unstretched_length(unit, rate: float) -> float:
     """``l`` from the tension ``T = (EA (L - l) + c dL/dt) / l`` and the geometric length."""
     model = unit.model
     rope = model.rope
-    y = np.concatenate((model.q[: len(model.blocks)], model._mover_y0 + model._mover_v * 1e-4))
+    held = model.held_parts()
+    moved = held.mover_positions + held.mover_velocities * 1e-4
+    y = np.concatenate((model.q[: len(model.blocks)], moved))
     big_l = float(model.span_lengths(y)[0].sum())
     tension = unit.values["path_end.tension"]
     return (rope.axial_stiffness * big_l + rope.damping * rate) / (tension + rope.axial_stiffness)

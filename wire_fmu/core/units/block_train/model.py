@@ -40,6 +40,7 @@ import operator
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -62,7 +63,7 @@ from wire_fmu.core.units.block_train.path import ReevedPath
 from wire_fmu.core.units.block_train.reeving import LINE_PORTS, MOVER_PORTS, Reeving
 from wire_fmu.core.units.block_train.start import StartingState
 
-__all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS", "FLAT_INPUTS"]
+__all__ = ["BlockTrainModel", "BlockTrainInputs", "BLOCK_TRAIN_EFFECTS", "FLAT_INPUTS", "HeldParts"]
 
 _INERTIA = ("sheave_inertia",)
 _EFFECTS = (  # name, the model without it, with it, the effects it needs
@@ -77,6 +78,23 @@ BLOCK_TRAIN_EFFECTS = EffectCatalogue(
     "block train",
     tuple(Effect(name, off, on, requires=needs) for name, off, on, needs in _EFFECTS),
 )
+
+
+class HeldParts(NamedTuple):
+    """The held inputs' vector in its parts (:meth:`BlockTrainModel.held_parts`)."""
+
+    line_positions: np.ndarray
+    """The line ports' rope positions at the step's start, m."""
+    line_rates: np.ndarray
+    """Their rates, m/s."""
+    mover_positions: np.ndarray
+    """The driven bodies' positions at the step's start, m."""
+    mover_velocities: np.ndarray
+    """Their velocities, m/s."""
+    line_accelerations: np.ndarray
+    """The line rates' slopes over the step (ramped flows; else 0), m/s^2."""
+    mover_accelerations: np.ndarray
+    """The driven bodies' accelerations over the step (ramped flows; else 0), m/s^2."""
 
 
 @dataclass
@@ -336,13 +354,19 @@ class BlockTrainModel(
         self._step_summary = None
         self.start_table: tuple | None = None  # (t, x, rows, table) of evaluate_start
         self.held_vector = vector
-        nl, nd = len(LINE_PORTS), len(self.driver_ports)
+
+    def held_parts(self) -> HeldParts:
+        """The held inputs' vector (:attr:`held_vector`) in its parts (views of it)."""
+        nl, nd, vector = len(LINE_PORTS), len(self.driver_ports), self.held_vector
         lines, movers, ramps = 1 + nl, 1 + 2 * nl, 1 + 2 * nl + 2 * nd
-        self._line_s0, self._line_rate = vector[1:lines], vector[lines:movers]
-        self._mover_y0 = vector[movers : movers + nd]
-        self._mover_v = vector[movers + nd : ramps]
-        self._line_acc = vector[ramps : ramps + nl]
-        self._mover_acc = vector[ramps + nl :]
+        return HeldParts(
+            vector[1:lines],
+            vector[lines:movers],
+            vector[movers : movers + nd],
+            vector[movers + nd : ramps],
+            vector[ramps : ramps + nl],
+            vector[ramps + nl :],
+        )
 
     def held_motion(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The held inputs' motion at ``t``: line rope positions and rates, driven bodies'
@@ -354,10 +378,11 @@ class BlockTrainModel(
             Time, s.
         """
         dt = t - self._t_step
-        line_rate = self._line_rate + self._line_acc * dt
-        mover_v = self._mover_v + self._mover_acc * dt
-        line_s = self._line_s0 + (self._line_rate + 0.5 * self._line_acc * dt) * dt
-        mover_y = self._mover_y0 + (self._mover_v + 0.5 * self._mover_acc * dt) * dt
+        line_s0, line_rate0, mover_y0, mover_v0, line_acc, mover_acc = self.held_parts()
+        line_rate = line_rate0 + line_acc * dt
+        mover_v = mover_v0 + mover_acc * dt
+        line_s = line_s0 + (line_rate0 + 0.5 * line_acc * dt) * dt
+        mover_y = mover_y0 + (mover_v0 + 0.5 * mover_acc * dt) * dt
         return line_s, line_rate, mover_y, mover_v
 
     @contextmanager

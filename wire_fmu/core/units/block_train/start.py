@@ -55,13 +55,14 @@ class StartingState:
         self.state = np.zeros(2 * self.n_coords + 2)
         self.broken = [False] * len(self.spans)
         nb = len(self.blocks)
-        y = np.concatenate((np.zeros(nb), self._mover_y0))
+        held = self.held_parts()
+        y = np.concatenate((np.zeros(nb), held.mover_positions))
         big_l, dl_dy = self.span_lengths(y)
         tension = pretension
         if equilibrium and self.blocks:
             tension = self._equilibrium_tension(dl_dy)
         ea = self.rope.axial_stiffness
-        flow = np.concatenate((self.q, self._line_s0))
+        flow = np.concatenate((self.q, held.line_positions))
         self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
         self.taut_mask = np.full(len(self.spans), tension > 0.0)
         self.contact_mask = np.array(
