@@ -96,10 +96,31 @@ def test_inputs_the_cylinder_cannot_take_are_refused_the_general_way():
     result = quiet.advance(0.0, 0.004)
     assert not result.success and "rod.stiffness" in result.message
     quiet.values["rod.stiffness"] = 0.0
+    quiet.values["rod.damping"] = -2.0
+    result = quiet.advance(0.0, 0.004)
+    assert not result.success and "rod.damping" in result.message
+    quiet.values["rod.damping"] = 0.0
     quiet.values["rod.force"] = math.nan
     result = quiet.advance(0.0, 0.004)
     assert not result.success and "rod.force" in result.message
-    assert taken == [False, False]
+    quiet.values["rod.force"] = F_EQ
+    quiet.values["rod.reference_velocity"] = math.inf
+    result = quiet.advance(0.0, 0.004)
+    assert not result.success and "rod.reference_velocity" in result.message
+    assert taken == [False] * 4
+    quiet.values["rod.reference_velocity"] = 0.0
+    assert quiet.advance(0.0, 0.004).success and taken[-1]
+
+
+def test_one_compiled_specialisation_serves_the_quiet_and_the_general_way():
+    # the unit's quiet step and the general way's first attempt call the same entry point
+    # with arguments of the same types, so a run loads one specialisation from the cache
+    quiet, general = both(lambda: make_unit(ALL_EFFECTS, force=F_EQ, **quiet_cylinder()))
+    taken = counted(quiet)
+    for interface in (False, True):
+        step_both(quiet, general, swaying(F_EQ, interface), 20, 0.004)
+    assert any(taken)
+    assert len(stepping.kernel.quiet_step_outputs.signatures) == 1
 
 
 def test_a_report_that_is_not_finite_changes_nothing_and_is_refused_the_general_way(
