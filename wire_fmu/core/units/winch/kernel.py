@@ -266,17 +266,20 @@ def _dynamics(t: float, x: np.ndarray, data):
     forces[0] += held[0] - held[1] * x[n]
     w = x[2 * n - 1]
     forces[n - 1] += rope_tension(t, x, data) * held[4] - 0.5 * held[6] * w * w
-    masses = inertia.copy()
-    masses[n - 1] += held[5] + held[6] * x[n - 1]
+    drum_mass = inertia[n - 1] + (held[5] + held[6] * x[n - 1])  # with the rope on it
     brake = 0.0
     engaged, mode = modes[1] == 1, modes[2]
     if engaged and mode != 0:
         brake = -mode * (held[7] if mode > 0 else held[8])
         forces[n - 1] += brake
-    acc = forces / masses
+    drum_torque = forces[n - 1]
+    acc = forces  # divided in place: one array made per call, not three
+    for i in range(n - 1):
+        acc[i] = forces[i] / inertia[i]
+    acc[n - 1] = drum_torque / drum_mass
     if engaged and mode == 0:
         acc[n - 1] = 0.0
-        brake = -forces[n - 1]
+        brake = -drum_torque
     return acc, brake
 
 
