@@ -74,12 +74,13 @@ def test_a_kernel_load_while_counting_is_left_out():
 
 def test_per_step_figures_divide_by_steps_and_units():
     row = bench_instructions.SceneInstructions(
-        "riser_tensioner", 2, 100, 3_000_000, in_fmi_calls=2_400_000
+        "riser_tensioner", 2, 100, 3_000_000, in_fmi_calls=2_400_000, arrays_made=12_500
     )
     assert row.per_step == 30_000 and row.per_unit_step == 15_000
     assert row.master_per_unit_step == 3_000  # (3e6 - 2.4e6) / (100 steps x 2 units)
+    assert row.arrays_per_step == 125
     table = bench_instructions.table([row])
-    assert "| riser_tensioner | 2 | 100 | 30,000 | 15,000 | 3,000 | 0 |" in table
+    assert "| riser_tensioner | 2 | 100 | 30,000 | 15,000 | 3,000 | 125 | 0 |" in table
     assert "where the instructions ran" not in table  # no libraries read: no second table
 
 
@@ -132,6 +133,8 @@ def test_the_count_is_the_same_in_two_runs():
     assert first.instructions > 10_000 * first.steps  # a step runs the units, not nothing
     # most of a step runs inside the units' FMI calls, some of it in the master
     assert 0.5 * first.instructions < first.in_fmi_calls < first.instructions
+    # the kernels make arrays (numba's allocator is found by name), and as many each run
+    assert first.arrays_made == second.arrays_made > first.steps
     # to the instruction with the address space fixed (setarch); else objects' addresses,
     # and the hashes made from them, may move from run to run
     allowed = 0 if shutil.which("setarch") else 5e-3 * first.instructions

@@ -38,13 +38,29 @@ ob=(3) ???
 fl=(3) ???
 fn=(3) 0x0000000012345678
 0 40
+cob=(4) /site-packages/numba/core/runtime/_nrt_python.so
+cfi=(4) nrt.cpp
+cfn=(4) NRT_MemInfo_alloc_aligned
+calls=7 0
+* 14
+cfn=(2)
+calls=2 20
+* 0
+cfn=(4)
+calls=5 0
+* 10
+
+ob=(4)
+fl=(4)
+fn=(4)
+0 24
 
 ob=(1)
 fl=(1)
 fn=(1)
 12 25
 
-totals: 250
+totals: 274
 """
 
 
@@ -61,8 +77,9 @@ def test_each_object_gets_its_own_lines_and_not_the_calls_it_makes(dump):
         "/usr/lib/libpython3.11.so.1.0": 100 + 50 + 5 + 25,  # the call's 30 is malloc's
         "/usr/lib/x86_64-linux-gnu/libc.so.6": 30,
         "???": 40,
+        "/site-packages/numba/core/runtime/_nrt_python.so": 24,
     }
-    assert sum(by_object.values()) == callgrind_file.callgrind_total(dump) == 250
+    assert sum(by_object.values()) == callgrind_file.callgrind_total(dump) == 274
 
 
 def test_libraries_are_grouped_most_first(dump):
@@ -70,7 +87,16 @@ def test_libraries_are_grouped_most_first(dump):
         "the Python interpreter": 180,
         "the compiled kernels (numba's machine code)": 40,
         "the C library (malloc, free, memset, memcpy)": 30,
+        "numba's runtime and dispatch": 24,
     }
+
+
+def test_calls_into_a_function_are_counted_by_its_name_given_once(dump):
+    # numba's allocator called 7 and then 5 times (named by id the second time); the
+    # calls of malloc in between are not its
+    assert callgrind_file.calls_to(dump, "NRT_MemInfo_alloc") == 12
+    assert callgrind_file.calls_to(dump, "malloc") == 3 + 2
+    assert callgrind_file.calls_to(dump, "free") == 0
 
 
 @pytest.mark.parametrize(

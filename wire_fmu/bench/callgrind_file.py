@@ -14,7 +14,9 @@ is read here:
   the cost line after it is the call's inclusive cost: counted again in the callee's
   own lines, so skipped in the exclusive costs, and summed by
   :func:`instructions_called_into`;
-* ``totals:`` (or ``summary:``) is the file's total.
+* ``totals:`` (or ``summary:``) is the file's total;
+* ``calls=`` starts with the number of calls (:func:`calls_to` sums them for the
+  functions ``cfn=`` names, whose ``(id)`` names ``fn=`` lines share).
 
 The exclusive costs of all functions add up to the total, which the test of this
 module checks.
@@ -28,6 +30,7 @@ from pathlib import Path
 
 __all__ = [
     "callgrind_total",
+    "calls_to",
     "FMU_BINARIES",
     "instructions_called_into",
     "instructions_by_library",
@@ -118,6 +121,32 @@ def instructions_called_into(path: Path, marks: tuple[str, ...]) -> int:
         for (caller, callee), count in _costs(path)[1].items()
         if inside(callee) and not inside(caller)
     )
+
+
+def calls_to(path: Path, prefix: str) -> int:
+    """How many calls the file counts into the functions whose names start with ``prefix``
+    (``calls=`` lines under a ``cfn=`` of such a name).
+
+    Parameters
+    ----------
+    path : Path
+        A callgrind output file.
+    prefix : str
+        The start of the called functions' names, e.g. ``"NRT_MemInfo_alloc"`` (numba's
+        allocator: one call per array a compiled function makes).
+    """
+    names: dict[tuple[str, str], str] = {}
+    called = ""
+    total = 0
+    with path.open(errors="replace") as lines:
+        for line in lines:
+            if line.startswith("cfn="):
+                called = _name(names, "fn", line[4:].strip())
+            elif line.startswith("fn="):
+                _name(names, "fn", line[3:].strip())  # defines a name cfn= may refer to
+            elif line.startswith("calls=") and called.startswith(prefix):
+                total += int(line[6:].split()[0])
+    return total
 
 
 def _costs(path: Path) -> tuple[Counter[str], Counter[tuple[str, str]]]:

@@ -64,6 +64,7 @@ from .callgrind_file import (
     LIBRARIES,
     OTHER,
     callgrind_total,
+    calls_to,
     instructions_by_library,
     instructions_called_into,
 )
@@ -82,6 +83,9 @@ logger = logging.getLogger(__name__)
 
 MODULE = "wire_fmu.bench.instructions"
 """This module's name, as ``python -m`` runs it under valgrind."""
+
+ALLOCATOR = "NRT_MemInfo_alloc"
+"""The start of the names of numba's runtime functions that make an array's memory."""
 
 HASH_SEED = "0"
 """``PYTHONHASHSEED`` of the counted process: the same sets and dicts in every run."""
@@ -109,6 +113,10 @@ class SceneInstructions:
         Of :attr:`instructions`, those run inside the FMU binaries' FMI functions
         (everything a unit's ``fmi2DoStep``, ``fmi2SetReal``, ... ran: its facade, its
         Python, its kernels); the rest is the master's own, the ctypes crossing included.
+    arrays_made : int
+        Arrays the compiled kernels made in them (calls of numba's allocator,
+        :data:`ALLOCATOR`): each costs a ``malloc``, a ``free`` and numba's bookkeeping,
+        a few hundred instructions.
     """
 
     scene: str
@@ -118,6 +126,7 @@ class SceneInstructions:
     kernel_loads: int = 0
     by_library: dict[str, int] = field(default_factory=dict)
     in_fmi_calls: int = 0
+    arrays_made: int = 0
 
     @property
     def per_step(self) -> float:
@@ -128,6 +137,11 @@ class SceneInstructions:
     def per_unit_step(self) -> float:
         """Instructions per unit and macro step."""
         return self.per_step / max(1, self.units)
+
+    @property
+    def arrays_per_step(self) -> float:
+        """Arrays the compiled kernels made per macro step."""
+        return self.arrays_made / max(1, self.steps)
 
     @property
     def master_per_unit_step(self) -> float:
@@ -222,6 +236,7 @@ def measure(
                 row["loads"],
                 instructions_by_library(dump),
                 instructions_called_into(dump, FMU_BINARIES),
+                calls_to(dump, ALLOCATOR),
             )
             for row, dump in zip(rows, dumps, strict=True)
         ]
@@ -266,10 +281,11 @@ def table(rows: list[SceneInstructions]) -> str:
     """
     counts = markdown_table(
         "scene | units | macro steps counted | instructions per step | per unit and step"
-        " | of which the master's own | kernel loads left out",
+        " | of which the master's own | arrays the kernels made per step"
+        " | kernel loads left out",
         (
             f"{r.scene} | {r.units} | {r.steps} | {r.per_step:,.0f} | {r.per_unit_step:,.0f}"
-            f" | {r.master_per_unit_step:,.0f} | {r.kernel_loads}"
+            f" | {r.master_per_unit_step:,.0f} | {r.arrays_per_step:,.0f} | {r.kernel_loads}"
             for r in rows
         ),
     )

@@ -161,8 +161,8 @@ class RefinedStepping:
         Parameters
         ----------
         t, h, force, interface
-            As :meth:`advance` takes them (``interface`` active only if it is, its
-            ``start`` ``t``).
+            As :meth:`advance` takes them, but ``interface`` as :meth:`advance` would hold
+            it: :data:`~.interface.NO_INTERFACE` unless it is active, and then about ``t``.
         initial_energy : float
             Stored energy at the start of the ledger, J.
 
