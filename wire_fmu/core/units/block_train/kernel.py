@@ -68,7 +68,7 @@ from wire_fmu.core.framework import bordered_band
 from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_structured
 from wire_fmu.core.units.block_train.kernel_friction import (
-    accelerations,
+    accelerations_into,
     capacities,
     friction_data,
     link_guards,
@@ -415,17 +415,15 @@ def _rhs_of(result, x: np.ndarray, data):
     masses = data[2]
     forces, loss, power = result[0], result[11], result[12]
     out = np.empty_like(x)
-    link_force = np.zeros(0)
     for i in range(n):
         out[i] = x[n + i]
     if data[17].shape[0] == 0:
+        link_force = out[:0]  # no links, no forces: a view, nothing made
         for i in range(n):
             out[n + i] = forces[i] / masses[i]
     else:
         caps = capacities(result[1], data)
-        acc, link_force = accelerations(forces, caps, masses, data)
-        for i in range(n):
-            out[n + i] = acc[i]
+        link_force = accelerations_into(out[n : 2 * n], forces, caps, masses, data)
         for i in data[24]:
             out[i] = 0.0
         loss = loss + loss_power(x, n, link_force, data)
@@ -468,7 +466,8 @@ def _guards_of(result, x: np.ndarray, data) -> np.ndarray:
     out = np.empty(n_links + 2 * n_spans + nb)
     if n_links:
         caps = capacities(tension, data)
-        link_force = accelerations(result[0], caps, masses, data)[1]
+        scratch = np.empty(data[0][0])  # the accelerations, not needed here
+        link_force = accelerations_into(scratch, result[0], caps, masses, data)
         link_guards(x, data[0][0], link_force, caps, out, data)
     for i in range(n_spans):
         if broken[i]:

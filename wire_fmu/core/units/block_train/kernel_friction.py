@@ -38,7 +38,7 @@ from wire_fmu.core.framework.compiled import kernel_decorators
 jit = kernel_decorators(__file__).jit
 
 __all__ = [
-    "accelerations",
+    "accelerations_into",
     "capacities",
     "friction_data",
     "link_guards",
@@ -91,11 +91,16 @@ def capacities(tension: np.ndarray, data) -> np.ndarray:
 
 
 @jit
-def accelerations(forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data):
-    """Accelerations (m/s^2) and link forces (N) in the present modes.
+def accelerations_into(
+    acc: np.ndarray, forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data
+) -> np.ndarray:
+    """Accelerations (m/s^2) into ``acc``, and the link forces (N), in the present modes.
 
     Parameters
     ----------
+    acc : numpy.ndarray
+        Where the acceleration of each coordinate goes (a coordinate's row of the state
+        derivative, or scratch), m/s^2.
     forces : numpy.ndarray
         All forces on the coordinates but the links' friction, N.
     caps : numpy.ndarray
@@ -104,9 +109,17 @@ def accelerations(forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data
         Mass of each coordinate, kg.
     data : tuple
         The kernel's tuple (see the module docstring).
+
+    Returns
+    -------
+    numpy.ndarray
+        The force of each link, N.
     """
     index, mode, clusters, members, edges = data[17], data[19], data[20], data[21], data[22]
-    total = forces.copy()
+    rows = np.empty((2, forces.size))  # one array for both: each made costs more than its sums
+    total, required = rows[0], rows[1]
+    total[:] = forces
+    required[:] = 0.0
     link_force = np.zeros(index.shape[0])
     for k in range(index.shape[0]):
         if mode[k] != 0:
@@ -115,8 +128,8 @@ def accelerations(forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data
             total[index[k, 0]] += f
             if index[k, 1] != GROUND:
                 total[index[k, 1]] -= f
-    acc = total / masses
-    required = np.zeros(forces.size)
+    for i in range(forces.size):
+        acc[i] = total[i] / masses[i]
     for c in range(clusters.shape[0]):
         first, end = clusters[c, 0], clusters[c, 1]
         a = 0.0
@@ -138,7 +151,7 @@ def accelerations(forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data
             link_force[k] = carried if index[k, 0] == child else -carried
             if parent != GROUND:
                 required[parent] += carried
-    return acc, link_force
+    return link_force
 
 
 @jit
@@ -161,7 +174,7 @@ def loss_power(x: np.ndarray, n: int, link_force: np.ndarray, data) -> float:
     n : int
         Number of coordinates.
     link_force : numpy.ndarray
-        Link forces from :func:`accelerations`, N.
+        Link forces from :func:`accelerations_into`, N.
     data : tuple
         The kernel's tuple (see the module docstring).
     """
@@ -184,7 +197,7 @@ def link_losses(x: np.ndarray, n: int, link_force: np.ndarray, out: np.ndarray, 
     n : int
         Number of coordinates.
     link_force : numpy.ndarray
-        Link forces from :func:`accelerations`, N.
+        Link forces from :func:`accelerations_into`, N.
     out : numpy.ndarray
         One entry per link, written in place.
     data : tuple
