@@ -235,23 +235,28 @@ def evaluate(t: float, x: np.ndarray, data):
     ea, damping = rope[0], rope[1]
     n_spans = len0.size
     dt = t - held[0]
-    # four blocks of rows rather than a score of small arrays (each costs more to make
-    # and free than its arithmetic): per body, per rope coordinate, per span, per block
-    bodies = np.zeros((3, nb + nd))
+    # one array of rows rather than a score of small arrays (each costs more to make and
+    # free than its arithmetic), in four blocks: per body, per rope coordinate, per span,
+    # per block
+    nbd, nf = nb + nd, n + N_LINES
+    rows = np.zeros(3 * nbd + 3 * nf + 11 * n_spans + 2 * nb)
+    at_flows, at_spans = 3 * nbd, 3 * (nbd + nf)
+    at_contacts = at_spans + 11 * n_spans
+    bodies = rows[:at_flows].reshape((3, nbd))
     y, ydot, body_force = bodies[0], bodies[1], bodies[2]
     for j in range(nb):
         y[j] = x[j]
         ydot[j] = x[n + j]
     for j in range(nd):
         y[nb + j], ydot[nb + j] = held_motion(held, j, True, nd, dt)
-    flows = np.zeros((3, n + N_LINES))
+    flows = rows[at_flows:at_spans].reshape((3, nf))
     flow_q, flow_v, generalised = flows[0], flows[1], flows[2]
     for i in range(n):
         flow_q[i] = x[i]
         flow_v[i] = x[n + i]
     for i in range(N_LINES):
         flow_q[n + i], flow_v[n + i] = held_motion(held, i, False, nd, dt)
-    spans = np.zeros((11, n_spans))
+    spans = rows[at_spans:at_contacts].reshape((11, n_spans))
     big_l_rate, small_l, small_l_rate, stretch_of = spans[1], spans[2], spans[3], spans[4]
     tension, trial, elastic = spans[5], spans[6], spans[7]
     on_unstretched, energy, span_loss = spans[8], spans[9], spans[10]
@@ -300,7 +305,7 @@ def evaluate(t: float, x: np.ndarray, data):
     _flow_vecmat_into(generalised, on_unstretched, flow_columns, flow_values)
     forces = generalised[:n]  # the line ends' part is read as it is, below
     potential = 0.0
-    contacts = np.zeros((2, nb))
+    contacts = rows[at_contacts:].reshape((2, nb))
     depth, trial_contact = contacts[0], contacts[1]
     for j in range(nb):
         weight = blocks[j, 0]
