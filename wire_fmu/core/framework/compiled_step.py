@@ -91,6 +91,18 @@ def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> np.ndarray
     return out
 
 
+@jit
+def _any_fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
+    """Whether any guard crossed between two evaluations (:func:`_fired`, no array made)."""
+    for i in range(g0.size):
+        if directions[i] < 0:
+            if g0[i] >= 0.0 and g1[i] < 0.0:
+                return True
+        elif np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0:
+            return True
+    return False
+
+
 @jit_inline
 def _jacobian(rhs, t: float, x: np.ndarray, data) -> np.ndarray:
     """Forward-difference Jacobian (see ``fixed_step.finite_difference_jacobian``)."""
@@ -141,11 +153,24 @@ def dense_solve(w_inv: np.ndarray, b: np.ndarray, data) -> np.ndarray:
 def _step(rhs, solve, method: int, t: float, x: np.ndarray, h: float, fac, data):
     """One RK4 step, or one ROS2 step with the factors ``fac`` of ``I - g h J``."""
     if method == _RK4:
+        # the stages' states written into one array (numpy's operations, element by
+        # element: three arrays fewer to make per step)
+        stage = np.empty_like(x)
+        half = 0.5 * h
         k1 = rhs(t, x, data)
-        k2 = rhs(t + 0.5 * h, x + 0.5 * h * k1, data)
-        k3 = rhs(t + 0.5 * h, x + 0.5 * h * k2, data)
-        k4 = rhs(t + h, x + h * k3, data)
-        return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for i in range(x.size):
+            stage[i] = x[i] + half * k1[i]
+        k2 = rhs(t + 0.5 * h, stage, data)
+        for i in range(x.size):
+            stage[i] = x[i] + half * k2[i]
+        k3 = rhs(t + 0.5 * h, stage, data)
+        for i in range(x.size):
+            stage[i] = x[i] + h * k3[i]
+        k4 = rhs(t + h, stage, data)
+        sixth = h / 6.0
+        for i in range(x.size):
+            stage[i] = x[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        return stage
     if x.size == 0:
         return x
     k1 = solve(fac, rhs(t, x, data), data)
@@ -281,11 +306,11 @@ def advance_structured(
             k += 1
             continue
         g1 = guards(t + h, x1, data)
-        mask = _fired(g0, g1, directions)
-        if not mask.any():
+        if not _any_fired(g0, g1, directions):
             t, x, g0 = t_next, x1, g1
             k += 1
             continue
+        mask = _fired(g0, g1, directions)
         # Illinois regula falsi on the step fraction, for the earliest crossing
         lo, hi = 0.0, 1.0
         x_hi = x1
