@@ -7,11 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from matplotlib import mathtext
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from wire_fmu.master.plot_figure import PlotContext, PlotRequest, plot_figure
 from wire_fmu.master.plot_references import references
 from wire_fmu.master.plot_signals import busiest_window, envelope, is_discrete, state_levels
+from wire_fmu.master.plot_ticks import power_of_ten
 from wire_fmu.master.plot_units import display_unit, pretty_unit
 from wire_fmu.master.plots import plot_results
 
@@ -248,3 +250,26 @@ def test_the_scene_s_axis_label_keeps_its_quantity_and_gets_the_unit_shown(given
     request = PlotRequest("Torque", ("full.motor.drive_torque",), given)
     (ax,) = _drawn(plot_figure(request, data, context))
     assert ax.get_ylabel() == label
+
+
+@pytest.mark.parametrize(("exponent", "text"), [(6, "×10⁶"), (-3, "×10⁻³"), (12, "×10¹²"), (0, "")])
+def test_a_power_of_ten_is_written_with_superscripts(exponent, text):
+    assert power_of_ten(exponent) == text
+
+
+def test_value_axes_label_their_ticks_in_plain_text_and_a_power_of_ten_above(monkeypatch):
+    # mathtext's parser costs half a second at the first label a process draws
+    def refuse(self, text, *args, **kwargs):
+        raise AssertionError(f"mathtext parsed {text!r}")
+
+    monkeypatch.setattr(mathtext.MathTextParser, "parse", refuse)
+    run = _tension_run()
+    run["winch.drum.speed"] = 3.0e-7 * np.sin(0.3 * run["time"])  # tiny: needs a power
+    request = PlotRequest("Drum", ("winch.drum.speed",), "speed (rad/s)")
+    (ax, *_) = _drawn(plot_figure(request, run, _CONTEXT))
+    assert ax.yaxis.get_offset_text().get_text() == "×10⁻⁷"
+    labels = [label.get_text() for label in ax.get_yticklabels()]
+    assert labels and not any("$" in label for label in labels)
+    assert "−2" in labels and "2" in labels  # the numbers themselves, a true minus sign
+    (ax,) = _drawn(plot_figure(PlotRequest("T", ("rope.line_a.tension",), ""), run, _CONTEXT))
+    assert ax.yaxis.get_offset_text().get_text() == ""  # no power where none is needed

@@ -362,8 +362,10 @@ def _legend(ax) -> None:
 
 def _plain_numbers(ax) -> None:
     """Tick labels as the numbers themselves, never less an offset (a power of ten may stand
-    above very small or large ones)."""
-    ax.ticklabel_format(axis="y", useOffset=False, useMathText=True)
+    above very small or large ones): :class:`~.plot_ticks.PlainTicks`."""
+    from .plot_ticks import PlainTicks
+
+    ax.yaxis.set_major_formatter(PlainTicks())
 
 
 def _unique(refs: list[Reference]) -> list[Reference]:
