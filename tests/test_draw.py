@@ -202,3 +202,16 @@ def test_no_label_of_a_shipped_reeving_overprints_another(scene, tmp_path):
     for i, (text, box) in enumerate(boxes):
         for other, second in boxes[i + 1 :]:
             assert not box.overlaps(second), f"{scene}: {text!r} overprints {other!r}"
+
+
+def test_a_drawing_sets_no_text_in_mathtext(tmp_path, monkeypatch):
+    # matplotlib builds its mathtext parser at the first formula a process draws: a third
+    # of a second of every run's report, for a legend's one arrow
+    from matplotlib import mathtext
+
+    def refuse(self, text, *args, **kwargs):
+        raise AssertionError(f"mathtext parsed {text!r}")
+
+    monkeypatch.setattr(mathtext.MathTextParser, "parse", refuse)
+    out = draw_reeving(drilling_block_train(4, floor=FLOOR), tmp_path / "plain.png")
+    assert out.stat().st_size > 10_000

@@ -295,6 +295,14 @@ def _draw_floors(ax, drawing: ReevingDrawing, arrow: float) -> list[Label]:
 
 def _legend(fig) -> None:
     from matplotlib.lines import Line2D
+    from matplotlib.path import Path
+
+    # an arrow drawn as a path: a mathtext marker (r"$\rightarrow$") would build
+    # matplotlib's mathtext parser, a third of a second, for this one glyph
+    arrow = Path(
+        [(-1.0, 0.0), (1.0, 0.0), (0.35, 0.45), (1.0, 0.0), (0.35, -0.45)],
+        [Path.MOVETO, Path.LINETO, Path.MOVETO, Path.LINETO, Path.LINETO],
+    )
 
     handles = [
         Line2D(
@@ -315,7 +323,7 @@ def _legend(fig) -> None:
             [],
             [],
             color="black",
-            marker=r"$\rightarrow$",
+            marker=arrow,
             linestyle="",
             markersize=12,
             label="line end",
