@@ -57,6 +57,7 @@ __all__ = [
     "STATUS_PYTHON",
     "advance_structured",
     "advance_to_event",
+    "any_fired",
     "dense_factor",
     "dense_linearise",
     "dense_solve",
@@ -92,8 +93,16 @@ def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> np.ndarray
 
 
 @jit
-def _any_fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
-    """Whether any guard crossed between two evaluations (:func:`_fired`, no array made)."""
+def any_fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
+    """Whether any guard crossed between two evaluations (:func:`_fired`, no array made).
+
+    Parameters
+    ----------
+    g0, g1 : numpy.ndarray
+        The guards at the start and the end of a step.
+    directions : numpy.ndarray
+        Guard directions (-1 fires downwards, 0 on any crossing).
+    """
     for i in range(g0.size):
         if directions[i] < 0:
             if g0[i] >= 0.0 and g1[i] < 0.0:
@@ -306,7 +315,7 @@ def advance_structured(
             k += 1
             continue
         g1 = guards(t + h, x1, data)
-        if not _any_fired(g0, g1, directions):
+        if not any_fired(g0, g1, directions):
             t, x, g0 = t_next, x1, g1
             k += 1
             continue

@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from wire_fmu.core.framework.compiled import kernel_decorators
-from wire_fmu.core.framework.compiled_step import COMPILED_METHODS
+from wire_fmu.core.framework.compiled_step import COMPILED_METHODS, any_fired
 from wire_fmu.core.framework.fixed_step import ROS2
 from wire_fmu.core.units.hydraulics.kernel_arrays import (
     H_FORCE,
@@ -182,18 +182,6 @@ def _finite(x: np.ndarray) -> bool:
 
 
 @jit
-def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
-    """Whether a guard crossed between two evaluations (``compiled_step._fired``)."""
-    for i in range(g0.size):
-        if directions[i] < 0:
-            if g0[i] >= 0.0 and g1[i] < 0.0:
-                return True
-        elif np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0:
-            return True
-    return False
-
-
-@jit
 def quiet_step(method, t0, t1, n, x, directions, data):
     """A communication step in which nothing happens, in one call.
 
@@ -261,7 +249,7 @@ def quiet_step(method, t0, t1, n, x, directions, data):
         if not _finite(following):
             return False, x, nothing
         point, acc, link = _evaluate_into(t + h, following, slope, g1, c)
-        if _fired(g0, g1, directions):
+        if any_fired(g0, g1, directions):
             return False, x, nothing
         if t + h != t_next:  # the shared loop's next first stage is at the grid's time
             _slope_into(t_next, following, slope, c)
