@@ -16,7 +16,7 @@ import pytest
 import scipy.linalg
 
 from wire_fmu.core.framework.compiled import KERNEL_ENV
-from wire_fmu.core.framework.interface_model import EffortModel
+from wire_fmu.core.framework.interface_model import EffortModel, inputs_taken
 from wire_fmu.core.units.winch.base import WinchInputs
 
 from .winch_helpers import BRAKE, capacities, make_unit, one_mass, run
@@ -219,3 +219,19 @@ def test_the_drawworks_winch_receives_the_fast_lines_stiffness(tmp_path):
     moving = frame[frame.index > 1.2]
     assert (moving["winch.drum.speed"] > 1.0).all()  # lowering
     assert (frame["winch.rope.damping"] >= 0.0).all()
+
+
+@pytest.mark.parametrize(
+    ("values", "taken"),
+    [
+        ((1.0, 5.0, 2.0, 0.0), True),
+        ((1.0, 0.0, 0.0, -3.0), True),  # a negative rate is an effort that falls
+        ((1.0, -5.0, 2.0, 0.0), False),  # a spring that pushes the port along
+        ((1.0, 5.0, -2.0, 0.0), False),
+        ((math.nan, 5.0, 2.0, 0.0), False),
+        ((1.0, 5.0, 2.0, math.inf), False),
+    ],
+)
+def test_a_flow_side_takes_finite_inputs_with_no_negative_spring_or_damper(values, taken):
+    assert inputs_taken(values, 1) is taken
+    assert (not EffortModel(*values[1:]).problems("rope")) is (values[1] >= 0 and values[2] >= 0)

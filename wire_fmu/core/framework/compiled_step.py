@@ -81,14 +81,20 @@ STATUS_PYTHON = 3
 
 
 @jit
+def _crossed(before: float, after: float, direction: float) -> bool:
+    """Whether a guard crossed from ``before`` to ``after`` (see ``fixed_step._fired``):
+    downwards through 0 from ``>= 0`` for direction -1, else a change of sign from nonzero."""
+    if direction < 0:
+        return before >= 0.0 and after < 0.0
+    return np.sign(before) != np.sign(after) and before != 0.0
+
+
+@jit
 def _fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> np.ndarray:
-    """Guards that crossed between two evaluations (see ``fixed_step._fired``)."""
+    """Guards that crossed between two evaluations (:func:`_crossed`, one per guard)."""
     out = np.zeros(g0.size, dtype=np.bool_)
     for i in range(g0.size):
-        if directions[i] < 0:
-            out[i] = g0[i] >= 0.0 and g1[i] < 0.0
-        else:
-            out[i] = np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0
+        out[i] = _crossed(g0[i], g1[i], directions[i])
     return out
 
 
@@ -104,10 +110,7 @@ def any_fired(g0: np.ndarray, g1: np.ndarray, directions: np.ndarray) -> bool:
         Guard directions (-1 fires downwards, 0 on any crossing).
     """
     for i in range(g0.size):
-        if directions[i] < 0:
-            if g0[i] >= 0.0 and g1[i] < 0.0:
-                return True
-        elif np.sign(g0[i]) != np.sign(g1[i]) and g0[i] != 0.0:
+        if _crossed(g0[i], g1[i], directions[i]):
             return True
     return False
 

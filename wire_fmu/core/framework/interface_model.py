@@ -22,12 +22,14 @@ damper and rate terms and the exact work of its spring. The flow side's inputs a
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from wire_fmu.core.framework.ports import INTERFACE_QUANTITIES, INTERFACE_UNITS
 from wire_fmu.core.framework.variables import Variable, input_
 
-__all__ = ["EffortModel", "interface_input_names", "interface_inputs"]
+__all__ = ["EffortModel", "inputs_taken", "interface_input_names", "interface_inputs"]
 
 
 def interface_input_names(port: str) -> tuple[str, ...]:
@@ -195,4 +197,26 @@ def interface_inputs(
     return tuple(
         input_(name, 0.0, unit, f"Interface model: {text}")
         for name, (unit, text) in zip(interface_input_names(port), described, strict=True)
+    )
+
+
+def inputs_taken(values: Sequence[float], stiffness_at: int) -> bool:
+    """Whether a flow side can step with its inputs' flat ``values``: all finite, and the
+    interface model's spring and damper (``values[stiffness_at]`` and the next, as
+    :class:`EffortModel` orders them) not negative, as :meth:`EffortModel.problems` asks.
+
+    The quiet steps' check, without a word put together; the general way names what is
+    wrong.
+
+    Parameters
+    ----------
+    values : sequence of float
+        The unit's flat inputs, the interface model's among them.
+    stiffness_at : int
+        Where the interface model's stiffness is in ``values``.
+    """
+    return (
+        all(map(math.isfinite, values))
+        and values[stiffness_at] >= 0.0
+        and values[stiffness_at + 1] >= 0.0
     )

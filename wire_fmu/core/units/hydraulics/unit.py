@@ -121,6 +121,7 @@ import numpy as np
 from wire_fmu.core.components.hydraulic_line import HydraulicLine
 from wire_fmu.core.components.rod_seal import SealSpec
 from wire_fmu.core.errors import ConfigurationError, ModelError
+from wire_fmu.core.framework.interface_model import inputs_taken
 from wire_fmu.core.framework.ports import PortSide, port
 from wire_fmu.core.framework.solver_options import solver_settings
 from wire_fmu.core.framework.unit import OdeView, Unit
@@ -173,14 +174,10 @@ _REPORTED_OUTPUTS = tuple(_OUTPUT_OF[name] for name in REPORT)
 _QUIET_OUTPUTS = tuple(_OUTPUT_OF.get(name) or _QUIET_OUTPUT_OF[name] for name in QUIET_OUTPUTS)
 """The outputs a quiet step writes, in the order of its values: every one but the modes'
 (``seal.stuck``, ``end_stop.contact``, ``mode_changes``), which such a step keeps."""
-_read_flat_inputs = itemgetter("rod.force", *INTERFACE_INPUTS)
-
-
-def _inputs_taken(flat: tuple[float, ...]) -> bool:
-    """Whether the cylinder can step with ``flat`` (the rod force, then the interface
-    model's inputs): all finite, the spring and the damper not negative
-    (:meth:`HydraulicsUnit._input_problems` names what is not)."""
-    return all(map(math.isfinite, flat)) and flat[1] >= 0.0 and flat[2] >= 0.0
+_FLAT_INPUTS = ("rod.force", *INTERFACE_INPUTS)
+"""The inputs a step takes, in the order the quiet step reads them."""
+_read_flat_inputs = itemgetter(*_FLAT_INPUTS)
+_STIFFNESS_AT = _FLAT_INPUTS.index("rod.stiffness")
 
 
 class HydraulicsUnit(Unit):
@@ -328,7 +325,7 @@ class HydraulicsUnit(Unit):
 
     def _input_problems(self, interface: RodInterface) -> list[str]:
         """:meth:`input_problems`, the interface model in the inputs being ``interface``."""
-        return self.non_finite_inputs(("rod.force", *INTERFACE_INPUTS)) + interface.problems("rod")
+        return self.non_finite_inputs(_FLAT_INPUTS) + interface.problems("rod")
 
     def _take_quiet_step(self, time: float, step: float) -> bool:
         """A step in which nothing happens, outputs included, in one compiled call
@@ -342,7 +339,7 @@ class HydraulicsUnit(Unit):
         if model is None or not model.compiled:
             return False
         flat = tuple(map(float, _read_flat_inputs(self.values)))
-        if not _inputs_taken(flat):
+        if not inputs_taken(flat, _STIFFNESS_AT):
             return False
         force, stiffness, damping, rate, *reference = flat
         if stiffness != 0.0 or damping != 0.0 or rate != 0.0:

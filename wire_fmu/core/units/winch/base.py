@@ -15,6 +15,7 @@ from wire_fmu.core.components.drive_train import DriveChain
 from wire_fmu.core.components.drum import Drum
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.interface_model import EffortModel, interface_input_names
+from wire_fmu.core.framework.interface_model import inputs_taken as interface_inputs_taken
 from wire_fmu.core.units.winch.brake import BandBrake
 
 __all__ = [
@@ -40,6 +41,7 @@ FLAT_INPUTS = (
 )
 """The unit's inputs, in the order :func:`inputs_taken` and the compiled quiet step
 (:meth:`~wire_fmu.core.units.winch.drive.WinchModel.quiet_step_outputs`) take them."""
+_ROPE_STIFFNESS_AT = FLAT_INPUTS.index(ROPE_MODEL_INPUTS[0])
 
 logger = logging.getLogger(__name__)
 
@@ -131,7 +133,7 @@ def inputs_taken(values: tuple[float, ...]) -> bool:
         (N m), speed command (rad/s), then the rope model's K (N/m), D (N s/m), R (N/s),
         reference payout (m) and rate (m/s).
     """
-    return all(map(math.isfinite, values)) and values[4] >= 0.0 and values[5] >= 0.0
+    return interface_inputs_taken(values, _ROPE_STIFFNESS_AT)
 
 
 @dataclass(frozen=True)
