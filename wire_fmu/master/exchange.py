@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 from .extrapolation import History, held_value, push_all, ramp
 from .scene.data import RAMP_ROLE
-from .unit_io import EndValues, InputPlan, Link, Watch, read_plan
+from .unit_io import EndValues, InputPlan, Link, Watch, input_order, read_plan
 
 __all__ = ["MODE_OUTPUT", "UnitExchange"]
 
@@ -65,8 +65,7 @@ class UnitExchange:
     def _build_plans(self) -> None:
         """Each unit's batched set and end-of-step reads (after the observers' watches)."""
         for name, slave in self.slaves.items():
-            # the links held constant first: the batch takes their values in one go
-            links = tuple(sorted(self.links_into.get(name, ()), key=lambda k: not k.constant))
+            links = input_order(self.links_into.get(name, ()))
             driven = tuple(self.drivers.targets(name))
             variables = [slave.variables.get(n) for n in driven]
             reals = all(v is not None and v.type == "Real" for v in variables)
@@ -221,24 +220,23 @@ class UnitExchange:
             values = plan.constant_values(fresh)
             # as many values as targets by construction; strict= costs a keyword parse
             held.update(zip(plan.constant_targets, values))  # noqa: B905
-        ramps = None  # a ramped flow's (start, slope), for its flow link and its ramp link
-        for link in plan.others:  # every history holds its latest value from initialisation on
-            if link.position:
-                value = self.latest[link.key]  # the unit advances it with the held velocity
-            elif link.ramp:
-                ramps = {} if ramps is None else ramps
-                if link.key not in ramps:
-                    source = None if fresh is None else fresh.get(link.key)
-                    ramps[link.key] = ramp(link.history, t, h, link.scheme, source)
-                start, slope = ramps[link.key]
-                value = slope if link.ramp == "slope" else start
-                values.append(value)
-                held[link.target] = slope if link.ramp == "slope" else start + 0.5 * slope * h
-                continue
-            else:
-                value = held_value(
-                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
-                )
+        if plan.position_keys:  # the unit advances them with the held velocity
+            positions = list(map(self.latest.__getitem__, plan.position_keys))
+            values += positions
+            held.update(zip(plan.position_targets, positions))  # noqa: B905
+        for source in plan.ramps:  # every history holds its latest value from initialisation on
+            fresh_value = None if fresh is None else fresh.get(source.key)
+            start, slope = ramp(source.history, t, h, source.scheme, fresh_value)
+            for target in source.starts:
+                values.append(start)
+                held[target] = start + 0.5 * slope * h  # the ramp's average over the step
+            for target in source.slopes:
+                values.append(slope)
+                held[target] = slope
+        for link in plan.extrapolated:
+            value = held_value(
+                link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+            )
             values.append(value)
             held[link.target] = value
         slave = self.slaves[unit]

@@ -35,7 +35,16 @@ from .manipulators import ScheduledEvents
 from .scene import Connection
 from .slave import Slave
 
-__all__ = ["EndValues", "InputPlan", "Link", "ReadPlan", "Watch", "read_plan"]
+__all__ = [
+    "EndValues",
+    "InputPlan",
+    "Link",
+    "RampedSource",
+    "ReadPlan",
+    "Watch",
+    "input_order",
+    "read_plan",
+]
 
 _Place = tuple[str, int]  # (FMI type, position in that type's answer)
 
@@ -88,6 +97,87 @@ class Link:
         self.extrapolated = not (self.constant or self.position)
 
 
+def _order_group(link: Link) -> int:
+    """Where ``link`` goes in a unit's batched set: 0 held constant, 1 a position,
+    2 ramped, 3 extrapolated."""
+    if link.constant:
+        return 0
+    if link.position:
+        return 1
+    return 2 if link.ramp else 3
+
+
+def input_order(links: Sequence[Link]) -> tuple[Link, ...]:
+    """``links`` in the order a unit's batched set takes their values (:class:`InputPlan`).
+
+    The links held constant first, then the positions, then the ramped links with each
+    source's start links before its slope links, then the extrapolated ones; within each,
+    in their order in ``links``.
+
+    Parameters
+    ----------
+    links : sequence of Link
+        The connections into one unit.
+
+    Returns
+    -------
+    tuple of Link
+    """
+    sources: dict[str, int] = {}
+    for link in links:
+        if link.ramp:
+            sources.setdefault(link.key, len(sources))
+
+    def rank(item: tuple[int, Link]) -> tuple[int, int, int, int]:
+        i, link = item
+        group = _order_group(link)
+        if group == 2:
+            return group, sources[link.key], link.ramp != "start", i
+        return group, 0, 0, i
+
+    return tuple(link for _, link in sorted(enumerate(links), key=rank))
+
+
+@dataclass(frozen=True)
+class RampedSource:
+    """The ramped links from one source output (see :func:`.extrapolation.ramp`).
+
+    Parameters
+    ----------
+    key : str
+        The source, ``"unit.variable"``.
+    history : History
+        Its past values.
+    scheme : str
+        Its extrapolation.
+    starts : tuple of str
+        The inputs set to the ramp's value at the step's start (``"unit.variable"``);
+        the master holds the ramp's average over the step for them.
+    slopes : tuple of str
+        The inputs set to the ramp's slope.
+    """
+
+    key: str
+    history: History
+    scheme: str
+    starts: tuple[str, ...]
+    slopes: tuple[str, ...]
+
+    @classmethod
+    def of(cls, links: Sequence[Link]) -> RampedSource:
+        """The entry of ``links``, all from one source, the start links first."""
+        first = links[0]
+        if first.history is None:
+            raise ValueError(f"ramped link {first.target} has no history")
+        return cls(
+            first.key,
+            first.history,
+            first.scheme,
+            tuple(link.target for link in links if link.ramp == "start"),
+            tuple(link.target for link in links if link.ramp == "slope"),
+        )
+
+
 @dataclass
 class InputPlan:
     """What one unit's batched set holds before each step.
@@ -95,7 +185,7 @@ class InputPlan:
     Parameters
     ----------
     links : tuple of Link
-        Connections into the unit, in order.
+        Connections into the unit, in :func:`input_order`.
     driven : tuple of str
         Inputs set by drivers, in the order of
         :meth:`~wire_fmu.master.manipulators.DriverSet.step_values`.
@@ -118,10 +208,15 @@ class InputPlan:
     idle : bool
         Whether nothing sets an input of the unit during the run.
     constant_keys, constant_targets : tuple of str
-        Source and target of each of the leading links that are held ``constant``
-        (:attr:`Link.constant`): set from their sources' values without a Python loop.
-    others : tuple of Link
-        The links after them.
+        Source and target of each link held ``constant`` (:attr:`Link.constant`): set
+        from their sources' values without a Python loop.
+    position_keys, position_targets : tuple of str
+        Source and target of each bond's position link (:attr:`Link.position`): set to
+        their sources' latest values, also without a loop.
+    ramps : tuple of RampedSource
+        The ramped links, one entry per source (its ramp is worked out once).
+    extrapolated : tuple of Link
+        The other links, each held at its own extrapolation.
     """
 
     links: tuple[Link, ...]
@@ -138,16 +233,27 @@ class InputPlan:
     idle: bool = field(init=False)
     constant_keys: tuple[str, ...] = field(init=False)
     constant_targets: tuple[str, ...] = field(init=False)
-    others: tuple[Link, ...] = field(init=False)
+    position_keys: tuple[str, ...] = field(init=False)
+    position_targets: tuple[str, ...] = field(init=False)
+    ramps: tuple[RampedSource, ...] = field(init=False)
+    extrapolated: tuple[Link, ...] = field(init=False)
 
     def __post_init__(self) -> None:
+        if self.links != input_order(self.links):
+            raise ValueError("an input plan takes its links in input_order()")
         self.idle = not (self.links or self.driven or self.evented)
-        leading = 0
-        while leading < len(self.links) and self.links[leading].constant:
-            leading += 1
-        constant, self.others = self.links[:leading], self.links[leading:]
+        constant = [link for link in self.links if link.constant]
         self.constant_keys = tuple(link.key for link in constant)
         self.constant_targets = tuple(link.target for link in constant)
+        positions = [link for link in self.links if link.position]
+        self.position_keys = tuple(link.key for link in positions)
+        self.position_targets = tuple(link.target for link in positions)
+        ramped: dict[str, list[Link]] = {}
+        for link in self.links:
+            if link.ramp:
+                ramped.setdefault(link.key, []).append(link)
+        self.ramps = tuple(RampedSource.of(links) for links in ramped.values())
+        self.extrapolated = tuple(link for link in self.links if _order_group(link) == 3)
 
     def constant_values(self, fresh: Mapping[str, float] | None) -> list[float]:
         """The values of the ``constant`` links: their sources' new values where ``fresh``
