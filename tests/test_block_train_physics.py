@@ -289,6 +289,24 @@ class TestBadInput:
             assert needle in text
         assert len(info.value.problems) >= 5
 
+    def test_a_rope_too_stiff_for_its_pretension_is_refused(self):
+        """T / EA below the span lengths' round-off: the spans would start slack."""
+        reeving = single_fall(axial_stiffness=1e30)
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(reeving, initial_equilibrium=False, pretension=3.56e5)
+        text = str(info.value)
+        assert "'axial_stiffness' 1e+30 N is too stiff" in text
+        assert "starting tension 356000 N" in text and "strain 3.56e-25" in text
+
+    @pytest.mark.parametrize("pretension", [1e-3, 1.0, 3.56e5])
+    def test_a_small_pretension_on_a_real_rope_starts_at_it(self, pretension):
+        unit = make_unit(
+            single_fall(axial_stiffness=1.3e8), initial_equilibrium=False, pretension=pretension
+        )
+        # the span lengths resolve the strain T / EA to about their round-off, eps L
+        resolution = 10 * np.finfo(float).eps * 1.3e8 / pretension
+        assert unit.values["line_a.tension"] == pytest.approx(pretension, rel=resolution)
+
     def test_overlapping_sheaves_are_named(self):
         reeving = drilling_block_train(4)
         reeving["sheaves"]["crown_1"]["centre"] = [0.5, 45.0, 0.0]  # on top of crown_0

@@ -15,7 +15,13 @@ from wire_fmu.core.errors import ConfigurationError
 if TYPE_CHECKING:
     from wire_fmu.core.units.block_train.model import BlockTrainInputs
 
-__all__ = ["StartingState"]
+__all__ = ["START_TENSION_TOLERANCE", "StartingState"]
+
+
+START_TENSION_TOLERANCE = 1e-3
+"""Largest relative difference between the starting tension asked for and the one the
+spans carry once their unstretched lengths are set (round-off in a rope of realistic
+stiffness leaves about 1e-13)."""
 
 
 class StartingState:
@@ -64,6 +70,7 @@ class StartingState:
         ea = self.rope.axial_stiffness
         flow = np.concatenate((self.q, held.line_positions))
         self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
+        self._check_start_tension(big_l, flow, tension)
         self.taut_mask = np.full(len(self.spans), tension > 0.0)
         self.contact_mask = np.array(
             [b.floor is not None and b.position < b.floor.position for b in self.blocks], dtype=bool
@@ -72,6 +79,31 @@ class StartingState:
         self.state = self._settle_modes(t0, self.state, [])
         self.preload_kernel(t0)
         return tension
+
+    def _check_start_tension(self, big_l: np.ndarray, flow: np.ndarray, tension: float) -> None:
+        """Refuse a start whose spans do not carry ``tension`` (N) once the unstretched
+        lengths are set: a rope so stiff that the strain ``tension / EA`` is lost to the
+        round-off of the span lengths (about 1e-16 of them).
+
+        Each span's tension is worked out as the kernels do, from its length ``big_l`` (m)
+        and its unstretched length (the offsets and the line ends' ``flow``, m).
+        """
+        if not tension > 0.0:
+            return
+        ea = self.rope.axial_stiffness
+        small_l = self.offsets + self.flow_matrix @ flow
+        carried = ea * ((big_l - small_l) / small_l)
+        worst = float(np.max(np.abs(carried - tension))) / tension
+        if worst > START_TENSION_TOLERANCE:
+            raise ConfigurationError(
+                "block train",
+                [
+                    f"rope: 'axial_stiffness' {ea:.6g} N is too stiff for the starting tension "
+                    f"{tension:.6g} N: its strain {tension / ea:.3g} is below what the span "
+                    f"lengths resolve, so the spans would start at {float(carried.min()):.6g} "
+                    "N; give the rope a stiffness it has (steel wire rope: about 1e7 to 1e9 N)"
+                ],
+            )
 
     def _equilibrium_tension(self, dl_dy: np.ndarray) -> float:
         gravity = np.array(self.reeving.gravity)
