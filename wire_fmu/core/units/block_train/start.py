@@ -98,10 +98,12 @@ class StartingState:
             raise ConfigurationError(
                 "block train",
                 [
-                    f"rope: 'axial_stiffness' {ea:.6g} N is too stiff for the starting tension "
-                    f"{tension:.6g} N: its strain {tension / ea:.3g} is below what the span "
-                    f"lengths resolve, so the spans would start at {float(carried.min()):.6g} "
-                    "N; give the rope a stiffness it has (steel wire rope: about 1e7 to 1e9 N)"
+                    f"starting tension {tension:.6g} N: its strain in a rope of "
+                    f"'axial_stiffness' {ea:.6g} N, {tension / ea:.3g}, is below what the span "
+                    f"lengths resolve, so the spans would start at {float(carried.min()):.6g} N; "
+                    "give the rope a stiffness it has (steel wire rope: about 1e7 to 1e9 N) or "
+                    "the start a larger tension (the pretension, or with initial_equilibrium the "
+                    "blocks' weight)"
                 ],
             )
 
