@@ -42,6 +42,7 @@ def _links(histories):
         _link("s", "signal", "signal", "quadratic", 15, histories),
         _link("v2", "rate_2", "flow", "linear", 16, histories),
         _link("x2", "position_2", "position", "linear", 17, histories),
+        _link("v1", "rate_1b", "flow", "linear", 18, histories),  # v1: two starts, a loop
     ]
 
 
@@ -63,6 +64,7 @@ def test_the_order_groups_links_by_kind_and_ramped_source():
         "u.position_1",
         "u.position_2",
         "u.rate_1",
+        "u.rate_1b",
         "u.acceleration_1",
         "u.rate_2",
         "u.acceleration_2",
@@ -102,6 +104,7 @@ def test_each_input_gets_its_own_value(fresh):
         11: (0.25, 0.25),
         17: (-0.5, -0.5),
         10: (start_1, start_1 + 0.5 * slope_1 * _H),
+        18: (start_1, start_1 + 0.5 * slope_1 * _H),
         14: (slope_1, slope_1),
         16: (start_2, start_2 + 0.5 * slope_2 * _H),
         12: (slope_2, slope_2),
@@ -112,3 +115,4 @@ def test_each_input_gets_its_own_value(fresh):
     by_vr = {link.target_vr: link.target for link in links}
     assert exchange.held == {by_vr[r]: held for r, (_, held) in expected.items()}
     assert slope_2 != 0.0 and start_2 != latest["src.v2"]  # the ramp is not trivially held
+    assert [source.pair is None for source in plan.ramps] == [True, False]

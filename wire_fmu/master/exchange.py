@@ -220,25 +220,38 @@ class UnitExchange:
             values = plan.constant_values(fresh)
             # as many values as targets by construction; strict= costs a keyword parse
             held.update(zip(plan.constant_targets, values))  # noqa: B905
-        if plan.position_keys:  # the unit advances them with the held velocity
-            positions = list(map(self.latest.__getitem__, plan.position_keys))
-            values += positions
-            held.update(zip(plan.position_targets, positions))  # noqa: B905
-        for source in plan.ramps:  # every history holds its latest value from initialisation on
-            fresh_value = None if fresh is None else fresh.get(source.key)
-            start, slope = ramp(source.history, t, h, source.scheme, fresh_value)
-            for target in source.starts:
-                values.append(start)
-                held[target] = start + 0.5 * slope * h  # the ramp's average over the step
-            for target in source.slopes:
-                values.append(slope)
-                held[target] = slope
-        for link in plan.extrapolated:
-            value = held_value(
-                link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
-            )
-            values.append(value)
-            held[link.target] = value
+        # each loop only where it has something to go over (an iterator is an object made)
+        if plan.positions:  # the unit advances them with the held velocity
+            latest = self.latest
+            for key, target in plan.positions:
+                value = latest[key]
+                values.append(value)
+                held[target] = value
+        if plan.ramps:  # every history holds its latest value from initialisation on
+            for source in plan.ramps:
+                fresh_value = None if fresh is None else fresh.get(source.key)
+                start, slope = ramp(source.history, t, h, source.scheme, fresh_value)
+                average = start + 0.5 * slope * h  # what a start input holds over the step
+                pair = source.pair
+                if pair is not None:  # a bond's flow and its ramp: one of each
+                    values.append(start)
+                    values.append(slope)
+                    held[pair[0]] = average
+                    held[pair[1]] = slope
+                    continue
+                for target in source.starts:
+                    values.append(start)
+                    held[target] = average
+                for target in source.slopes:
+                    values.append(slope)
+                    held[target] = slope
+        if plan.extrapolated:
+            for link in plan.extrapolated:
+                value = held_value(
+                    link.history, t, h, link.scheme, None if fresh is None else fresh.get(link.key)
+                )
+                values.append(value)
+                held[link.target] = value
         slave = self.slaves[unit]
         by_name = None
         if plan.driven:

@@ -155,6 +155,12 @@ class RampedSource:
         the master holds the ramp's average over the step for them.
     slopes : tuple of str
         The inputs set to the ramp's slope.
+
+    Attributes
+    ----------
+    pair : (str, str) or None
+        The start and the slope input when there is one of each (a bond's flow and ramp
+        links, the usual case: set without a loop), else None.
     """
 
     key: str
@@ -162,6 +168,11 @@ class RampedSource:
     scheme: str
     starts: tuple[str, ...]
     slopes: tuple[str, ...]
+    pair: tuple[str, str] | None = field(init=False)
+
+    def __post_init__(self) -> None:
+        one_each = len(self.starts) == 1 and len(self.slopes) == 1
+        object.__setattr__(self, "pair", (self.starts[0], self.slopes[0]) if one_each else None)
 
     @classmethod
     def of(cls, links: Sequence[Link]) -> RampedSource:
@@ -210,9 +221,9 @@ class InputPlan:
     constant_keys, constant_targets : tuple of str
         Source and target of each link held ``constant`` (:attr:`Link.constant`): set
         from their sources' values without a Python loop.
-    position_keys, position_targets : tuple of str
+    positions : tuple of (str, str)
         Source and target of each bond's position link (:attr:`Link.position`): set to
-        their sources' latest values, also without a loop.
+        their sources' latest values.
     ramps : tuple of RampedSource
         The ramped links, one entry per source (its ramp is worked out once).
     extrapolated : tuple of Link
@@ -233,8 +244,7 @@ class InputPlan:
     idle: bool = field(init=False)
     constant_keys: tuple[str, ...] = field(init=False)
     constant_targets: tuple[str, ...] = field(init=False)
-    position_keys: tuple[str, ...] = field(init=False)
-    position_targets: tuple[str, ...] = field(init=False)
+    positions: tuple[tuple[str, str], ...] = field(init=False)
     ramps: tuple[RampedSource, ...] = field(init=False)
     extrapolated: tuple[Link, ...] = field(init=False)
 
@@ -245,9 +255,7 @@ class InputPlan:
         constant = [link for link in self.links if link.constant]
         self.constant_keys = tuple(link.key for link in constant)
         self.constant_targets = tuple(link.target for link in constant)
-        positions = [link for link in self.links if link.position]
-        self.position_keys = tuple(link.key for link in positions)
-        self.position_targets = tuple(link.target for link in positions)
+        self.positions = tuple((link.key, link.target) for link in self.links if link.position)
         ramped: dict[str, list[Link]] = {}
         for link in self.links:
             if link.ramp:
