@@ -6,7 +6,9 @@ ROS2 (finite-difference Jacobian at the start of every interval, the
 located by Illinois regula falsi. What changes is where it runs: a unit's
 compiled kernel gives plain functions
 
-``rhs(t, x, data) -> x'``, ``guards(t, x, data) -> g`` and ``project(x, data) -> x``
+``rhs(t, x, data) -> x'``, ``guards(t, x, data) -> g``,
+``rhs_guards(t, x, data) -> (x', g)`` (both from one evaluation of the model) and
+``project(x, data) -> x``
 
 over a tuple ``data`` of arrays (parameters, modes, held inputs), the linear
 algebra of ROS2 (the ``dense_*`` functions here, or a structured set of its own
@@ -17,6 +19,12 @@ them. The linear algebra is four functions:
 ``linearise(rhs, t, x, data) -> (J, evaluations)``, ``unlinearised(data) -> J``
 (an empty ``J`` of the same type), ``factor(J, g h, data) -> F`` (empty for a NaN
 ``g h``) and ``solve(F, b, data) -> (I - g h J)^-1 b``.
+
+Every state the loop reaches is evaluated once where it can be: the derivative and the
+guards at the start come from one ``rhs_guards``, and so do the guards at the end of
+a step and the first stage of the next (the guards alone at the end of the last step,
+and a first stage of its own where ``t + h`` and the grid's ``t_next`` differ in their
+last bit). The event location's trial steps start from that same first stage.
 
 The compiled loop returns at the end of the step or at the first located event;
 :class:`CompiledFixedStep` then lets the Python model switch its mode (and say
@@ -162,14 +170,15 @@ def dense_solve(w_inv: np.ndarray, b: np.ndarray, data) -> np.ndarray:
 
 
 @jit_inline
-def _step(rhs, solve, method: int, t: float, x: np.ndarray, h: float, fac, data):
-    """One RK4 step, or one ROS2 step with the factors ``fac`` of ``I - g h J``."""
+def _step(rhs, solve, method: int, t: float, x: np.ndarray, h: float, fac, data, f0):
+    """One RK4 step, or one ROS2 step with the factors ``fac`` of ``I - g h J``, from
+    ``(t, x)`` where the derivative is ``f0`` (``rhs(t, x, data)``, evaluated already)."""
     if method == _RK4:
         # the stages' states written into one array (numpy's operations, element by
         # element: three arrays fewer to make per step)
         stage = np.empty_like(x)
         half = 0.5 * h
-        k1 = rhs(t, x, data)
+        k1 = f0
         for i in range(x.size):
             stage[i] = x[i] + half * k1[i]
         k2 = rhs(t + 0.5 * h, stage, data)
@@ -185,7 +194,7 @@ def _step(rhs, solve, method: int, t: float, x: np.ndarray, h: float, fac, data)
         return stage
     if x.size == 0:
         return x
-    k1 = solve(fac, rhs(t, x, data), data)
+    k1 = solve(fac, f0, data)
     k2 = solve(fac, rhs(t + h, x + h * k1, data) - 2.0 * k1, data)
     return x + h * (1.5 * k1 + 0.5 * k2)
 
@@ -215,12 +224,15 @@ def _stage_calls(method: int, x: np.ndarray) -> int:
 
 
 @jit_inline
-def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data):
+def advance_to_event(
+    rhs, guards, rhs_guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+):
     """:func:`advance_structured` with the ``dense_*`` linear algebra (every state
     differenced, ``I - g h J`` inverted): for the units of a few states."""
     return advance_structured(
         rhs,
         guards,
+        rhs_guards,
         project,
         dense_linearise,
         dense_unlinearised,
@@ -243,6 +255,7 @@ def advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, direction
 def advance_structured(
     rhs,
     guards,
+    rhs_guards,
     project,
     linearise,
     unlinearised,
@@ -263,7 +276,7 @@ def advance_structured(
 
     Parameters
     ----------
-    rhs, guards, project : compiled functions
+    rhs, guards, rhs_guards, project : compiled functions
         The unit's kernel (see the module docstring).
     linearise, unlinearised, factor, solve : compiled functions
         ROS2's linear algebra (see the module docstring), e.g. the ``dense_*`` functions.
@@ -302,13 +315,13 @@ def advance_structured(
         calls += evaluations
     w_h = math.nan
     fac = factor(jac, w_h, data)
-    g0 = guards(t, x, data)
+    f0, g0 = rhs_guards(t, x, data)  # the first stage and the guards: one evaluation
     no_fire = np.zeros(g0.size, dtype=np.bool_)
     while k < n:
         t_next = t0 + (t1 - t0) * (k + 1) / n
         h = t_next - t
         fac, w_h = _refactor(factor, method, jac, h, w_h, fac, data)
-        x1 = project(_step(rhs, solve, method, t, x, h, fac, data), data)
+        x1 = project(_step(rhs, solve, method, t, x, h, fac, data, f0), data)
         steps += 1
         calls += _stage_calls(method, x)
         if not _all_finite(x1):
@@ -316,17 +329,27 @@ def advance_structured(
         if g0.size == 0:
             t, x = t_next, x1
             k += 1
+            if k < n:
+                f0 = rhs(t, x, data)
             continue
-        g1 = guards(t + h, x1, data)
+        # the guards at the step's end and the next step's first stage: one evaluation,
+        # unless there is no next step or the grid's time differs from t + h
+        fused = k + 1 < n and t + h == t_next
+        if fused:
+            f1, g1 = rhs_guards(t + h, x1, data)
+        else:
+            f1, g1 = f0, guards(t + h, x1, data)
         if not any_fired(g0, g1, directions):
             t, x, g0 = t_next, x1, g1
             k += 1
+            if k < n:
+                f0 = f1 if fused else rhs(t, x, data)
             continue
         mask = _fired(g0, g1, directions)
         # Illinois regula falsi on the step fraction, for the earliest crossing
         lo, hi = 0.0, 1.0
         x_hi = x1
-        g_lo, g_hi = g0, guards(t + h, x1, data)
+        g_lo, g_hi = g0, g1
         frac_tol = tol / h
         side = 0
         for _ in range(_MAX_LOCATE_ITERATIONS):
@@ -340,7 +363,7 @@ def advance_structured(
                     theta = min(theta, est)
             theta = min(max(theta, lo + 0.05 * frac_tol), hi - 0.05 * frac_tol)
             fac, w_h = _refactor(factor, method, jac, theta * h, w_h, fac, data)
-            x_mid = project(_step(rhs, solve, method, t, x, theta * h, fac, data), data)
+            x_mid = project(_step(rhs, solve, method, t, x, theta * h, fac, data, f0), data)
             steps += 1
             calls += _stage_calls(method, x)
             if not _all_finite(x_mid):

@@ -440,6 +440,19 @@ def _rhs_of(result, x: np.ndarray, data):
 
 
 @jit
+def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
+    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one :func:`evaluate`.
+
+    Parameters
+    ----------
+    t, x, data
+        As :func:`rhs` takes them.
+    """
+    result = evaluate(t, x, data)
+    return _rhs_of(result, x, data)[0], _guards_of(result, x, data)
+
+
+@jit
 def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     """Friction links, slack/taut ropes, floor contact and rope break, each firing below zero.
 
@@ -587,6 +600,7 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     return advance_structured(
         rhs,
         guards,
+        rhs_guards,
         project,
         linearise,
         unlinearised,

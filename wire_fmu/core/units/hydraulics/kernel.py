@@ -44,6 +44,7 @@ from wire_fmu.core.units.hydraulics.kernel_hybrid import (
     project,
     report,
     rhs,
+    rhs_guards,
 )
 from wire_fmu.core.units.hydraulics.kernel_quiet_step import quiet_step, quiet_step_outputs
 
@@ -77,7 +78,9 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+    return advance_to_event(
+        rhs, guards, rhs_guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+    )
 
 
 resume = advance

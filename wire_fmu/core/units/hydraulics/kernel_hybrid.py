@@ -54,6 +54,7 @@ __all__ = [
     "report",
     "report_into",
     "rhs",
+    "rhs_guards",
 ]
 
 
@@ -109,6 +110,25 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     out = np.empty_like(x)
     derivative_into(out, point, acc, friction_loss, c)
     return out
+
+
+@jit
+def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
+    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one evaluation.
+
+    Parameters
+    ----------
+    t, x, data
+        As :func:`rhs` takes them.
+    """
+    c = cylinder(data)
+    point = evaluate(t, x, c)
+    acc, link, friction_loss = accelerate(point, c)
+    out = np.empty_like(x)
+    derivative_into(out, point, acc, friction_loss, c)
+    values = np.empty(guard_count(data[1]))
+    guards_into(values, point, acc, link, c)
+    return out, values
 
 
 @jit

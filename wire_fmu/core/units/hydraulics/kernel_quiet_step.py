@@ -19,10 +19,10 @@ with the same stage arithmetic element for element, but
 * every state is evaluated once: the guards at the end of a step, the first stage of the
   next and the report at the end of the communication step come from one evaluation, as
   do the limits, the Jacobian's base point, the first guards and the first stage at the
-  start (the shared loop evaluates the guards at ``t + h`` and the next step's first
-  stage at the grid's ``t_next``: with the interface model's rate the right-hand side
-  depends on time, and where the two differ in their last bit the first stage is
-  evaluated again at ``t_next``);
+  start (the shared loop shares the first two and the start's guards and first stage
+  too; where ``t + h`` and the grid's ``t_next`` differ in their last bit, both
+  evaluate the next first stage again at ``t_next``: with the interface model's rate the
+  right-hand side depends on time);
 * the products with ``(I - g h J)^-1`` go into those arrays (the same BLAS ``gemv``).
 
 The results are those of the shared loop to the last bit: the same numbers in the same

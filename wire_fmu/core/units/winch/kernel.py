@@ -296,9 +296,15 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
+    acc, brake = _dynamics(t, x, data)
+    return _derivative(t, x, data, acc, brake)
+
+
+@jit
+def _derivative(t: float, x: np.ndarray, data, acc: np.ndarray, brake: float) -> np.ndarray:
+    """:func:`rhs` from :func:`_dynamics`'s accelerations and brake torque at ``(t, x)``."""
     modes, inertia, _, damping, held = data
     n = inertia.size
-    acc, brake = _dynamics(t, x, data)
     out = np.empty_like(x)
     loss = 0.0
     for i in range(n):
@@ -329,6 +335,30 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     t, x, data
         Time (s), state and kernel data, as :func:`rhs` takes them.
     """
+    modes = data[0]
+    brake = 0.0
+    if modes[0] == 2 and modes[1] == 1 and modes[2] == 0:  # the only guard that needs it
+        brake = _dynamics(t, x, data)[1]
+    return _guards_of(x, data, brake)
+
+
+@jit
+def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
+    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one :func:`_dynamics`.
+
+    Parameters
+    ----------
+    t, x, data
+        Time (s), state and kernel data, as :func:`rhs` takes them.
+    """
+    acc, brake = _dynamics(t, x, data)
+    return _derivative(t, x, data, acc, brake), _guards_of(x, data, brake)
+
+
+@jit
+def _guards_of(x: np.ndarray, data, brake: float) -> np.ndarray:
+    """:func:`guards` at state ``x`` with the brake torque ``brake`` (N m) :func:`_dynamics`
+    gives there (read only while the brake holds the drum)."""
     modes, inertia, _, _, held = data
     n = inertia.size
     out = np.empty(modes[0] + modes[3])
@@ -336,7 +366,6 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
     if modes[0] == 2:
         if modes[1] == 1:
             if modes[2] == 0:
-                brake = _dynamics(t, x, data)[1]
                 against = held[7] if (-brake if brake != 0.0 else 1.0) > 0 else held[8]
                 out[0] = against - abs(brake)
             else:
@@ -451,7 +480,9 @@ def advance(method, t0, t1, n, k, t, x, directions, tol, data):
     method, t0, t1, n, k, t, x, directions, tol, data
         As :func:`~wire_fmu.core.framework.compiled_step.advance_to_event` takes them.
     """
-    return advance_to_event(rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data)
+    return advance_to_event(
+        rhs, guards, rhs_guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+    )
 
 
 @jit
@@ -503,7 +534,7 @@ def quiet_step(
     no_outputs = np.zeros(0)
     if resume:
         status, x, t, k, fired, steps, calls, h = advance_to_event(
-            rhs, guards, project, method, t0, t1, n, k, t, x, directions, tol, data
+            rhs, guards, rhs_guards, project, method, t0, t1, n, k, t, x, directions, tol, data
         )
         return status, x, t, k, fired, steps, calls, h, no_outputs, False
     if check_stick and guards(t0, x, data)[0] < 0.0:
@@ -517,7 +548,7 @@ def quiet_step(
         data = (modes, inertia, stiffness, damping, held)
         x = project(x, data)
     status, x, t, k, fired, steps, calls, h = advance_to_event(
-        rhs, guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
+        rhs, guards, rhs_guards, project, method, t0, t1, n, 0, t0, x, directions, tol, data
     )
     if status != STATUS_DONE:
         return status, x, t, k, fired, steps, calls, h, no_outputs, False
