@@ -44,6 +44,7 @@ jit = kernel_decorators(__file__).jit
 __all__ = [
     "breaks_away",
     "derivative_into",
+    "evaluate_into",
     "first_limit",
     "guard_count",
     "guards",
@@ -55,6 +56,7 @@ __all__ = [
     "report_into",
     "rhs",
     "rhs_guards",
+    "slope_into",
 ]
 
 
@@ -104,31 +106,45 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         ``(parameters, layout, held)`` (see :mod:`.kernel_arrays`).
     """
-    c = cylinder(data)
-    point = evaluate(t, x, c)
-    acc, _, friction_loss = accelerate(point, c)
     out = np.empty_like(x)
-    derivative_into(out, point, acc, friction_loss, c)
+    slope_into(t, x, out, cylinder(data))
     return out
 
 
 @jit
 def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
-    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one evaluation.
+    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one evaluation (:func:`evaluate_into`).
 
     Parameters
     ----------
     t, x, data
         As :func:`rhs` takes them.
     """
-    c = cylinder(data)
+    out = np.empty_like(x)
+    values = np.empty(guard_count(data[1]))
+    evaluate_into(t, x, out, values, cylinder(data))
+    return out, values
+
+
+@jit
+def slope_into(t: float, x: np.ndarray, out: np.ndarray, c: Cylinder) -> None:
+    """The state derivative at ``(t, x)`` into ``out`` (what :func:`rhs` returns)."""
+    point = evaluate(t, x, c)
+    acc, _, friction_loss = accelerate(point, c)
+    derivative_into(out, point, acc, friction_loss, c)
+
+
+@jit
+def evaluate_into(t: float, x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cylinder):
+    """Evaluate at ``(t, x)`` once: its derivative into ``slope``, its guards into ``values``.
+
+    Returns the point, the acceleration (m/s^2) and the seal force (N), for the report.
+    """
     point = evaluate(t, x, c)
     acc, link, friction_loss = accelerate(point, c)
-    out = np.empty_like(x)
-    derivative_into(out, point, acc, friction_loss, c)
-    values = np.empty(guard_count(data[1]))
+    derivative_into(slope, point, acc, friction_loss, c)
     guards_into(values, point, acc, link, c)
-    return out, values
+    return point, acc, link
 
 
 @jit

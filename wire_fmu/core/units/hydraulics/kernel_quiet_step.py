@@ -52,18 +52,16 @@ from wire_fmu.core.units.hydraulics.kernel_arrays import (
 )
 from wire_fmu.core.units.hydraulics.kernel_hybrid import (
     breaks_away,
-    derivative_into,
+    evaluate_into,
     first_limit,
     guard_count,
-    guards_into,
     hold,
     report_into,
+    slope_into,
 )
 from wire_fmu.core.units.hydraulics.kernel_physics import (
     Cylinder,
-    accelerate,
     cylinder,
-    evaluate,
     seal_stuck,
 )
 
@@ -82,27 +80,6 @@ communication step usually has two or three)."""
 
 
 @jit
-def _slope_into(t: float, x: np.ndarray, out: np.ndarray, c: Cylinder) -> None:
-    """The state derivative at ``(t, x)`` into ``out`` (what ``kernel_hybrid.rhs`` returns)."""
-    point = evaluate(t, x, c)
-    acc, _, friction_loss = accelerate(point, c)
-    derivative_into(out, point, acc, friction_loss, c)
-
-
-@jit
-def _evaluate_into(t: float, x: np.ndarray, slope: np.ndarray, values: np.ndarray, c: Cylinder):
-    """Evaluate at ``(t, x)`` once: its derivative into ``slope``, its guards into ``values``.
-
-    Returns the point, the acceleration (m/s^2) and the seal force (N), for the report.
-    """
-    point = evaluate(t, x, c)
-    acc, link, friction_loss = accelerate(point, c)
-    derivative_into(slope, point, acc, friction_loss, c)
-    guards_into(values, point, acc, link, c)
-    return point, acc, link
-
-
-@jit
 def _jacobian_into(jac, t, x, f0, probe, slope, c: Cylinder) -> None:
     """Forward-difference Jacobian at ``(t, x)`` with ``f0`` the slope there (``_jacobian``)."""
     n = x.size
@@ -110,7 +87,7 @@ def _jacobian_into(jac, t, x, f0, probe, slope, c: Cylinder) -> None:
         dx = 1e-7 * max(1.0, abs(x[j]))
         probe[:] = x
         probe[j] += dx
-        _slope_into(t, probe, slope, c)
+        slope_into(t, probe, slope, c)
         for i in range(n):
             jac[i, j] = (slope[i] - f0[i]) / dx
 
@@ -146,7 +123,7 @@ def _ros2_step(out, t, state, slope, h, w_inv, stage, k1, rest, k2, c: Cylinder)
     np.dot(w_inv, slope, k1)
     for i in range(n):
         stage[i] = state[i] + h * k1[i]
-    _slope_into(t + h, stage, rest, c)
+    slope_into(t + h, stage, rest, c)
     for i in range(n):
         rest[i] = rest[i] - 2.0 * k1[i]
     np.dot(w_inv, rest, k2)
@@ -161,13 +138,13 @@ def _rk4_step(out, t, state, slope, h, stage, k2, k3, k4, c: Cylinder) -> None:
     half = 0.5 * h
     for i in range(n):
         stage[i] = state[i] + half * slope[i]
-    _slope_into(t + 0.5 * h, stage, k2, c)
+    slope_into(t + 0.5 * h, stage, k2, c)
     for i in range(n):
         stage[i] = state[i] + half * k2[i]
-    _slope_into(t + 0.5 * h, stage, k3, c)
+    slope_into(t + 0.5 * h, stage, k3, c)
     for i in range(n):
         stage[i] = state[i] + h * k3[i]
-    _slope_into(t + h, stage, k4, c)
+    slope_into(t + h, stage, k4, c)
     sixth = h / 6.0
     for i in range(n):
         out[i] = state[i] + sixth * (slope[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -221,13 +198,13 @@ def quiet_step(method, t0, t1, n, x, directions, data):
     made = 0
     values = np.empty((2, guard_count(data[1])))
     g0, g1 = values[0], values[1]
-    point, acc, link = _evaluate_into(t0, x, slope, g0, c)
+    point, acc, link = evaluate_into(t0, x, slope, g0, c)
     if first_limit(g0, c) >= 0 or breaks_away(point.force, c):
         return False, x, nothing
     state[:] = x
     if seal_stuck(c):  # the rod is held where it stuck, at rest: evaluate it there
         hold(state, c)
-        point, acc, link = _evaluate_into(t0, state, slope, g0, c)
+        point, acc, link = evaluate_into(t0, state, slope, g0, c)
     if method == _ROS2:
         _jacobian_into(jac, t0, state, slope, stage, first, c)
     t = t0
@@ -248,11 +225,11 @@ def quiet_step(method, t0, t1, n, x, directions, data):
         hold(following, c)
         if not _finite(following):
             return False, x, nothing
-        point, acc, link = _evaluate_into(t + h, following, slope, g1, c)
+        point, acc, link = evaluate_into(t + h, following, slope, g1, c)
         if any_fired(g0, g1, directions):
             return False, x, nothing
         if t + h != t_next:  # the shared loop's next first stage is at the grid's time
-            _slope_into(t_next, following, slope, c)
+            slope_into(t_next, following, slope, c)
         state, following = following, state
         g0, g1 = g1, g0
         t = t_next
