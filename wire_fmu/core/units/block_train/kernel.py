@@ -68,12 +68,11 @@ from wire_fmu.core.framework import bordered_band
 from wire_fmu.core.framework.compiled import kernel_decorators
 from wire_fmu.core.framework.compiled_step import STATUS_DONE, STATUS_PYTHON, advance_structured
 from wire_fmu.core.units.block_train.kernel_friction import (
-    accelerations_into,
-    capacities,
     friction_data,
     link_guards,
     link_losses,
     loss_power,
+    stick_slip,
 )
 from wire_fmu.core.units.block_train.kernel_geometry import segment_lengths, span_geometry
 from wire_fmu.core.units.block_train.kernel_jacobian import coloured_jacobian
@@ -406,7 +405,7 @@ def rhs_parts(t: float, x: np.ndarray, data):
         for j in range(nd):
             p += tension[i] * jac[i, nb + j] * mover_v[j]
         span_power[i] = p
-    out, link_force = _rhs_of(result, x, data)
+    out, link_force, _ = _rhs_of(result, x, data)
     link_loss = np.zeros(link_force.size)
     link_losses(x, n, link_force, link_loss, data)
     return out, tension, result[15], span_power, jac, link_loss
@@ -415,7 +414,7 @@ def rhs_parts(t: float, x: np.ndarray, data):
 @jit
 def _rhs_of(result, x: np.ndarray, data):
     """:func:`rhs` from :func:`evaluate`'s ``result`` at state ``x``, and the link forces
-    (N; none without friction links)."""
+    and capacities (N; none without friction links)."""
     n = data[0][0]
     masses = data[2]
     forces, loss, power = result[0], result[11], result[12]
@@ -423,12 +422,11 @@ def _rhs_of(result, x: np.ndarray, data):
     for i in range(n):
         out[i] = x[n + i]
     if data[17].shape[0] == 0:
-        link_force = out[:0]  # no links, no forces: a view, nothing made
+        link_force = caps = out[:0]  # no links, no forces: a view, nothing made
         for i in range(n):
             out[n + i] = forces[i] / masses[i]
     else:
-        caps = capacities(result[1], data)
-        link_force = accelerations_into(out[n : 2 * n], forces, caps, masses, data)
+        caps, link_force = stick_slip(out[n : 2 * n], forces, result[1], masses, data)
         for i in data[24]:
             out[i] = 0.0
         loss = loss + loss_power(x, n, link_force, data)
@@ -436,12 +434,13 @@ def _rhs_of(result, x: np.ndarray, data):
     out[2 * n + 1] = power
     if not result[13]:
         out[:] = math.nan
-    return out, link_force
+    return out, link_force, caps
 
 
 @jit
 def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
-    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one :func:`evaluate`.
+    """:func:`rhs` and :func:`guards` at ``(t, x)`` from one :func:`evaluate` and one
+    solve of the friction links.
 
     Parameters
     ----------
@@ -449,7 +448,8 @@ def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
         As :func:`rhs` takes them.
     """
     result = evaluate(t, x, data)
-    return _rhs_of(result, x, data)[0], _guards_of(result, x, data)
+    out, link_force, caps = _rhs_of(result, x, data)
+    return out, _guards_with(result, x, data, caps, link_force)
 
 
 @jit
@@ -471,8 +471,22 @@ def guards(t: float, x: np.ndarray, data) -> np.ndarray:
 @jit
 def _guards_of(result, x: np.ndarray, data) -> np.ndarray:
     """:func:`guards` from :func:`evaluate`'s ``result`` at state ``x``."""
+    tension = result[1]
+    if data[17].shape[0] == 0:
+        return _guards_with(result, x, data, tension[:0], tension[:0])
+    scratch = np.empty(data[0][0])  # the accelerations, not needed here
+    caps, link_force = stick_slip(scratch, result[0], tension, data[2], data)
+    return _guards_with(result, x, data, caps, link_force)
+
+
+@jit
+def _guards_with(
+    result, x: np.ndarray, data, caps: np.ndarray, link_force: np.ndarray
+) -> np.ndarray:
+    """:func:`guards` from :func:`evaluate`'s ``result`` at state ``x`` and the friction
+    links' capacities and forces there (N; empty without links)."""
     breaking_load = data[1][2]
-    masses, blocks, taut, broken, contact = data[2], data[6], data[8], data[9], data[10]
+    blocks, taut, broken, contact = data[6], data[8], data[9], data[10]
     tension, trial, elastic, depth, trial_contact = (
         result[1],
         result[2],
@@ -483,9 +497,6 @@ def _guards_of(result, x: np.ndarray, data) -> np.ndarray:
     n_links, n_spans, nb = data[17].shape[0], tension.size, depth.size
     out = np.empty(n_links + 2 * n_spans + nb)
     if n_links:
-        caps = capacities(tension, data)
-        scratch = np.empty(data[0][0])  # the accelerations, not needed here
-        link_force = accelerations_into(scratch, result[0], caps, masses, data)
         link_guards(x, data[0][0], link_force, caps, out, data)
     for i in range(n_spans):
         if broken[i]:

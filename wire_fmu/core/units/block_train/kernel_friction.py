@@ -38,12 +38,11 @@ from wire_fmu.core.framework.compiled import kernel_decorators
 jit = kernel_decorators(__file__).jit
 
 __all__ = [
-    "accelerations_into",
-    "capacities",
     "friction_data",
     "link_guards",
     "link_losses",
     "loss_power",
+    "stick_slip",
 ]
 
 GROUND = -1
@@ -71,30 +70,9 @@ def friction_data(model) -> tuple:
 
 
 @jit
-def capacities(tension: np.ndarray, data) -> np.ndarray:
-    """Holding capacity of every link from the tensions of its two spans, N.
-
-    Parameters
-    ----------
-    tension : numpy.ndarray
-        Span tensions, N.
-    data : tuple
-        The kernel's tuple (see the module docstring).
-    """
-    index, params = data[17], data[18]
-    caps = np.empty(index.shape[0])
-    for k in range(index.shape[0]):
-        t_in = tension[index[k, 2]]
-        t_out = tension[index[k, 3]]
-        caps[k] = params[k, 0] + params[k, 1] * (t_in + t_out) + params[k, 2] * min(t_in, t_out)
-    return caps
-
-
-@jit
-def accelerations_into(
-    acc: np.ndarray, forces: np.ndarray, caps: np.ndarray, masses: np.ndarray, data
-) -> np.ndarray:
-    """Accelerations (m/s^2) into ``acc``, and the link forces (N), in the present modes.
+def stick_slip(acc: np.ndarray, forces: np.ndarray, tension: np.ndarray, masses: np.ndarray, data):
+    """The links' capacities and forces (N), and the accelerations (m/s^2) into ``acc``, in
+    the present modes, with one array made for all the scratch they need.
 
     Parameters
     ----------
@@ -103,8 +81,8 @@ def accelerations_into(
         derivative, or scratch), m/s^2.
     forces : numpy.ndarray
         All forces on the coordinates but the links' friction, N.
-    caps : numpy.ndarray
-        Link capacities from :func:`capacities`, N.
+    tension : numpy.ndarray
+        Span tensions, N.
     masses : numpy.ndarray
         Mass of each coordinate, kg.
     data : tuple
@@ -112,15 +90,46 @@ def accelerations_into(
 
     Returns
     -------
-    numpy.ndarray
-        The force of each link, N.
+    tuple of numpy.ndarray
+        The holding capacity of every link and the force of every link, N.
     """
+    n_links, n = data[17].shape[0], forces.size
+    # each array made costs more than the sums it holds: one for the four
+    work = np.empty(2 * n_links + 2 * n)
+    caps, link_force = work[:n_links], work[n_links : 2 * n_links]
+    total, required = work[2 * n_links : 2 * n_links + n], work[2 * n_links + n :]
+    _capacities_into(caps, tension, data)
+    _accelerations_into(acc, link_force, total, required, forces, caps, masses, data)
+    return caps, link_force
+
+
+@jit
+def _capacities_into(caps: np.ndarray, tension: np.ndarray, data) -> None:
+    """Holding capacity of every link from the tensions of its two spans into ``caps``, N."""
+    index, params = data[17], data[18]
+    for k in range(index.shape[0]):
+        t_in = tension[index[k, 2]]
+        t_out = tension[index[k, 3]]
+        caps[k] = params[k, 0] + params[k, 1] * (t_in + t_out) + params[k, 2] * min(t_in, t_out)
+
+
+@jit
+def _accelerations_into(
+    acc: np.ndarray,
+    link_force: np.ndarray,
+    total: np.ndarray,
+    required: np.ndarray,
+    forces: np.ndarray,
+    caps: np.ndarray,
+    masses: np.ndarray,
+    data,
+) -> None:
+    """Accelerations (m/s^2) into ``acc`` and the link forces (N) into ``link_force``, in
+    the present modes (``total`` and ``required``: scratch, one entry per coordinate)."""
     index, mode, clusters, members, edges = data[17], data[19], data[20], data[21], data[22]
-    rows = np.empty((2, forces.size))  # one array for both: each made costs more than its sums
-    total, required = rows[0], rows[1]
     total[:] = forces
     required[:] = 0.0
-    link_force = np.zeros(index.shape[0])
+    link_force[:] = 0.0
     for k in range(index.shape[0]):
         if mode[k] != 0:
             f = -mode[k] * caps[k]
@@ -151,7 +160,6 @@ def accelerations_into(
             link_force[k] = carried if index[k, 0] == child else -carried
             if parent != GROUND:
                 required[parent] += carried
-    return link_force
 
 
 @jit
