@@ -204,6 +204,13 @@ def held_motion(held: np.ndarray, port: int, mover: bool, nd: int, dt: float) ->
 
 
 @jit
+def _row(rows: np.ndarray, start: int, length: int, i: int) -> np.ndarray:
+    """Row ``i`` of the block of rows of ``length`` entries from ``start`` in ``rows``:
+    ``rows[start:].reshape((-1, length))[i]`` as a slice."""
+    return rows[start + i * length : start + (i + 1) * length]
+
+
+@jit
 def evaluate(t: float, x: np.ndarray, data):
     """Forces, tensions, energies and guard inputs at ``(t, x)``.
 
@@ -236,33 +243,34 @@ def evaluate(t: float, x: np.ndarray, data):
     dt = t - held[0]
     # one array of rows rather than a score of small arrays (each costs more to make and
     # free than its arithmetic), in four blocks: per body, per rope coordinate, per span,
-    # per block
+    # per block; each row a slice of it (a reshape is a call into numba's runtime)
     nbd, nf = nb + nd, n + N_LINES
     rows = np.zeros(3 * nbd + 3 * nf + 11 * n_spans + 2 * nb)
     at_flows, at_spans = 3 * nbd, 3 * (nbd + nf)
     at_contacts = at_spans + 11 * n_spans
-    bodies = rows[:at_flows].reshape((3, nbd))
-    y, ydot, body_force = bodies[0], bodies[1], bodies[2]
+    y, ydot, body_force = _row(rows, 0, nbd, 0), _row(rows, 0, nbd, 1), _row(rows, 0, nbd, 2)
     for j in range(nb):
         y[j] = x[j]
         ydot[j] = x[n + j]
     for j in range(nd):
         y[nb + j], ydot[nb + j] = held_motion(held, j, True, nd, dt)
-    flows = rows[at_flows:at_spans].reshape((3, nf))
-    flow_q, flow_v, generalised = flows[0], flows[1], flows[2]
+    flow_q, flow_v = _row(rows, at_flows, nf, 0), _row(rows, at_flows, nf, 1)
+    generalised = _row(rows, at_flows, nf, 2)
     for i in range(n):
         flow_q[i] = x[i]
         flow_v[i] = x[n + i]
     for i in range(N_LINES):
         flow_q[n + i], flow_v[n + i] = held_motion(held, i, False, nd, dt)
-    spans = rows[at_spans:at_contacts].reshape((11, n_spans))
-    big_l_rate, small_l, small_l_rate, stretch_of = spans[1], spans[2], spans[3], spans[4]
-    tension, trial, elastic = spans[5], spans[6], spans[7]
-    on_unstretched, energy, span_loss = spans[8], spans[9], spans[10]
+    big_l_rate, small_l = _row(rows, at_spans, n_spans, 1), _row(rows, at_spans, n_spans, 2)
+    small_l_rate = _row(rows, at_spans, n_spans, 3)
+    stretch_of, tension = _row(rows, at_spans, n_spans, 4), _row(rows, at_spans, n_spans, 5)
+    trial, elastic = _row(rows, at_spans, n_spans, 6), _row(rows, at_spans, n_spans, 7)
+    on_unstretched = _row(rows, at_spans, n_spans, 8)
+    energy, span_loss = _row(rows, at_spans, n_spans, 9), _row(rows, at_spans, n_spans, 10)
     if sizes[3]:
         big_l, jac, ok = span_geometry(y, data)
     else:
-        big_l, jac, ok = spans[0], jac0, True
+        big_l, jac, ok = _row(rows, at_spans, n_spans, 0), jac0, True
         _matvec_into(big_l, jac0, y)
         for i in range(n_spans):
             big_l[i] = len0[i] + big_l[i]
@@ -304,8 +312,7 @@ def evaluate(t: float, x: np.ndarray, data):
     _flow_vecmat_into(generalised, on_unstretched, flow_columns, flow_values)
     forces = generalised[:n]  # the line ends' part is read as it is, below
     potential = 0.0
-    contacts = rows[at_contacts:].reshape((2, nb))
-    depth, trial_contact = contacts[0], contacts[1]
+    depth, trial_contact = _row(rows, at_contacts, nb, 0), _row(rows, at_contacts, nb, 1)
     for j in range(nb):
         weight = blocks[j, 0]
         forces[j] += body_force[j] + weight
