@@ -250,9 +250,17 @@ def rope_tension(t: float, x: np.ndarray, data) -> float:
 @jit
 def _dynamics(t: float, x: np.ndarray, data):
     """Accelerations (rad/s^2) and the brake torque on the drum (N m) in the present mode."""
+    acc = np.empty(data[1].size)
+    return acc, _dynamics_into(acc, t, x, data)
+
+
+@jit
+def _dynamics_into(acc: np.ndarray, t: float, x: np.ndarray, data) -> float:
+    """Accelerations into ``acc`` (rad/s^2; a derivative's rows, or scratch), and the brake
+    torque on the drum (N m), in the present mode."""
     modes, inertia, stiffness, damping, held = data
     n = inertia.size
-    forces = np.empty(n)
+    forces = acc  # the torques, divided in place: no array made
     if n > 1:
         for i in range(n):
             total = 0.0
@@ -273,14 +281,13 @@ def _dynamics(t: float, x: np.ndarray, data):
         brake = -mode * (held[7] if mode > 0 else held[8])
         forces[n - 1] += brake
     drum_torque = forces[n - 1]
-    acc = forces  # divided in place: one array made per call, not three
     for i in range(n - 1):
         acc[i] = forces[i] / inertia[i]
     acc[n - 1] = drum_torque / drum_mass
     if engaged and mode == 0:
         acc[n - 1] = 0.0
         brake = -drum_torque
-    return acc, brake
+    return brake
 
 
 @jit
@@ -296,20 +303,21 @@ def rhs(t: float, x: np.ndarray, data) -> np.ndarray:
     data : tuple
         See the module docstring.
     """
-    acc, brake = _dynamics(t, x, data)
-    return _derivative(t, x, data, acc, brake)
+    out = np.empty_like(x)
+    n = data[1].size
+    brake = _dynamics_into(out[n : 2 * n], t, x, data)
+    return _derivative_into(out, t, x, data, brake)
 
 
 @jit
-def _derivative(t: float, x: np.ndarray, data, acc: np.ndarray, brake: float) -> np.ndarray:
-    """:func:`rhs` from :func:`_dynamics`'s accelerations and brake torque at ``(t, x)``."""
+def _derivative_into(out: np.ndarray, t: float, x: np.ndarray, data, brake: float) -> np.ndarray:
+    """:func:`rhs` into ``out``, whose accelerations' rows :func:`_dynamics_into` wrote, with
+    the brake torque (N m) it gave at ``(t, x)``."""
     modes, inertia, _, damping, held = data
     n = inertia.size
-    out = np.empty_like(x)
     loss = 0.0
     for i in range(n):
         out[i] = x[n + i]
-        out[n + i] = acc[i]
         row = 0.0
         for j in range(n):
             row += x[n + j] * damping[j, i]
@@ -351,8 +359,10 @@ def rhs_guards(t: float, x: np.ndarray, data) -> tuple:
     t, x, data
         Time (s), state and kernel data, as :func:`rhs` takes them.
     """
-    acc, brake = _dynamics(t, x, data)
-    return _derivative(t, x, data, acc, brake), _guards_of(x, data, brake)
+    out = np.empty_like(x)
+    n = data[1].size
+    brake = _dynamics_into(out[n : 2 * n], t, x, data)
+    return _derivative_into(out, t, x, data, brake), _guards_of(x, data, brake)
 
 
 @jit
