@@ -93,20 +93,38 @@ def stick_slip(acc: np.ndarray, forces: np.ndarray, tension: np.ndarray, masses:
     tuple of numpy.ndarray
         The holding capacity of every link and the force of every link, N.
     """
-    n_links, n = data[17].shape[0], forces.size
+    index, params, mode, clusters, members, edges = data[17:23]
+    n_links, n = index.shape[0], forces.size
     # each array made costs more than the sums it holds: one for the four
     work = np.empty(2 * n_links + 2 * n)
     caps, link_force = work[:n_links], work[n_links : 2 * n_links]
     total, required = work[2 * n_links : 2 * n_links + n], work[2 * n_links + n :]
-    _capacities_into(caps, tension, data)
-    _accelerations_into(acc, link_force, total, required, forces, caps, masses, data)
+    # the callees take the arrays they read, not the tuple: a call that is not inlined
+    # passes every array of its arguments
+    _capacities_into(caps, tension, index, params)
+    _accelerations_into(
+        acc,
+        link_force,
+        total,
+        required,
+        forces,
+        caps,
+        masses,
+        index,
+        mode,
+        clusters,
+        members,
+        edges,
+    )
     return caps, link_force
 
 
 @jit
-def _capacities_into(caps: np.ndarray, tension: np.ndarray, data) -> None:
-    """Holding capacity of every link from the tensions of its two spans into ``caps``, N."""
-    index, params = data[17], data[18]
+def _capacities_into(
+    caps: np.ndarray, tension: np.ndarray, index: np.ndarray, params: np.ndarray
+) -> None:
+    """Holding capacity of every link from the tensions of its two spans into ``caps``, N
+    (``index`` and ``params``: the module docstring's 17 and 18)."""
     for k in range(index.shape[0]):
         t_in = tension[index[k, 2]]
         t_out = tension[index[k, 3]]
@@ -122,11 +140,15 @@ def _accelerations_into(
     forces: np.ndarray,
     caps: np.ndarray,
     masses: np.ndarray,
-    data,
+    index: np.ndarray,
+    mode: np.ndarray,
+    clusters: np.ndarray,
+    members: np.ndarray,
+    edges: np.ndarray,
 ) -> None:
     """Accelerations (m/s^2) into ``acc`` and the link forces (N) into ``link_force``, in
-    the present modes (``total`` and ``required``: scratch, one entry per coordinate)."""
-    index, mode, clusters, members, edges = data[17], data[19], data[20], data[21], data[22]
+    the present modes (``total`` and ``required``: scratch, one entry per coordinate;
+    ``index`` to ``edges``: the module docstring's 17 and 19 to 22)."""
     total[:] = forces
     required[:] = 0.0
     link_force[:] = 0.0
