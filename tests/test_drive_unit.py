@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -291,6 +292,45 @@ def test_configuration_problems_are_all_reported():
                 }
             }
         )
+
+
+@pytest.mark.parametrize(
+    ("drive", "kept"),
+    [(default_multimass_drive(), "2..4"), (two_motor_drive(), "4 (a branched")],
+    ids=["chain", "two motors"],
+)
+def test_more_masses_kept_than_the_drive_has_is_refused_with_the_range(drive, kept):
+    with pytest.raises(ConfigurationError) as info:
+        make_drive({"drive": drive, "masses_kept": 99})
+    text = str(info.value)
+    assert "MultiMassDrive 'drive'" in text and "parameter 'masses_kept'" in text
+    assert f"keep {kept}" in text and "got 99" in text
+    assert make_drive({"masses_kept": 4}).model.n == 4  # every mass kept: the full drive
+
+
+@pytest.mark.parametrize(
+    ("values", "named"),
+    [
+        ({"initial_speed": 1e300}, ["parameter 'initial_speed' = 1e+300 rad/s"]),
+        ({"motor.torque": 1e308}, ["input 'motor.torque' = 1e+308 N.m"]),
+        (
+            {"initial_speed": 1e200, "motor.torque": 1e308},
+            ["parameter 'initial_speed' = 1e+200 rad/s", "input 'motor.torque' = 1e+308 N.m"],
+        ),
+    ],
+)
+def test_a_start_too_large_for_the_drive_is_named_without_numpy_warnings(values, named):
+    unit = DriveUnit("drive")
+    unit.values["effects"] = ""
+    unit.configure()
+    unit.values.update(values)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a numpy RuntimeWarning would fail here
+        with pytest.raises(ConfigurationError) as info:
+            unit.initialize(0.0)
+    text = str(info.value)
+    assert "MultiMassDrive 'drive'" in text and "start state" in text
+    assert all(name in text for name in named)
 
 
 def test_declarations_and_feedthrough():

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from wire_fmu.master.run import run_scene
+from wire_fmu.master.run import SCENE_DIR, run_scene
+from wire_fmu.master.scene import SceneError
 
 from .hostile_scene_helpers import (
     CYL,
@@ -33,6 +34,8 @@ from .hostile_scene_helpers import (
 
 pytestmark = pytest.mark.integration
 
+MULTIMASS = SCENE_DIR / "multimass_drive.toml"
+
 
 @pytest.fixture(scope="module")
 def fmu_dir(tmp_path_factory) -> Path:
@@ -46,11 +49,12 @@ def fmu_dir(tmp_path_factory) -> Path:
         ('initial_equilibrium = "false"', "initial_equilibrium", "true or false"),
         ("initial_equilibrium = 1", "initial_equilibrium", "true or false"),
         ('initial_position = "1.9"', "initial_position", "a number"),
-        ("initial_position = true", "initial_position", "a number"),
+        ("initial_position = true", "initial_position", "a number (Real), got a boolean"),
         ("initial_position = nan", "initial_position", "finite"),
         ("initial_position = inf", "initial_position", "must lie in"),  # the unit says
         ("initial_position = 1e999", "initial_position", "must lie in"),
-        ("initial_position = [1.0, 2.0]", "initial_position", "a number"),
+        ("initial_position = [1.0, 2.0]", "initial_position", "a number (Real), got a list"),
+        ("initial_position = { at = 1.9 }", "initial_position", "a number (Real), got a table"),
     ],
 )
 def test_a_parameter_of_the_wrong_type_is_named_with_its_type(
@@ -261,6 +265,44 @@ def test_problems_in_five_places_come_out_together_each_once(tmp_path, fmu_dir):
         ("event", "rope.break_segment"),
     ):
         only(problems, *words)
+
+
+def test_a_units_own_problems_come_out_with_its_parameter_of_the_wrong_type(tmp_path, fmu_dir):
+    """The unit is checked without the value it cannot take, and says the rest."""
+    full = "[units.full.parameters]\n"
+    path = variant(
+        tmp_path,
+        MULTIMASS,
+        replace={
+            f"{full}motor_slope = 25.6": f'{full}motor_slope = "abc"\nsolver_rtol = 5.0',
+            "masses_kept = 3": "masses_kept = 1",
+        },
+        sections={"[units.full.parameters]": 'solver = "rk5"'},
+    )
+    problems = problems_of(path, fmu_dir)
+    own = only(problems, "unit 'full'", "solver 'rk5' is unknown", "solver_rtol")
+    assert "found with 'motor_slope' left out" in own
+    only(problems, "unit 'full'", "parameter 'motor_slope' = 'abc'", "got text")
+    only(problems, "unit 'reduced3'", "masses_kept")
+    assert len(problems) == 3
+
+
+def test_run_lists_the_scenes_problems_with_those_its_units_find(tmp_path, fmu_dir):
+    """An unknown unit no longer hides a misspelt variable of a known one from ``run``."""
+    path = variant(
+        tmp_path,
+        MULTIMASS,
+        replace={'"full.load.torque" = 201.0,': '"full.load.torqe" = 201.0, "nounit.x" = 1.0,'},
+        append='\n[[connections]]\nfrom = "full.load.sped"\nto = "ghost.load.torque"\n',
+    )
+    with pytest.raises(SceneError) as caught:
+        run_scene(path, tmp_path / "out", fmu_dir=fmu_dir, stop_time=0.1)
+    problems = caught.value.problems
+    only(problems, "nounit.x names no unit 'nounit'")
+    only(problems, "full.load.torqe", "no variable 'load.torqe'")
+    only(problems, "ghost.load.torque names no unit 'ghost'")
+    only(problems, "full.load.sped", "no variable 'load.sped'")
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize(

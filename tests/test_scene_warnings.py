@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import textwrap
 from pathlib import Path
 
@@ -137,3 +138,38 @@ def test_a_setting_equal_to_its_declared_default_asks_for_nothing_and_is_not_war
     warnings = inactive_settings(load_scene_file(path))
     assert not [w for w in warnings if "damping" in w or "efficiency" in w]
     assert [w for w in warnings if "'sheaves.<name>.inertia' (crown)" in w]
+
+
+def test_an_event_after_the_stop_time_is_a_warning_check_prints_and_run_records(tmp_path, capsys):
+    path = _scene(tmp_path, ["drum_inertia", "band_brake", "rope_layers"], [])
+    text = path.read_text(encoding="utf-8").replace("time = 0.02", "time = 0.5")
+    path.write_text(text, encoding="utf-8")
+    said = "event 'brake on' at 0.5 s is after the run's stop time, 0.05 s; it will not happen"
+    assert main(["check", str(path)]) == 0
+    assert f"warning: {said}" in capsys.readouterr().out.splitlines()
+    assert main(["run", str(path), "-q", "-o", str(tmp_path / "out")]) == 0
+    meta = json.loads((tmp_path / "out" / "metadata.json").read_text(encoding="utf-8"))
+    assert said in [w["message"] for w in meta["warnings"] if w["level"] == "warning"]
+
+
+def test_an_input_its_units_parameters_leave_without_influence_is_named(tmp_path):
+    """A driver on the handle torque of a jack whose handle_drive is "speed" (it follows
+    handle.speed_command): the parameter that silences the input is named."""
+    text = shipped_scenes()["scissor_jack"].read_text(encoding="utf-8")
+    text = text.replace('target = "self_locking.', 'target = "lift.')
+    text = text.replace(
+        'handle_drive = "torque"', 'handle_drive = "torque"\ninitial_handle_speed = 1.0'
+    )
+    text = text.replace(
+        'handle_drive = "speed"', 'handle_drive = "speed"\ninitial_handle_speed = 2.0', 1
+    )
+    path = tmp_path / "jack.toml"
+    path.write_text(text, encoding="utf-8")
+    warnings = inactive_settings(load_scene_file(path))
+    (driven,) = [w for w in warnings if "'handle.torque_command'" in w]
+    assert driven.startswith("unit 'lift': input 'handle.torque_command' (set by driver ")
+    assert 'no influence with handle_drive = "speed"' in driven
+    assert 'it acts only with handle_drive = "torque"; change handle_drive' in driven
+    (start,) = [w for w in warnings if "'initial_handle_speed'" in w]
+    assert start.startswith("unit 'lift': parameter 'initial_handle_speed'")
+    assert len(warnings) == 2

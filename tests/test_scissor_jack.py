@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -264,6 +265,27 @@ def test_bad_parameters_are_all_reported():
     text = str(info.value)
     for word in ("nonsense", "pedal", "glue", "initial_height"):
         assert word in text
+
+
+@pytest.mark.parametrize("initial", [{}, {"initial_height": 0.15}], ids=["default", "0.15 m"])
+def test_ends_of_travel_the_wrong_way_round_are_named_not_the_initial_height(initial):
+    with pytest.raises(ConfigurationError) as info:
+        make_jack(min_height=0.2, max_height=0.1, **initial)
+    text = str(info.value)
+    assert "min_height 0.2 m must be below max_height 0.1 m" in text
+    assert "initial_height" not in text
+    with pytest.raises(ConfigurationError, match=r"initial_height 0.05 m must lie within"):
+        make_jack(min_height=0.1, max_height=0.2, initial_height=0.05)
+
+
+def test_a_speed_command_past_the_whole_travel_in_one_step_is_named():
+    unit = make_jack(handle_drive="speed", **{"handle.speed_command": 1.0e6})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a numpy RuntimeWarning would fail here
+        result = unit.advance(0.0, 0.01)
+    assert not result.success
+    assert "handle.speed_command = 1e+06 rad/s" in result.message
+    assert "beyond the jack's whole travel" in result.message
 
 
 def test_end_of_travel_refuses_the_step():

@@ -134,8 +134,9 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a scene and initialise its units as a run would; exit 1 listing every problem.
 
-    Settings the scene's effects leave without influence, and bonds that cannot give the
-    interface model ``run.interface_models`` asks for, are warnings (exit 0).
+    Settings the scene's effects leave without influence, bonds that cannot give the
+    interface model ``run.interface_models`` asks for, and events after the stop time are
+    warnings (exit 0).
 
     Parameters
     ----------
@@ -148,7 +149,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         Exit status: 0 on success.
     """
     from wire_fmu.master.run import check_scene
-    from wire_fmu.master.scene import interface_warnings
+    from wire_fmu.master.scene import interface_warnings, late_event_warnings
     from wire_fmu.unit_reference.scene_warnings import inactive_settings
 
     scene = check_scene(args.scene, args.fmu_dir)
@@ -158,7 +159,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         f"scene {scene.name!r}: no problems ({plural(len(scene.units), 'unit')}, "
         f"{bonds}, {plural(len(scene.connections), 'connection')})"
     )
-    for warning in inactive_settings(scene) + interface_warnings(scene):
+    warnings = inactive_settings(scene) + interface_warnings(scene) + late_event_warnings(scene)
+    for warning in warnings:
         _print(f"warning: {warning}")
     return 0
 
@@ -363,14 +365,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     """
     from wire_fmu.master.run import find_scene
     from wire_fmu.master.scene import load_scene
-    from wire_fmu.sweep import load_sweep_spec, run_sweep
+    from wire_fmu.sweep import load_sweep, run_sweep
 
     if not args.verbose:  # a local cluster's scheduler runs here and logs every event
         import distributed  # noqa: F401 - sets its loggers' levels on import; then quieten
 
         logging.getLogger("distributed").setLevel(logging.WARNING)
     scene = load_scene(find_scene(args.scene))
-    spec = load_sweep_spec(args.spec)
+    spec = load_sweep(scene, args.spec, args.fmu_dir)
     out = args.output or Path("results") / "sweeps" / f"{scene.name}_{spec.name}"
     try:
         result = run_sweep(

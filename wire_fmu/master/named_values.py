@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from .unit_errors import UnitFailedError
@@ -117,6 +117,34 @@ class NamedValues:
 
 
 _INT32 = (-(2**31), 2**31 - 1)
+_KINDS = (
+    (bool, "a boolean"),
+    (int | float, "a number"),
+    (str, "text"),
+    (list, "a list"),
+    (Mapping, "a table"),
+)
+"""What a value of a scene file is, as the problems name it (a boolean before the numbers)."""
+
+
+def _value_kind(value: Any) -> str:
+    """What ``value`` is, as a scene file writes it: ``"a list"``, ``"a table"``, ``"text"``.
+
+    Parameters
+    ----------
+    value : object
+        A value as TOML reads it (or as a Python caller passes it).
+
+    Returns
+    -------
+    str
+        ``"a boolean"``, ``"a number"``, ``"text"``, ``"a list"``, ``"a table"``, else the
+        type's name.
+    """
+    for kind, words in _KINDS:
+        if isinstance(value, kind):
+            return words
+    return type(value).__name__
 
 
 def value_problem(variable, value) -> str | None:
@@ -140,7 +168,7 @@ def value_problem(variable, value) -> str | None:
     kind = variable.type
     if kind == "Real":
         if isinstance(value, bool) or not isinstance(value, int | float):
-            return f"expected a number (Real), got {type(value).__name__}"
+            return f"expected a number (Real), got {_value_kind(value)}"
         if value != value or (variable.causality == "input" and not math.isfinite(value)):
             return "expected a finite number (Real)"
         if isinstance(value, int) and abs(value) > 1.7976931348623157e308:
@@ -152,7 +180,7 @@ def value_problem(variable, value) -> str | None:
             return f"outside the 32-bit range of an {kind} ({_INT32[0]} to {_INT32[1]})"
     elif kind == "Boolean":
         if not isinstance(value, bool):
-            return f"expected true or false (Boolean), got {type(value).__name__} {value!r}"
+            return f"expected true or false (Boolean), got {_value_kind(value)} {value!r}"
     elif kind == "String" and not isinstance(value, str):
-        return f"expected text (String), got {type(value).__name__}"
+        return f"expected text (String), got {_value_kind(value)}"
     return None

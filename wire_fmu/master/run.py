@@ -22,7 +22,7 @@ from .catalog import DEFAULT_FMU_DIR
 from .observers import FLUSH_EVERY, CsvRecorder, Progress
 from .results_frame import IncompleteResultsWarning, ResultsError, read_results_frame
 from .run_result import RunResult
-from .scene import Scene, SceneError, read_scene
+from .scene import Scene, SceneError, late_event_warnings, read_scene
 from .simulation import Simulation
 from .validate import validate_scene
 
@@ -260,14 +260,22 @@ def run_scene(
     Outcome
         The scene run, its result, the results folder and files, the simulation.
     """
+    problems: list[str] = []
     if not isinstance(scene, Scene):
-        scene = load_scene_file(find_scene(scene))
+        path = find_scene(scene)
+        scene, problems = read_scene_file(path)
+        if scene is None:
+            raise SceneError(str(path), problems)
     if run_overrides:
-        scene = with_run_settings(scene, **run_overrides)
+        scene, problems = _with_overrides(scene, run_overrides, problems)
+    if problems:  # with the problems the units find, before a results folder is made
+        validate_scene(scene, Path(fmu_dir), problems=problems)  # raises: there are problems
     directory = Path(results) if results else Path("results") / scene.name
     make_results_folder(directory)
     with WarningLog() as said:
         structure = validate_scene(scene, Path(fmu_dir))
+        for warning in late_event_warnings(scene):
+            logger.warning("%s", warning)
         recorder = CsvRecorder(directory, scene.run.output_interval, flush_every)
         chain = [recorder, *observers] + ([Progress()] if progress else [])
         sim = Simulation(scene, structure, chain)
@@ -277,6 +285,14 @@ def run_scene(
             outcome.plots = _plots(scene, recorder.csv_path, directory)
     note_warnings(recorder.meta_path, said.messages)
     return outcome
+
+
+def _with_overrides(scene: Scene, overrides: dict, problems: list[str]) -> tuple[Scene, list[str]]:
+    """:func:`with_run_settings`, its problems added to ``problems`` (the scene's own kept)."""
+    try:
+        return with_run_settings(scene, **overrides), problems
+    except SceneError as err:
+        return scene, problems + err.problems
 
 
 class WarningLog(logging.Handler):

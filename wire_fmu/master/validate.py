@@ -15,9 +15,10 @@ effect) are reported too — through FMI only.
 
 from __future__ import annotations
 
+import json
 import logging
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -349,11 +350,7 @@ def _other_problems(scene: Scene, structure: Structure) -> list[str]:
             if ref is not None:
                 p = _variable_problem(structure, ref, "input", "driver target")
                 problems += [p] if p else []
-    for e in scene.events:
-        if e.time > scene.run.stop_time:  # a shortened run simply ends before it
-            logger.info(
-                "event %r at %g s is after the stop time; it will not happen", e.label, e.time
-            )
+    for e in scene.events:  # one after the stop time is a warning (late_event_warnings)
         for ref in e.values:
             p = _variable_problem(structure, ref, "input", f"event {e.label!r} sets")
             problems += [p] if p else []
@@ -392,21 +389,39 @@ def _other_problems(scene: Scene, structure: Structure) -> list[str]:
 
 def _parameter_problems(name: str, spec, structure: Structure) -> list[str]:
     """Parameters a unit does not have, or values of the wrong type for it."""
+    return list(_refused_parameters(name, spec, structure).values())
+
+
+def _refused_parameters(name: str, spec, structure: Structure) -> dict[str, str]:
+    """Each parameter (or start input) the scene gives unit ``name`` that its FMU cannot
+    take, by name, with the problem that says why."""
     md = structure.descriptions[name]
     params = {v.name: v for v in md.modelVariables if v.causality in ("parameter", "input")}
-    problems = []
-    for key, value in spec.parameter_values().items():
+    refused = {}
+    for key, value in spec.parameters.items():
         if key not in params:
-            problems.append(f"unit {name!r}: no parameter {key!r}")
+            refused[key] = f"unit {name!r}: no parameter {key!r}"
             continue
-        problem = value_problem(params[key], value)
+        problem = _start_value_problem(params[key], value)
         if problem:
-            problems.append(f"unit {name!r}: parameter {key!r} = {_short(value)}: {problem}")
-    return problems
+            refused[key] = f"unit {name!r}: parameter {key!r} = {_short(value)}: {problem}"
+    return refused
+
+
+def _start_value_problem(variable, value) -> str | None:
+    """:func:`value_problem` of a value as the scene gives it: a table or a list is passed
+    to a String parameter as JSON, and is no number, whole number or boolean."""
+    if variable.type != "String" or not isinstance(value, Mapping | list):
+        return value_problem(variable, value)
+    try:
+        json.dumps(value)
+    except (TypeError, ValueError) as err:  # a TOML date or time: JSON has none
+        return f"a table or list is passed as JSON text, which has no dates or times ({err})"
+    return None
 
 
 def _short(value) -> str:
-    text = repr(value)
+    text = str(value).lower() if isinstance(value, bool) else repr(value)  # as TOML writes it
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -436,6 +451,10 @@ def check_structure(scene: Scene, structure: Structure) -> list[str]:
 def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
     """Instantiate each unit with its parameters and enter initialisation mode.
 
+    A parameter the unit does not have, or a value it cannot take (said by
+    :func:`check_structure`), is left out, so that the unit's own problems with the rest
+    come out in the same list; what the unit says then notes what was left out.
+
     Parameters
     ----------
     scene : Scene
@@ -452,17 +471,29 @@ def check_through_fmi(scene: Scene, structure: Structure) -> list[str]:
 
     problems = []
     for name, spec in scene.units.items():
-        if name not in structure.paths or _parameter_problems(name, spec, structure):
-            continue  # its parameters' names or types are wrong: said already
+        if name not in structure.paths:
+            continue
+        # parameters it has not, or values it cannot take, are said already: the unit checks
+        # the rest, so that its own problems come out with them
+        refused = _refused_parameters(name, spec, structure)
         slave = Slave(name, structure.paths[name])
         try:
             slave.instantiate()
-            slave.initialize(0.0, unit_start_values(spec, slave))
+            slave.initialize(0.0, unit_start_values(spec, slave, leave_out=refused))
         except UnitFailedError as exc:
-            problems += unit_messages(name, slave, exc)
+            problems += [m + _left_out(refused) for m in unit_messages(name, slave, exc)]
         finally:
             slave.terminate()
     return problems
+
+
+def _left_out(refused: Mapping[str, str]) -> str:
+    """The note on what a unit said when parameters it cannot take were left out."""
+    if not refused:
+        return ""
+    names = ", ".join(repr(k) for k in refused)
+    values = "value" if len(refused) == 1 else "values"
+    return f" (found with {names} left out: the unit cannot take the {values} given)"
 
 
 def unit_messages(name: str, slave, exc: Exception) -> list[str]:
@@ -513,7 +544,7 @@ def dry_initialization(scene: Scene, structure: Structure) -> list[str]:
     return []
 
 
-def unit_start_values(spec, slave) -> dict:
+def unit_start_values(spec, slave, *, leave_out: Collection[str] = ()) -> dict:
     """Parameters (and the effects list of ours) as FMI values for ``slave``.
 
     Parameters
@@ -522,13 +553,15 @@ def unit_start_values(spec, slave) -> dict:
         The unit in the scene.
     slave : Slave
         The unit's FMU (whether it has an ``effects`` parameter).
+    leave_out : collection of str
+        Parameters not to give (those it cannot take).
 
     Returns
     -------
     dict of str to object
         Start value by variable name.
     """
-    values = spec.parameter_values()
+    values = spec.parameter_values(leave_out)
     if spec.effects or is_ours(spec.fmu):
         if "effects" in slave.variables:
             values["effects"] = ",".join(spec.effects)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,7 +20,7 @@ from wire_fmu.core.errors import ConfigurationError
 from wire_fmu.core.framework.data_fields import DataField, acts_with_effects
 from wire_fmu.core.framework.effects import Effect, EffectCatalogue
 from wire_fmu.core.framework.ports import PORT_KINDS, Port, PortSide
-from wire_fmu.core.framework.variables import Causality, Variable
+from wire_fmu.core.framework.variables import Causality, Settings, Variable, acts_with_settings
 from wire_fmu.registry import BY_NAME, UNIT_TYPES
 
 __all__ = [
@@ -32,6 +32,7 @@ __all__ = [
     "format_value",
     "format_range",
     "condition_text",
+    "settings_text",
     "port_quantities",
 ]
 
@@ -124,6 +125,8 @@ class Entry:
         The declaration's description.
     acts_with, acts_without : tuple of str
         The effects it needs (one of), and those that silence it.
+    acts_when : tuple of (str, tuple)
+        The parameter settings it needs: ``(parameter, values it acts with)`` pairs.
     required : bool
         A field that must be given.
     tunable : bool
@@ -144,6 +147,7 @@ class Entry:
     required: bool = False
     tunable: bool = False
     value: Any = None
+    acts_when: Settings = ()
 
     def is_default(self, value: Any) -> bool:
         """Whether ``value`` is the default (numbers compared as numbers).
@@ -169,6 +173,16 @@ class Entry:
         """
         return acts_with_effects(self.acts_with, self.acts_without, effects)
 
+    def acts_with_parameters(self, parameters: Mapping[str, Any]) -> bool:
+        """Whether this has any influence with the unit's parameters set so.
+
+        Parameters
+        ----------
+        parameters : mapping of str to object
+            The unit's parameter values by name (its defaults where the scene sets none).
+        """
+        return acts_with_settings(self.acts_when, parameters)
+
     @classmethod
     def of_variable(cls, var: Variable) -> Entry:
         """The row of a declared variable.
@@ -191,6 +205,7 @@ class Entry:
             var.acts_without,
             tunable=var.variability.value == "tunable",
             value=None if output else var.start,
+            acts_when=var.acts_when,
         )
 
     @classmethod
@@ -362,9 +377,13 @@ def chosen_effects(ref: UnitReference, effects: Iterable[str]) -> frozenset[str]
 
 
 def condition_text(
-    effects: tuple[Effect, ...], acts_with: tuple[str, ...], acts_without: tuple[str, ...]
+    effects: tuple[Effect, ...],
+    acts_with: tuple[str, ...],
+    acts_without: tuple[str, ...],
+    acts_when: Settings = (),
 ) -> str:
-    """When something acts, in words: the effects it needs (and what those need).
+    """When something acts, in words: the effects it needs (and what those need), and the
+    parameter settings.
 
     Parameters
     ----------
@@ -372,6 +391,8 @@ def condition_text(
         The unit's effect catalogue (for what each needed effect requires).
     acts_with, acts_without : tuple of str
         The effects it needs (one of) and those that silence it.
+    acts_when : tuple of (str, tuple)
+        The parameter settings it needs (:func:`settings_text`).
 
     Returns
     -------
@@ -392,7 +413,27 @@ def condition_text(
     if acts_without:
         noun = "effect" if len(acts_without) == 1 else "the effects"
         parts.append(f"acts only without {noun} {_quoted(acts_without)}")
+    if acts_when:
+        parts.append(f"acts only with {settings_text(acts_when)}")
     return "; ".join(parts)
+
+
+def settings_text(settings: Settings) -> str:
+    """Parameter settings in words, as a scene sets them.
+
+    Parameters
+    ----------
+    settings : tuple of (str, tuple)
+        ``(parameter, values)`` pairs.
+
+    Returns
+    -------
+    str
+        E.g. ``'handle_drive = "torque"'``; values joined by ``or``, pairs by ``and``.
+    """
+    return " and ".join(
+        f"{name} = {' or '.join(format_value(v) for v in values)}" for name, values in settings
+    )
 
 
 def _quoted(names: Iterable[str]) -> str:

@@ -134,7 +134,7 @@ def _entries(
     rows += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for item in entries:
         text = item.description.rstrip(".")
-        condition = condition_text(ref.effects, item.acts_with, item.acts_without)
+        condition = condition_text(ref.effects, item.acts_with, item.acts_without, item.acts_when)
         if condition:
             text += f". *{condition[0].upper()}{condition[1:]}.*"
         default = item.default or ("required" if item.required else "")

@@ -1,16 +1,17 @@
-"""What a scene sets that its chosen effects leave without influence.
+"""What a scene sets that its chosen effects, or its units' parameters, leave without influence.
 
 A scene may set a parameter, a key of a structured parameter (a sheave's
 ``efficiency`` in a reeving) or an input (by an event, a driver or a
-connection) that acts only with an effect the unit does not include: the
-value is then silently ignored. A value equal to the declared default is not
-reported: the scene asks for nothing the unit does not do.
-:func:`inactive_settings` finds each one from
-the units' declarations (``acts_with``/``acts_without`` on
-:class:`~wire_fmu.core.framework.variables.Variable` and
-:class:`~wire_fmu.core.framework.data_fields.DataField`), naming the unit, the
-setting and the effect that would make it act. Only our unit types declare
-this; units given as FMU files are passed over.
+connection) that acts only with an effect the unit does not include, or only
+with a setting of another parameter (the scissor jack's handle torque acts only
+with ``handle_drive = "torque"``): the value is then silently ignored. A value
+equal to the declared default is not reported: the scene asks for nothing the
+unit does not do. :func:`inactive_settings` finds each one from
+the units' declarations (``acts_with``/``acts_without``/``acts_when`` on
+:class:`~wire_fmu.core.framework.variables.Variable`, ``acts_with``/``acts_without``
+on :class:`~wire_fmu.core.framework.data_fields.DataField`), naming the unit, the
+setting and the effect or parameter setting that would make it act. Only our unit
+types declare this; units given as FMU files are passed over.
 """
 
 from __future__ import annotations
@@ -21,7 +22,13 @@ from typing import Any
 
 from wire_fmu.master.scene import Scene
 from wire_fmu.registry import BY_NAME
-from wire_fmu.unit_reference.catalogue import Entry, UnitReference, condition_text, unit_reference
+from wire_fmu.unit_reference.catalogue import (
+    Entry,
+    UnitReference,
+    condition_text,
+    settings_text,
+    unit_reference,
+)
 
 __all__ = ["inactive_settings", "scene_file_warnings"]
 
@@ -50,17 +57,36 @@ def inactive_settings(scene: Scene) -> list[str]:
             continue
         ref = unit_reference(spec.fmu)
         effects = frozenset(spec.effects)
+        settings = {**{p.name: p.value for p in ref.parameters}, **spec.parameters}
         for key, value in spec.parameters.items():
             entry = ref.entry(key)
-            if entry is not None and not entry.acts(effects) and not entry.is_default(value):
-                warnings.append(_warning(name, ref, effects, f"parameter {key!r}", entry))
+            if entry is not None and not entry.is_default(value):
+                what = f"parameter {key!r}"
+                warnings += _silenced(name, ref, effects, settings, what, entry)
             for field, places in _fields_set(ref.fields.get(key, ()), value):
                 if not field.acts(effects):
                     where = _places([p for p in places if p])
                     what = f"{key} key {field.name!r}" + (f" ({where})" if where else "")
                     warnings.append(_warning(name, ref, effects, what, field))
-        warnings += _inputs_set(scene, name, ref, effects)
+        warnings += _inputs_set(scene, name, ref, effects, settings)
     return warnings
+
+
+def _silenced(
+    unit: str,
+    ref: UnitReference,
+    effects: frozenset[str],
+    settings: Mapping[str, Any],
+    what: str,
+    entry: Entry,
+) -> list[str]:
+    """The warning that ``what`` has no influence with the unit's effects or with its
+    parameters (``settings``, by name), or none."""
+    if not entry.acts(effects):
+        return [_warning(unit, ref, effects, what, entry)]
+    if not entry.acts_with_parameters(settings):
+        return [_settings_warning(unit, settings, what, entry)]
+    return []
 
 
 def _warning(unit: str, ref: UnitReference, effects: frozenset[str], what: str, entry) -> str:
@@ -72,14 +98,31 @@ def _warning(unit: str, ref: UnitReference, effects: frozenset[str], what: str, 
     )
 
 
+def _settings_warning(unit: str, settings: Mapping[str, Any], what: str, entry: Entry) -> str:
+    """``what`` has no influence with the unit's parameters so set (``settings``, by name)."""
+    unmet = tuple((p, (settings[p],)) for p, values in entry.acts_when if settings[p] not in values)
+    names = " and ".join(p for p, _ in unmet)
+    return (
+        f"unit {unit!r}: {what} has no influence with {settings_text(unmet)}: it acts only "
+        f"with {settings_text(entry.acts_when)}; change {names} or leave it out"
+    )
+
+
 def _places(places: list[str]) -> str:
     shown = ", ".join(places[:_SHOWN])
     more = len(places) - _SHOWN
     return shown + (f" and {more} more" if more > 0 else "")
 
 
-def _inputs_set(scene: Scene, unit: str, ref: UnitReference, effects: frozenset[str]) -> list[str]:
-    """Inputs of ``unit`` that events, drivers or connections set without influence."""
+def _inputs_set(
+    scene: Scene,
+    unit: str,
+    ref: UnitReference,
+    effects: frozenset[str],
+    settings: Mapping[str, Any],
+) -> list[str]:
+    """Inputs of ``unit`` that events, drivers or connections set without influence (with
+    its effects, or with its parameters: ``settings``, by name)."""
     setters: dict[str, list[str]] = {}
     for event in scene.events:
         for target in event.values:
@@ -95,9 +138,9 @@ def _inputs_set(scene: Scene, unit: str, ref: UnitReference, effects: frozenset[
     out = []
     for item in ref.inputs:
         who = setters.get(f"{unit}.{item.name}")
-        if who and not item.acts(effects):
+        if who:
             what = f"input {item.name!r} (set by {', '.join(dict.fromkeys(who))})"
-            out.append(_warning(unit, ref, effects, what, item))
+            out += _silenced(unit, ref, effects, settings, what, item)
     return out
 
 

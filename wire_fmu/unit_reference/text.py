@@ -100,7 +100,7 @@ def _entries(
         silent = chosen is not None and not item.acts(chosen)
         out.append(("- " if silent else "  ") + head[2:])
         out += _wrapped(_INDENT, item.description)
-        condition = condition_text(ref.effects, item.acts_with, item.acts_without)
+        condition = condition_text(ref.effects, item.acts_with, item.acts_without, item.acts_when)
         if condition:
             note = "no influence with these effects: " if silent else ""
             out += _wrapped(_INDENT, f"{note}{condition}")

@@ -188,11 +188,17 @@ class Unit(ABC):
         inputs = {v.name for v in cls.VARIABLES if v.causality is Causality.input}
         for name in sorted({n for n in names if names.count(n) > 1}):
             problems.append(f"{cls.NAME}: variable {name!r} declared twice")
+        parameters = {v.name for v in cls.VARIABLES if v.causality is Causality.parameter}
         for var in cls.VARIABLES:
             unknown = [d for d in var.depends_on if d not in inputs]
             if unknown:
                 problems.append(
                     f"{cls.NAME}.{var.name}: depends_on names {unknown}, which are not inputs"
+                )
+            unknown = [p for p, _ in var.acts_when if p not in parameters]
+            if unknown:
+                problems.append(
+                    f"{cls.NAME}.{var.name}: acts_when names {unknown}, which are not parameters"
                 )
         causality = {v.name: v.causality.value for v in cls.VARIABLES}
         units = {v.name: v.unit for v in cls.VARIABLES if v.type is float}

@@ -8,14 +8,23 @@ are the short ways to declare one.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
 from wire_fmu.core.framework.data_fields import acts_with_effects
 
-__all__ = ["Causality", "Variability", "Variable", "input_", "output", "parameter"]
+__all__ = [
+    "Causality",
+    "Variability",
+    "Variable",
+    "Settings",
+    "acts_with_settings",
+    "input_",
+    "output",
+    "parameter",
+]
 
 
 class Causality(StrEnum):
@@ -36,6 +45,27 @@ class Variability(StrEnum):
 
 
 _TYPES = (float, int, bool, str)
+
+Settings = tuple[tuple[str, tuple[Any, ...]], ...]
+"""Parameter settings something needs to act: ``(parameter, values it acts with)`` pairs."""
+
+
+def acts_with_settings(acts_when: Settings, parameters: Mapping[str, Any]) -> bool:
+    """Whether something that needs the settings ``acts_when`` acts with ``parameters``.
+
+    Parameters
+    ----------
+    acts_when : tuple of (str, tuple)
+        Each parameter it needs and the values it acts with (one of them).
+    parameters : mapping of str to object
+        The unit's parameter values by name (a parameter not in it: no need checked).
+
+    Returns
+    -------
+    bool
+        True when every parameter named is set to one of its values.
+    """
+    return all(name not in parameters or parameters[name] in values for name, values in acts_when)
 
 
 @dataclass(frozen=True)
@@ -75,6 +105,10 @@ class Variable:
     acts_without : tuple of str
         Effects none of which may be chosen for it to act (a speed command that
         only a drum without inertia follows); empty when none silences it.
+    acts_when : tuple of (str, tuple)
+        Parameter settings it needs to act, as ``(parameter, values)`` pairs: the
+        parameter must be set to one of the values (``handle.torque_command`` acts
+        only with ``handle_drive`` ``"torque"``); empty when no parameter silences it.
     """
 
     name: str
@@ -91,6 +125,7 @@ class Variable:
     min_exclusive: bool = False
     acts_with: tuple[str, ...] = ()
     acts_without: tuple[str, ...] = ()
+    acts_when: Settings = ()
 
     def __post_init__(self) -> None:
         if self.type not in _TYPES:
@@ -106,6 +141,8 @@ class Variable:
             )
         if self.min_exclusive and self.min is None:
             raise ValueError(f"variable {self.name!r}: min_exclusive needs a min")
+        if not all(isinstance(p, str) and isinstance(v, tuple) for p, v in self.acts_when):
+            raise ValueError(f"variable {self.name!r}: acts_when takes (parameter, values) pairs")
 
     def acts(self, effects: Iterable[str]) -> bool:
         """Whether the variable has any influence with the effects chosen.
@@ -131,6 +168,7 @@ def parameter(
     min_exclusive: bool = False,
     acts_with: tuple[str, ...] = (),
     acts_without: tuple[str, ...] = (),
+    acts_when: Settings = (),
 ) -> Variable:
     """Declare a parameter (``fixed`` unless ``fixed=False``).
 
@@ -154,6 +192,8 @@ def parameter(
         The value must be strictly greater than ``min``.
     acts_with, acts_without : tuple of str
         The effects without which (with which) it has no influence; see :class:`Variable`.
+    acts_when : tuple of (str, tuple)
+        The parameter settings it needs to act; see :class:`Variable`.
 
     Returns
     -------
@@ -173,6 +213,7 @@ def parameter(
         min_exclusive=min_exclusive,
         acts_with=tuple(acts_with),
         acts_without=tuple(acts_without),
+        acts_when=tuple(acts_when),
     )
 
 
@@ -185,12 +226,13 @@ def input_(
     type: type = float,  # noqa: A002
     acts_with: tuple[str, ...] = (),
     acts_without: tuple[str, ...] = (),
+    acts_when: Settings = (),
 ) -> Variable:
     """Declare an input: continuous for a Real, discrete otherwise.
 
     Parameters
     ----------
-    name, start, unit, description, type, acts_with, acts_without
+    name, start, unit, description, type, acts_with, acts_without, acts_when
         As for :func:`parameter`.
 
     Returns
@@ -209,6 +251,7 @@ def input_(
         variability=variability,
         acts_with=tuple(acts_with),
         acts_without=tuple(acts_without),
+        acts_when=tuple(acts_when),
     )
 
 

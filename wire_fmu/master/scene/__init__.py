@@ -93,6 +93,7 @@ from .checks import (
     interface_warnings,
     is_plain_name,
     is_scalar,
+    late_event_warnings,
     unknown_unit_problems,
     valid_time,
 )
@@ -133,6 +134,7 @@ __all__ = [
     "is_plain_name",
     "unknown_unit_problems",
     "interface_warnings",
+    "late_event_warnings",
     "valid_time",
     "is_scalar",
     "MAX_SCENE_BYTES",

@@ -1,5 +1,6 @@
 """Checks of scene values: names, unit references, times, scalars and run settings, and
-the warnings about bonds that cannot give the interface model the scene asks for."""
+the warnings about bonds that cannot give the interface model the scene asks for and about
+events after the stop time."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ __all__ = [
     "valid_time",
     "is_scalar",
     "interface_warnings",
+    "late_event_warnings",
 ]
 
 MIN_TIME, MAX_TIME = 1e-9, 1e12
@@ -109,6 +111,33 @@ def interface_warnings(scene: Scene) -> list[str]:
             if not bond.ramped
         ]
     return warnings
+
+
+def late_event_warnings(scene: Scene) -> list[str]:
+    """Each event after the run's stop time: it will not happen.
+
+    A warning, not a problem: a run shortened on purpose (``--stop-time``) ends before
+    its later events.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its events and ``run.stop_time``, s).
+
+    Returns
+    -------
+    list of str
+        One warning per such event, naming it, its time and the stop time.
+    """
+    stop = scene.run.stop_time
+    if not _finite(stop):
+        return []  # a stop time that is no number is a problem, said where it is read
+    return [
+        f"event {e.label!r} at {e.time:g} s is after the run's stop time, {stop:g} s; "
+        "it will not happen"
+        for e in scene.events
+        if e.time > stop
+    ]
 
 
 def valid_time(value: Any) -> bool:

@@ -15,7 +15,7 @@ override) is wired by its own settings.
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -146,11 +146,19 @@ class UnitSpec:
             return self
         return replace(self, parameters={**own, **dict.fromkeys(added, True)}, switched_on=added)
 
-    def parameter_values(self) -> dict[str, Any]:
-        """Parameters as FMI values (tables and lists serialised to JSON)."""
+    def parameter_values(self, leave_out: Collection[str] = ()) -> dict[str, Any]:
+        """Parameters as FMI values (tables and lists serialised to JSON).
+
+        Parameters
+        ----------
+        leave_out : collection of str
+            Parameters not to give (those the unit cannot take, a table holding a date
+            among them: JSON has none).
+        """
         out = {}
         for key, value in self.parameters.items():
-            out[key] = json.dumps(value) if isinstance(value, Mapping | list) else value
+            if key not in leave_out:
+                out[key] = json.dumps(value) if isinstance(value, Mapping | list) else value
         return out
 
 

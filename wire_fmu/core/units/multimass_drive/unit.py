@@ -251,10 +251,13 @@ class DriveUnit(Unit):
         """
         model = self._require_model()
         self._bind(model)
-        model.initialize(float(self.values["initial_speed"]))
-        self.time = start_time
-        self.initial_energy = model.stored_energy()
-        self._update_outputs()
+        # set-up only: values too large for the drive overflow here, and are named below
+        with np.errstate(over="ignore", invalid="ignore"):
+            if not _finite_start(model, float(self.values["initial_speed"])):
+                raise ConfigurationError(self.who, [self._overflow_problem(model)])
+            self.time = start_time
+            self.initial_energy = model.stored_energy()
+            self._update_outputs()
 
     def input_problems(self) -> list[str]:
         """Torque inputs that are not finite."""
@@ -331,7 +334,14 @@ class DriveUnit(Unit):
         if tree.n > MAX_MASSES:
             problems.append(f"parameter 'drive': at most {MAX_MASSES} masses, got {tree.n}")
         keep = int(self.values["masses_kept"])
-        if keep == 0 or keep >= tree.n:
+        if keep > tree.n:
+            kept = "2..{n}" if tree.is_chain() else "{n} (a branched drive is not reduced)"
+            problems.append(
+                f"parameter 'masses_kept': the drive has {tree.n} masses; keep "
+                f"{kept.format(n=tree.n)} or 0 (the full drive); got {keep}"
+            )
+            return tree
+        if keep == 0 or keep == tree.n:
             return tree
         if not tree.is_chain() or keep < 2:
             what = "a branched drive" if not tree.is_chain() else f"{keep} masses"
@@ -347,6 +357,36 @@ class DriveUnit(Unit):
             )
             return tree
         return DriveTree.from_chain(tree.to_chain().reduced(keep))
+
+    def _overflow_problem(self, model: DriveModel) -> str:
+        """Which start values make the drive's start state overflow, each with its value.
+
+        The start state is linear in the initial speed and the torques, so each is tried
+        alone; when none overflows alone, all that are set are named together.
+        """
+        names = ("initial_speed", *_MOTOR_INPUTS[: len(model.motors)], "load.torque")
+        given = {name: float(self.values[name]) for name in names if self.values[name] != 0.0}
+        alone = [n for n, value in given.items() if not self._finite_alone(model, n, value)]
+        self._bind(model)
+        guilty = alone or list(given)
+        if not guilty:
+            return "the drive's start state is not finite (its parameters overflow it)"
+        shown = " and ".join(
+            f"{self.variable(n).causality.value} {n!r} = {given[n]:g} {self.variable(n).unit}"
+            for n in guilty
+        )
+        verb = "is" if len(guilty) == 1 else "are"
+        return (
+            f"{shown} {verb} too large for this drive: its start state (shaft twists, "
+            "stored energy) is not finite"
+        )
+
+    def _finite_alone(self, model: DriveModel, name: str, value: float) -> bool:
+        """Whether the start state is finite with ``name`` at ``value`` and all else at 0."""
+        motors = _MOTOR_INPUTS[: len(model.motors)]
+        model.commands = np.array([value if m == name else 0.0 for m in motors])
+        model.load_torque = value if name == "load.torque" else 0.0
+        return _finite_start(model, value if name == "initial_speed" else 0.0)
 
     def _update_outputs(self) -> None:
         m = self._require_model()
@@ -381,6 +421,12 @@ class DriveUnit(Unit):
         out["mode_changes"] = 0
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"{self.instance_name}: non-finite state")
+
+
+def _finite_start(model: DriveModel, speed: float) -> bool:
+    """Start ``model`` at ``speed`` (rad/s); whether its state and stored energy are finite."""
+    model.initialize(speed)
+    return bool(np.all(np.isfinite(model.state))) and math.isfinite(model.stored_energy())
 
 
 def _stability_problems(model: DriveModel, max_step: float) -> list[str]:

@@ -83,18 +83,24 @@ class JackGeometry:
 
     def problems(self) -> list[str]:
         """Every problem with the geometry, as sentences."""
-        out = []
         two_l = 2.0 * self.rod_length
         if not (self.rod_length > 0.0 and math.isfinite(self.rod_length)):
             return [f"rod_length must be a positive number of metres, got {self.rod_length}"]
+        out, bad = [], set()
         for name in ("min_height", "initial_height", "max_height"):
             value = getattr(self, name)
             if not (0.0 < value < two_l):
+                bad.add(name)
                 out.append(
                     f"{name} must lie strictly between 0 and twice the rod length "
                     f"({two_l:.6g} m), got {value}"
                 )
-        if not out and not self.min_height <= self.initial_height <= self.max_height:
+        if not bad & {"min_height", "max_height"} and not self.min_height < self.max_height:
+            out.append(
+                f"min_height {self.min_height} m must be below max_height {self.max_height} m "
+                "(the ends of the travel)"
+            )
+        elif not out and not self.min_height <= self.initial_height <= self.max_height:
             out.append(
                 f"initial_height {self.initial_height} m must lie within the travel "
                 f"[{self.min_height}, {self.max_height}] m"

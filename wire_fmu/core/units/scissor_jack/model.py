@@ -97,7 +97,7 @@ import numpy as np
 
 from wire_fmu.core.components.friction import GROUND, FrictionLink, StickSlip
 from wire_fmu.core.errors import ModelError
-from wire_fmu.core.framework.hybrid import SolverSettings, make_solver
+from wire_fmu.core.framework.hybrid import IntegrationError, SolverSettings, make_solver
 from wire_fmu.core.units.scissor_jack.config import JackConfig, JackInputs, JackReport
 from wire_fmu.core.units.scissor_jack.mechanics import JackMechanics
 
@@ -313,7 +313,10 @@ class ScissorJackModel(JackMechanics):
             x = self._speed_jump(x, inputs.speed_command)
         else:
             x = self._settle(t, x, [])
-        x, events = self.solver.advance(self, t, x, t + h)
+        try:
+            x, events = self.solver.advance(self, t, x, t + h)
+        except IntegrationError as err:
+            raise IntegrationError(f"{err}{self._overrun(inputs, h)}") from None
         geometry = self.config.geometry
         height = self.height(float(x[0]))
         if not geometry.min_height <= height <= geometry.max_height:
@@ -323,6 +326,24 @@ class ScissorJackModel(JackMechanics):
             )
         self.state = x
         return events
+
+    def _overrun(self, inputs: JackInputs, h: float) -> str:
+        """Why a step of ``h`` (s) failed, when a speed command turns the screw past the
+        jack's whole travel within it (the rods' geometry then has no solution); else ""."""
+        if self.config.drive != "speed":
+            return ""
+        geometry = self.config.geometry
+        span = geometry.travel_at_height(geometry.max_height) - geometry.travel_at_height(
+            geometry.min_height
+        )
+        travel = self.config.thread.lead_per_radian * abs(inputs.speed_command) * h
+        if not travel > span:
+            return ""
+        return (
+            f": input handle.speed_command = {inputs.speed_command:g} rad/s (handle_drive "
+            f"'speed') turns the screw {travel:.3g} m in this step, beyond the jack's whole "
+            f"travel of {span:.3g} m"
+        )
 
     def _speed_jump(self, x: np.ndarray, command: float) -> np.ndarray:
         """Adopt a new commanded speed; the drive supplies the kinetic-energy jump."""

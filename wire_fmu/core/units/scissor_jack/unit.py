@@ -73,6 +73,9 @@ _INPUTS = ("handle.speed_command", "handle.torque_command")
 _FRICTION = ("thread_friction",)
 _POSITIVE = {"min": 0.0, "min_exclusive": True}
 _SPEED = ("handle.speed_command",)
+_SPEED_DRIVE = (("handle_drive", ("speed",)),)
+_TORQUE_DRIVE = (("handle_drive", ("torque",)),)
+"""What acts only with one handle drive: its command, the torque drive's start speed."""
 RK4_STABILITY = 2.5
 """Largest ``|lambda| h`` accepted for ``rk4`` (its real-axis limit is about 2.8)."""
 
@@ -174,7 +177,11 @@ def _parameters():
             **_POSITIVE,
         ),
         parameter(
-            "initial_handle_speed", 0.0, "rad/s", "Handle speed at the start with a torque drive"
+            "initial_handle_speed",
+            0.0,
+            "rad/s",
+            "Handle speed at the start with a torque drive",
+            acts_when=_TORQUE_DRIVE,
         ),
         *solver_parameters(
             "rk4",
@@ -193,12 +200,14 @@ def _inputs():
             0.0,
             "rad/s",
             "Handle speed with handle_drive 'speed', positive lifts",
+            acts_when=_SPEED_DRIVE,
         ),
         input_(
             "handle.torque_command",
             0.0,
             "N.m",
             "Handle torque with handle_drive 'torque', positive lifts",
+            acts_when=_TORQUE_DRIVE,
         ),
     )
 
