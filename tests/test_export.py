@@ -144,6 +144,8 @@ def test_getters_and_setters_map_onto_unit_values():
     values = facade.unit.values
     assert (values["mass"], values["substeps"], values["flag"]) == (2.5, 7, True)
     assert values["label"] == "crane 1"
+    initialised(facade)  # a get before initialisation is refused
+    values = facade.unit.values
     values["position"], values["moving_forward"] = 0.25, True
     assert facade.get_real([vr(facade, "position")]) == [0.25]
     assert facade.get_boolean([vr(facade, "moving_forward")]) == [True]
@@ -151,9 +153,63 @@ def test_getters_and_setters_map_onto_unit_values():
     assert facade.get_string([vr(facade, "label")]) == ["crane 1"]
 
 
+def test_a_get_of_an_output_before_initialisation_is_refused_saying_from_when():
+    """An output has no value before the unit is initialised (the Oscillator's position
+    would read 0, not its start x0); parameters and inputs read their start values."""
+    facade = make(x0=0.3, substeps=7, flag=True, label="crane 1")
+    outputs = {"real": vr(facade, "position"), "bool": vr(facade, "moving_forward")}
+    for name, get in [
+        ("fmi2GetReal", lambda: facade.get_real([vr(facade, "mass"), outputs["real"]])),
+        ("fmi2GetBoolean", lambda: facade.get_boolean([outputs["bool"]])),
+    ]:
+        with pytest.raises(FacadeError, match=f"{name} of '.*' called in phase 'instantiated'"):
+            get()
+    said = log_entries(facade, Fmi2Status.error)
+    assert len(said) == 2
+    assert "'position'" in said[0] and "'mass'" not in said[0]
+    assert all("have values from fmi2EnterInitializationMode on" in m for m in said)
+    assert facade.get_real([vr(facade, "x0"), vr(facade, "force")]) == [0.3, 0.0]
+    assert facade.get_integer([vr(facade, "substeps")]) == [7]
+    assert facade.get_boolean([vr(facade, "flag")]) == [True]
+    assert facade.get_string([vr(facade, "label")]) == ["crane 1"]
+    facade.setup_experiment(0.0)
+    facade.enter_initialization_mode()
+    assert facade.get_real([outputs["real"]]) == [0.3]  # the value it starts with, not 0
+
+
+def test_the_model_description_still_has_the_start_values_read_through_get():
+    root = make(mass=2.5).to_xml()
+    starts = {v.get("name"): v[0].get("start") for v in root.iter("ScalarVariable")}
+    assert starts["mass"] == "2.5" and starts["label"] is not None
+
+
+def test_value_references_no_variable_has_are_all_named():
+    facade = initialised(make())
+    count = len(facade.vars)
+    for call, name in [
+        (lambda: facade.get_real([9999, vr(facade, "position"), 12345, 9999]), "fmi2GetReal"),
+        (lambda: facade.set_real([9999, 12345], [1.0, 2.0]), "fmi2SetReal"),
+    ]:
+        facade.log_queue.clear()
+        with pytest.raises(FacadeError) as caught:
+            call()
+        assert str(caught.value) == (
+            f"no variable has value reference 9999 or 12345; the unit's value references "
+            f"are 0 to {count - 1}"
+        )
+        (message,) = log_entries(facade, Fmi2Status.error)
+        assert message.startswith(f"Oscillator 'osc': {name} failed: no variable has")
+    with pytest.raises(FacadeError, match="value reference 0 is the Real variable 'mass', not an"):
+        facade.get_integer([0])
+    with pytest.raises(FacadeError, match=r"value references 0 and 1 are not String variables"):
+        facade.get_string([0, 1])
+    assert not any("unexpectedly" in m.msg for m in facade.log_queue)
+
+
 def test_dotted_names_are_plain_keys_not_attribute_paths():
     facade = make(Dotted)
     facade.set_real([vr(facade, "drive.speed")], [1.5])
+    initialised(facade)  # a get before initialisation is refused
     facade.unit.values["line_a.tension"] = 42.0
     assert facade.unit.values["drive.speed"] == 1.5
     assert facade.get_real([vr(facade, "line_a.tension"), vr(facade, "line_a.length")]) == [

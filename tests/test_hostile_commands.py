@@ -227,3 +227,62 @@ def test_study_options_out_of_range_are_refused_by_the_command_line(args, capsys
         cli(["study", "effects", "--quick", *args, "scissor_jack"])
     assert caught.value.code == 2
     assert "expected" in capsys.readouterr().err
+
+
+SWEEP_SPEC_WITH_EVERY_KIND_OF_PROBLEM = """\
+name = "bad"
+max_cases = "many"
+[[axes]]
+target = "units.nosuch.parameters.x"
+linspace = [1.0, 2.0, -3]
+[[axes]]
+target = "units.lift.parameters.load_mass"
+values = []
+[figures]
+peak = "maximum(lift.load.height)"
+h = "max(lift.load.heigth)"
+"""
+
+
+def test_a_sweep_spec_s_own_problems_and_the_scene_s_are_said_at_once(tmp_path, fmu_dir, capsys):
+    spec = tmp_path / "bad.toml"
+    spec.write_text(SWEEP_SPEC_WITH_EVERY_KIND_OF_PROBLEM)
+    out = tmp_path / "out"
+    args = ["--fmu-dir", str(fmu_dir), "sweep", "scissor_jack", str(spec), "-o", str(out)]
+    assert cli([*args, "--workers", "0", "-q"]) == 1
+    said = capsys.readouterr().out
+    assert said.startswith("error: sweep spec 'bad' for scene 'scissor_jack': 6 problems:")
+    for words in (
+        "'linspace' must be [start, stop, count]",
+        "'values' must be a non-empty list",
+        "unknown function 'maximum'",
+        "'max_cases' must be a whole number >= 1, got 'many'",
+        "the scene has no unit 'nosuch'",
+        "unit 'lift' has no variable 'load.heigth'",
+    ):
+        assert words in said, words
+    assert "unexpected" not in said and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--workers", "-1"], "--workers: expected a whole number >= 1, or 0 to run"),
+        (["--workers", "two"], "--workers: expected a whole number >= 1, or 0 to run"),
+        (["--scheduler", "notaurl"], "expected PROTOCOL://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        (["--scheduler", "foo://host:8786"], "unknown protocol 'foo'"),
+    ],
+)
+def test_sweep_options_out_of_range_are_refused_by_the_command_line(tmp_path, capsys, args, words):
+    with pytest.raises(SystemExit) as caught:
+        cli(["sweep", "scissor_jack", str(tmp_path / "spec.toml"), *args])
+    assert caught.value.code == 2
+    assert words in capsys.readouterr().err
+
+
+def test_a_sweep_of_negative_workers_is_refused_before_anything_runs(tmp_path):
+    from wire_fmu.sweep import SweepError, run_sweep
+
+    with pytest.raises(SweepError, match=r"workers = -1: expected .*; scheduler: expected"):
+        run_sweep("scissor_jack", tmp_path / "none.toml", tmp_path / "out", -1, "notaurl")
+    assert not (tmp_path / "out").exists()

@@ -152,9 +152,26 @@ def test_calls_out_of_order_are_errors_naming_the_phase(built, log, unit):
 def test_an_unknown_value_reference_is_an_error_and_the_instance_lives_on(built, log):
     fmu = built["block_train"]
     instance = _started(fmu, log)
-    _refused(log, lambda: instance.getReal([987654]), "fmi2GetReal", "987654")
-    _refused(log, lambda: instance.setReal([987654], [1.0]), "fmi2SetReal")
+    unknown = "no variable has value reference 987654 or 4294967295; the unit's value references"
+    said = _refused(log, lambda: instance.getReal([987654, 0, 2**32 - 1]), "fmi2GetReal", unknown)
+    assert "unexpectedly" not in said
+    said = _refused(log, lambda: instance.setReal([987654], [1.0]), "fmi2SetReal", "987654")
+    assert "unexpectedly" not in said
     instance.doStep(0.0, 0.01)
+    instance.freeInstance()
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_a_get_before_initialisation_is_an_error_and_initialisation_goes_on(built, log, unit):
+    fmu = built[unit]
+    instance = fmu.instantiate("early", log)
+    said = _refused(
+        log, lambda: instance.getReal([_first_output(fmu)]), "fmi2GetReal", "'instantiated'"
+    )
+    assert "have values from fmi2EnterInitializationMode on" in said
+    instance.setupExperiment(startTime=0.0)
+    instance.enterInitializationMode()
+    instance.getReal([_first_output(fmu)])
     instance.freeInstance()
 
 
@@ -162,9 +179,13 @@ def test_a_value_of_the_wrong_type_is_an_error(built, log):
     fmu = built["block_train"]
     instance = _started(fmu, log)
     real = _first_output(fmu)
-    _refused(log, lambda: instance.getString([real]), "fmi2GetString")
-    _refused(log, lambda: instance.setBoolean([real], [True]), "fmi2SetBoolean")
-    _refused(log, lambda: instance.getInteger([real]), "fmi2GetInteger")
+    for call, name, kind in [
+        (lambda: instance.getString([real]), "fmi2GetString", "String"),
+        (lambda: instance.setBoolean([real], [True]), "fmi2SetBoolean", "Boolean"),
+        (lambda: instance.getInteger([real]), "fmi2GetInteger", "Integer"),
+    ]:
+        said = _refused(log, call, name, f"value reference {real} is the Real variable")
+        assert f"not a {kind}" in said or f"not an {kind}" in said
     instance.doStep(0.0, 0.01)
     instance.freeInstance()
 

@@ -150,6 +150,51 @@ def test_report_command_writes_the_page_and_refuses_a_folder_without_metadata(tm
     assert out.startswith("error:") and "metadata.json" in out
 
 
+def test_report_command_writes_report_html_into_a_folder_given_as_output(tmp_path, capsys):
+    (tmp_path / "run").mkdir()
+    folder = _results(tmp_path / "run")
+    (tmp_path / "pages").mkdir()
+    assert main(["report", str(folder), "-o", str(tmp_path / "pages")]) == 0
+    written = tmp_path / "pages" / "report.html"
+    assert f"report: {written.resolve()}" in capsys.readouterr().out
+    assert [a["id"] for t, a in _parse(written).tags if t == "section"] == SECTIONS
+    assert main(["report", str(folder), "-o", str(tmp_path / "nowhere" / "x.html")]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith(f"error: {tmp_path / 'nowhere' / 'x.html'}: the report cannot be written")
+    assert f"no folder {tmp_path / 'nowhere'}" in out and "unexpected" not in out
+
+
+def test_report_of_a_run_cut_off_mid_line_leaves_the_line_out_and_says_which(
+    tmp_path, capsys, caplog
+):
+    folder = _results(tmp_path)
+    table = folder / "timeseries.csv"
+    text = table.read_text()
+    table.write_text(text[: len(text) - 12])  # the process killed while writing its last row
+    last = text.count("\n")
+    with caplog.at_level("WARNING", logger="wire_fmu"):
+        assert main(["report", str(folder)]) == 0
+    assert f"{table}: line {last}, the last, was cut off" in caplog.text
+    assert f"the {last - 2} rows before it are read" in caplog.text
+    assert "report:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("", "empty; expected at least the header line"),
+        ("t,a.x\n0.0,1.0\n", "expected a header line starting with 'time', found 't,a.x'"),
+    ],
+)
+def test_report_of_an_empty_or_headerless_table_is_an_error_naming_it(
+    tmp_path, capsys, text, words
+):
+    folder = _results(tmp_path)
+    (folder / "timeseries.csv").write_text(text)
+    assert main(["report", str(folder)]) == 1
+    assert capsys.readouterr().out.startswith(f"error: {folder / 'timeseries.csv'}: {words}")
+
+
 @pytest.mark.integration
 def test_run_writes_the_report_of_a_shipped_scene(tmp_path, capsys):
     assert main(["run", "riser_tensioner", "-q", "--stop-time", "0.5", "-o", str(tmp_path)]) == 0

@@ -282,6 +282,7 @@ def test_a_run_cut_off_mid_row_gives_the_rows_it_wrote_and_says_so(outcome, tmp_
         frame = read_results_frame(folder)
     said = str(caught[0].message)
     assert str(folder) in said and "cut off" in said and "no summary" in said
+    assert f"timeseries.csv line {text.count(chr(10))}, the last, was cut off" in said
     header, rows = csv_rows(outcome.csv_path)
     assert len(frame) == len(rows) - 1
     assert list(frame["rope.line_a.tension"]) == [
@@ -329,6 +330,30 @@ def test_a_table_not_as_a_run_writes_it_is_refused_naming_it(tmp_path, text, wor
     (tmp_path / "metadata.json").write_text(json.dumps(meta))
     with pytest.raises(ResultsError, match="timeseries.csv: " + words):
         read_results_frame(tmp_path)
+    if "not numbers" not in words:  # the column reader reads a text cell as NaN
+        with pytest.raises(ResultsError, match="timeseries.csv: " + words):
+            read_results(tmp_path / "timeseries.csv")
+
+
+def test_both_readers_leave_out_a_cut_off_last_line_naming_it(tmp_path, caplog):
+    table = tmp_path / "timeseries.csv"
+    table.write_text("time,a.x\r\n0.0,1.0\r\n0.5,2.0\r\n1.0,3")
+    meta = {"column_units": {"time": "s", "a.x": "m"}, "result": {"status": "finished"}}
+    (tmp_path / "metadata.json").write_text(json.dumps(meta))
+    with pytest.warns(IncompleteResultsWarning, match="timeseries.csv line 4, the last, was cut"):
+        frame = read_results_frame(tmp_path)
+    with caplog.at_level("WARNING", logger="wire_fmu.master.plots"):
+        columns = read_results(table)
+    assert f"{table}: line 4, the last, was cut off" in caplog.text
+    assert list(frame["a.x"]) == list(columns["a.x"]) == [1.0, 2.0]
+
+
+def test_a_row_of_another_width_is_refused_naming_its_line(tmp_path):
+    table = tmp_path / "timeseries.csv"
+    table.write_text("time,a.x\n0.0,1.0\n0.5\n1.0,3.0,4.0\n1.5,2.0\n")
+    lines = r"line 3 \(1 cell\), 4 \(3 cells\) differ"
+    with pytest.raises(ResultsError, match=r"expected 2 cells in every line, .* " + lines):
+        read_results(table)
 
 
 def test_text_columns_stay_text_and_numbers_read_nan_and_inf(tmp_path):

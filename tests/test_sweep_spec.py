@@ -15,7 +15,7 @@ import pytest
 
 from wire_fmu.master.scene import SceneError, VarRef, parse_scene
 from wire_fmu.sweep.axes import Axis, Sampling
-from wire_fmu.sweep.cases import apply_case, case_id, check_targets, expand
+from wire_fmu.sweep.cases import apply_case, case_id, check_targets, expand, target_problems
 from wire_fmu.sweep.figures import Figure
 from wire_fmu.sweep.spec import SweepSpecError, parse_sweep_spec
 
@@ -271,3 +271,31 @@ def test_a_distribution_whose_samples_overflow_is_refused():
     data["sampling"] = {"samples": 3}
     with pytest.raises(SweepSpecError, match="would overflow"):
         parse_sweep_spec(data)
+
+
+def test_max_cases_that_is_no_number_is_said_with_the_other_problems():
+    with pytest.raises(SweepSpecError) as err:
+        parse_sweep_spec(
+            {"max_cases": "many", "axes": [{"target": "units.b.parameters.mass", "values": []}]}
+        )
+    text = "\n".join(err.value.problems)
+    assert "'values' must be a non-empty list" in text
+    assert "'max_cases' must be a whole number >= 1, got 'many'" in text
+
+
+def test_a_spec_with_problems_keeps_what_can_still_be_checked_against_a_scene():
+    with pytest.raises(SweepSpecError) as err:
+        parse_sweep_spec(
+            {
+                "axes": [
+                    {"target": "units.c.parameters.mass", "linspace": [1.0, 2.0, -3]},
+                    {"target": "vessel.heave", "values": [1.0]},
+                ],
+                "figures": {"peak": "maximum(c.position)", "spread": "range(b.position)"},
+            }
+        )
+    assert err.value.targets == ("units.c.parameters.mass",)
+    assert [f.column for f in err.value.figures] == ["c.position", "b.position"]
+    problems = target_problems(err.value.targets, err.value.figures, scene())
+    assert len(problems) == 2
+    assert "no unit 'c'" in problems[0] and "'c.position' is neither" in problems[1]

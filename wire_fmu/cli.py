@@ -77,6 +77,28 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _worker_count(text: str) -> int:
+    """Worker processes of a sweep's local cluster from the command line: 0 runs serially."""
+    expected = "expected a whole number >= 1, or 0 to run the cases serially in this process"
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{expected}, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{expected}, got {value}")
+    return value
+
+
+def _scheduler_address(text: str) -> str:
+    """A Dask scheduler's address from the command line, checked for its form."""
+    from wire_fmu.sweep.cluster import scheduler_problem
+
+    problem = scheduler_problem(text)
+    if problem:
+        raise argparse.ArgumentTypeError(problem)
+    return text
+
+
 def _positive_float(text: str) -> float:
     """A finite number > 0 from the command line."""
     try:
@@ -226,7 +248,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--workers",
-        type=int,
+        type=_worker_count,
         default=2,
         help="worker processes of the local cluster; 0 runs serially in this "
         "process (default: %(default)s)",
@@ -234,6 +256,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
+        type=_scheduler_address,
         help="use an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
     )
     p.add_argument(
@@ -256,7 +279,12 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_export)
     p = sub.add_parser("report", help="write a run's results as one self-contained HTML page")
     p.add_argument("results", type=Path, help="a results folder, as 'run' writes it")
-    p.add_argument("-o", "--output", type=Path, help="the HTML file (default RESULTS/report.html)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        help="the HTML file, or a folder for report.html (default RESULTS/report.html)",
+    )
     p.set_defaults(func=cmd_report)
     p = sub.add_parser("build", help="build our FMUs")
     p.add_argument("-o", "--output", type=Path, help="output folder")

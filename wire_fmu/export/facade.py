@@ -17,6 +17,11 @@ What the facade does at each FMI call
     (:mod:`wire_fmu.export.start_values`).
 ``fmi2SetupExperiment``
     Remembers the start time.
+``fmi2Get*``
+    Of a calculated variable (an output), refused (status Error) before
+    ``fmi2EnterInitializationMode``: it has no value yet (FMI 2.0 allows no get in the
+    Instantiated state; the parameters' and inputs' start values stay readable). A
+    value reference no variable has, or one of another type, fails the call naming each.
 ``fmi2EnterInitializationMode``
     ``unit.configure()``; a :class:`~wire_fmu.core.errors.ConfigurationError`
     is logged (status Error, every problem) and fails the call.
@@ -53,8 +58,9 @@ import functools
 import logging
 import math
 import operator
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, ClassVar
+from xml.etree.ElementTree import Element
 
 from pythonfmu import Boolean, Fmi2Slave, Integer, Real, String
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
@@ -95,6 +101,19 @@ _INITIAL = {
     Causality.output: Fmi2Initial.calculated,
 }
 
+_SHOWN = 10
+"""Most value references a message lists one by one."""
+
+
+def _joined(items: list[str], word: str) -> str:
+    """``"a"``, ``"a or b"``, ``"a, b or c"`` (``word`` joins the last); past :data:`_SHOWN`
+    items, ``"a, b, ... or N more"``."""
+    if len(items) > _SHOWN:
+        return f"{', '.join(items[:_SHOWN])} {word} {len(items) - _SHOWN} more"
+    if len(items) == 1:
+        return items[0]
+    return f"{', '.join(items[:-1])} {word} {items[-1]}"
+
 
 class CoreFacade(FacadeState, Fmi2Slave):
     """pythonfmu slave that exposes one core :class:`~wire_fmu.core.framework.unit.Unit`.
@@ -126,6 +145,7 @@ class CoreFacade(FacadeState, Fmi2Slave):
         self.version = wire_fmu.__version__
         self.unit: Unit = unit_class(instance_name=self.instance_name)
         self._phase = Phase.instantiated
+        self._describing = False  # to_xml reads start values through get_*, before any phase
         self._start_time = 0.0
         self._time = 0.0
         self._reconfigure = False
@@ -224,6 +244,23 @@ class CoreFacade(FacadeState, Fmi2Slave):
         )
         self.register_variable(timing, nested=False)
 
+    def to_xml(self, model_options: dict[str, str] | None = None) -> Element:
+        """The model description, as :meth:`pythonfmu.Fmi2Slave.to_xml` builds it.
+
+        pythonfmu reads the start values through ``get_*``, which a host may not call
+        before ``fmi2EnterInitializationMode``; here they are the unit's defaults.
+
+        Parameters
+        ----------
+        model_options : dict of str to str, optional
+            pythonfmu's model options.
+        """
+        self._describing = True
+        try:
+            return super().to_xml({} if model_options is None else model_options)
+        finally:
+            self._describing = False
+
     @property
     def phase(self) -> Phase:
         """Current life-cycle phase."""
@@ -294,11 +331,11 @@ class CoreFacade(FacadeState, Fmi2Slave):
     # The FMU binary's variable access, each failure logged (fmi2GetReal ... fmi2SetString).
     # Reals and Integers, read every step, take a plan worked out once per list of references
     # (and Reals, set every step, another).
-    _get_reals = fmi_access("fmi2GetReal", Fmi2Slave.get_real)
-    _get_integers = fmi_access("fmi2GetInteger", Fmi2Slave.get_integer)
-    get_boolean = fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean)
-    get_string = fmi_access("fmi2GetString", Fmi2Slave.get_string)
-    _set_reals = fmi_access("fmi2SetReal", Fmi2Slave.set_real)
+    _get_reals = fmi_access("fmi2GetReal", Fmi2Slave.get_real, Real)
+    _get_integers = fmi_access("fmi2GetInteger", Fmi2Slave.get_integer, Integer)
+    get_boolean = fmi_access("fmi2GetBoolean", Fmi2Slave.get_boolean, Boolean)
+    get_string = fmi_access("fmi2GetString", Fmi2Slave.get_string, String)
+    _set_reals = fmi_access("fmi2SetReal", Fmi2Slave.set_real, Real)
 
     def get_real(self, vrs: list[int]) -> list[float]:
         """fmi2GetReal: the values of ``vrs``, in their declared units.
@@ -393,9 +430,67 @@ class CoreFacade(FacadeState, Fmi2Slave):
             return None
         return tuple(v.name for v in found)
 
-    set_integer = fmi_access("fmi2SetInteger", Fmi2Slave.set_integer)
-    set_boolean = fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean)
-    set_string = fmi_access("fmi2SetString", Fmi2Slave.set_string)
+    set_integer = fmi_access("fmi2SetInteger", Fmi2Slave.set_integer, Integer)
+    set_boolean = fmi_access("fmi2SetBoolean", Fmi2Slave.set_boolean, Boolean)
+    set_string = fmi_access("fmi2SetString", Fmi2Slave.set_string, String)
+
+    def _calculated_among(self, vrs: Iterable[int]) -> list[str]:
+        """Names of the calculated variables (``initial="calculated"``: outputs, calculated
+        locals) among the value references ``vrs``; those no variable has are left to the
+        access, which names them.
+
+        Parameters
+        ----------
+        vrs : iterable of int
+            The value references of a get.
+        """
+        found = (self.vars.get(vr) for vr in vrs)
+        return [v.name for v in found if v is not None and v.initial is Fmi2Initial.calculated]
+
+    def _reference_problems(self, vrs: Iterable[int], kind: type) -> list[str]:
+        """What is wrong with the value references of a get or set of ``kind`` variables.
+
+        Called by :func:`~wire_fmu.export.facade_calls.fmi_access` only once pythonfmu's
+        access failed, so a valid call never pays for it.
+
+        Parameters
+        ----------
+        vrs : iterable of int
+            The value references the host passed.
+        kind : type
+            The pythonfmu variable class of the call (``pythonfmu.Real`` ...).
+
+        Returns
+        -------
+        list of str
+            One sentence for the references no variable has, one for those to variables
+            of another type (each names them all); empty if every reference is right.
+        """
+        wanted = list(dict.fromkeys(vrs))
+        unknown = [str(vr) for vr in wanted if vr not in self.vars]
+        others = [
+            (vr, var)
+            for vr in wanted
+            if (var := self.vars.get(vr)) is not None and not isinstance(var, kind)
+        ]
+        problems = []
+        if unknown:
+            problems.append(
+                f"no variable has value reference {_joined(unknown, 'or')}; the unit's value "
+                f"references are 0 to {len(self.vars) - 1}"
+            )
+        article = "an" if kind.__name__[0] in "AEIOU" else "a"
+        if len(others) == 1:
+            vr, var = others[0]
+            problems.append(
+                f"value reference {vr} is the {type(var).__name__} variable {var.name!r}, "
+                f"not {article} {kind.__name__}"
+            )
+        elif others:
+            refs = _joined([str(vr) for vr, _ in others], "and")
+            which = _joined([f"{v.name!r} ({type(v).__name__})" for _, v in others], "and")
+            problems.append(f"value references {refs} are not {kind.__name__} variables: {which}")
+        return problems
 
     # -- life cycle ---------------------------------------------------------------
     @fmi_entry("fmi2SetupExperiment")

@@ -31,8 +31,18 @@ logger = logging.getLogger("wire_fmu.export.facade")
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
-def fmi_access(fmi_name: str, access: Callable[..., Any]) -> Callable[..., Any]:
+def fmi_access(fmi_name: str, access: Callable[..., Any], kind: type) -> Callable[..., Any]:
     """Make pythonfmu's variable access ``access`` a facade method whose failures are logged.
+
+    A get of a calculated variable (an output, a calculated local) is refused before
+    ``fmi2EnterInitializationMode``: it has no value before the unit is initialised (FMI
+    2.0 allows no get in the Instantiated state at all; parameters and inputs, whose start
+    values are set then, stay readable, as hosts that read back what they set rely on).
+    While the facade writes its model description (its ``_describing``), pythonfmu reads
+    the start values so. When ``access`` fails on value
+    references, the failure names every reference no variable has and every one of
+    another type than ``kind`` (the facade's ``_reference_problems``); the references are
+    looked at only then, not on each call.
 
     Parameters
     ----------
@@ -41,10 +51,27 @@ def fmi_access(fmi_name: str, access: Callable[..., Any]) -> Callable[..., Any]:
     access : callable
         The :class:`pythonfmu.Fmi2Slave` method: ``(self, vrs)`` for a get, ``(self, vrs,
         values)`` for a set (value references and values in the variables' declared units).
+    kind : type
+        The pythonfmu variable class ``access`` reads or writes (``pythonfmu.Real`` ...).
     """
+    reads = fmi_name.startswith("fmi2Get")
 
-    def method(self: CoreFacade, *args: Any) -> Any:
-        return access(self, *args)
+    def method(self: CoreFacade, vrs: list[int], *values: Any) -> Any:
+        if reads and self._phase is Phase.instantiated and not self._describing:
+            calculated = self._calculated_among(vrs)
+            if calculated:
+                raise FacadeError(
+                    f"{fmi_name} of {', '.join(map(repr, calculated))} called in phase "
+                    f"{Phase.instantiated.value!r}: calculated variables have values from "
+                    "fmi2EnterInitializationMode on (parameters and inputs may be read before)"
+                )
+        try:
+            return access(self, vrs, *values)
+        except (KeyError, TypeError):
+            problems = self._reference_problems(vrs, kind)
+            if not problems:
+                raise
+            raise FacadeError("; ".join(problems)) from None
 
     method.__name__ = access.__name__
     method.__doc__ = (

@@ -12,6 +12,7 @@ lists), so a results folder can be plotted again on its own
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
 import math
@@ -22,6 +23,7 @@ import numpy as np
 
 from .observers import LEDGER_CHANNEL
 from .plot_figure import PlotContext, PlotRequest, plot_figure
+from .results_frame import ResultsError, read_table_text
 from .scene import Scene
 
 __all__ = ["read_results", "plot_scene", "plot_results", "plot_requests", "plot_context"]
@@ -35,6 +37,9 @@ ENERGY_PLOT = "energy"
 def read_results(csv_path: Path) -> dict[str, np.ndarray]:
     """Columns of a results file as float arrays, by name (a text cell reads as NaN).
 
+    A last line cut off (a run killed while writing it) is left out, with a
+    warning naming the file and the line; the rows before it are read.
+
     Parameters
     ----------
     csv_path : Path
@@ -45,16 +50,58 @@ def read_results(csv_path: Path) -> dict[str, np.ndarray]:
     dict of str to ndarray
         Each column by its header (``"time"`` in s, ``"unit.variable"`` in the
         variable's unit), shape (rows,).
+
+    Raises
+    ------
+    ResultsError
+        When the file cannot be read, is empty, has no header line starting with
+        ``time``, or has a row (other than a cut-off last one) of another number
+        of cells than the header; the message names the file and the lines.
     """
-    with Path(csv_path).open(newline="") as f:
-        rows = list(csv.reader(f))
-    header, body = rows[0], rows[1:]
-    data = (
-        np.array([[_number(c) for c in row] for row in body])
-        if body
-        else np.zeros((0, len(header)))
-    )
+    csv_path = Path(csv_path)
+    header, text, cut_line = read_table_text(csv_path)
+    rows = _rows(csv_path, text, len(header))
+    if cut_line is not None:
+        logger.warning(
+            "%s: line %d, the last, was cut off (the run ended while writing it) and is "
+            "dropped; the %d rows before it are read",
+            csv_path,
+            cut_line,
+            len(rows),
+        )
+    data = np.array(rows, dtype=float) if rows else np.zeros((0, len(header)))
     return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def _rows(csv_path: Path, text: str | None, width: int) -> list[list[float]]:
+    """The rows after the header as numbers (the file's, or ``text`` if given).
+
+    Every row must have ``width`` cells; those that do not are named all at once.
+    """
+    rows, wrong = [], []
+    try:
+        with (
+            csv_path.open(encoding="utf-8", newline="")
+            if text is None
+            else io.StringIO(text, newline="")
+        ) as f:
+            reader = csv.reader(f)
+            next(reader, None)  # the header, read and checked already
+            for row in reader:
+                if len(row) == width:
+                    rows.append([_number(c) for c in row])
+                elif row:  # a blank line is no row
+                    wrong.append(f"{reader.line_num} ({len(row)} cell{'s' * (len(row) != 1)})")
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise ResultsError(f"{csv_path}: cannot be read ({err})") from None
+    if wrong:
+        shown = ", ".join(wrong[:5]) + (f" and {len(wrong) - 5} more" if len(wrong) > 5 else "")
+        raise ResultsError(
+            f"{csv_path}: expected {width} cells in every line, as in the header; "
+            f"line {shown} {'differs' if len(wrong) == 1 else 'differ'} "
+            "(not a table as a run writes it)"
+        )
+    return rows
 
 
 def _number(cell: str) -> float:
@@ -206,7 +253,12 @@ def plot_scene(scene: Scene, csv_path: Path, directory: Path) -> list[Path]:
     return _write(read_results(csv_path), meta, Path(directory), scene)
 
 
-def plot_results(folder: str | Path, directory: str | Path | None = None) -> list[Path]:
+def plot_results(
+    folder: str | Path,
+    directory: str | Path | None = None,
+    *,
+    data: dict[str, np.ndarray] | None = None,
+) -> list[Path]:
     """Draw the plots of a results folder again, from its files alone.
 
     Parameters
@@ -215,6 +267,8 @@ def plot_results(folder: str | Path, directory: str | Path | None = None) -> lis
         A results folder (``timeseries.csv`` and ``metadata.json``).
     directory : str or Path, optional
         Where to write the PNG files (default: ``folder``).
+    data : dict of str to ndarray, optional
+        Its ``timeseries.csv`` as :func:`read_results` reads it, if read already.
 
     Returns
     -------
@@ -223,7 +277,8 @@ def plot_results(folder: str | Path, directory: str | Path | None = None) -> lis
     """
     folder = Path(folder)
     meta = read_metadata(folder)
-    data = read_results(folder / "timeseries.csv")
+    if data is None:
+        data = read_results(folder / "timeseries.csv")
     return _write(data, meta, Path(directory or folder), None)
 
 

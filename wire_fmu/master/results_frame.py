@@ -21,7 +21,12 @@ Its ``attrs`` say where it came from and how the run ended:
 ``complete``
     Whether the results are all a finished run writes: False if the run did
     not finish, wrote no summary, or the file's last row was cut off (then
-    dropped). A warning (:class:`IncompleteResultsWarning`) says which.
+    dropped). A warning (:class:`IncompleteResultsWarning`) says which, and
+    the number of the line dropped.
+
+:func:`read_table_text` is the part both readers of the table share (this one and
+:func:`~wire_fmu.master.plots.read_results`): its header, checked, and its text
+without a cut-off last line.
 
 Nothing here imports pandas until a frame is read: the command line imports
 this module through :mod:`~wire_fmu.master.run`.
@@ -36,6 +41,8 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from wire_fmu.core.errors import WireFmuError
+
 from .column_units import TEXT
 
 if TYPE_CHECKING:
@@ -47,6 +54,7 @@ __all__ = [
     "ResultsError",
     "IncompleteResultsWarning",
     "read_results_frame",
+    "read_table_text",
 ]
 
 logger = logging.getLogger(__name__)
@@ -58,7 +66,7 @@ METADATA_NAME = "metadata.json"
 """Units, descriptions, settings and summary of the run, beside the table."""
 
 
-class ResultsError(ValueError):
+class ResultsError(WireFmuError, ValueError):
     """A results folder that cannot be read; the message names the file and what was expected."""
 
 
@@ -100,13 +108,43 @@ def read_results_frame(folder: str | Path) -> pd.DataFrame:
     """
     folder = Path(folder)
     csv_path, meta = _files(folder)
-    text, cut = _complete_lines(csv_path)
-    header = _header(csv_path, text)
+    header, text, cut_line = read_table_text(csv_path)
     units = _units(folder / METADATA_NAME, meta, header)
     frame = _table(csv_path, text, units)
-    frame.attrs.update(_provenance(folder, meta, units, cut))
-    _warn_if_incomplete(folder, frame.attrs, cut)
+    frame.attrs.update(_provenance(folder, meta, units, cut_line is not None))
+    _warn_if_incomplete(folder, frame.attrs, cut_line)
     return frame
+
+
+def read_table_text(csv_path: Path) -> tuple[list[str], str | None, int | None]:
+    """The header of a results table, and its text without a cut-off last line.
+
+    A run killed while writing a row leaves that row without its line end: the
+    row is cut off, and left out here; the rows before it are whole.
+
+    Parameters
+    ----------
+    csv_path : Path
+        A ``timeseries.csv``.
+
+    Returns
+    -------
+    header : list of str
+        The column names, ``"time"`` first.
+    text : str or None
+        The table's complete lines when its last line was cut off; None when the
+        file ends with a complete line (then read the file itself).
+    cut_line : int or None
+        The number (from 1) of the cut-off line left out; None if there is none.
+
+    Raises
+    ------
+    ResultsError
+        When the file cannot be read, is empty, is not UTF-8 text, or its first
+        line is not a whole header starting with ``time``.
+    """
+    text, cut_line = _complete_lines(csv_path)
+    return _header(csv_path, text), text, cut_line
 
 
 def _files(folder: Path) -> tuple[Path, dict[str, Any]]:
@@ -136,7 +174,7 @@ def _files(folder: Path) -> tuple[Path, dict[str, Any]]:
     return csv_path, meta
 
 
-def _complete_lines(csv_path: Path) -> tuple[str | None, bool]:
+def _complete_lines(csv_path: Path) -> tuple[str | None, int | None]:
     """The table's text up to its last complete line if its last line was cut off.
 
     Returns
@@ -144,8 +182,8 @@ def _complete_lines(csv_path: Path) -> tuple[str | None, bool]:
     text : str or None
         The complete lines when the last one is cut off; None when the file ends
         with a complete line (then it is read from the file itself).
-    cut : bool
-        Whether a cut-off last line was dropped.
+    cut_line : int or None
+        The number (from 1) of the cut-off last line dropped; None if none was.
     """
     try:
         with csv_path.open("rb") as f:
@@ -154,7 +192,7 @@ def _complete_lines(csv_path: Path) -> tuple[str | None, bool]:
                 raise ResultsError(f"{csv_path}: empty; expected at least the header line")
             f.seek(size - 1)
             if f.read(1) == b"\n":
-                return None, False
+                return None, None
             f.seek(0)
             data = f.read()
     except OSError as err:
@@ -162,7 +200,8 @@ def _complete_lines(csv_path: Path) -> tuple[str | None, bool]:
     end = data.rfind(b"\n")
     if end < 0:
         raise ResultsError(f"{csv_path}: its header line is cut off; expected a complete header")
-    return _decode(csv_path, data[: end + 1]), True
+    complete = data[: end + 1]
+    return _decode(csv_path, complete), complete.count(b"\n") + 1
 
 
 def _decode(csv_path: Path, data: bytes) -> str:
@@ -264,11 +303,11 @@ def _provenance(
     }
 
 
-def _warn_if_incomplete(folder: Path, attrs: dict[str, Any], cut: bool) -> None:
+def _warn_if_incomplete(folder: Path, attrs: dict[str, Any], cut_line: int | None) -> None:
     """Say why the frame holds less than a finished run writes, if it does."""
     reasons = []
-    if cut:
-        reasons.append(f"the last line of {CSV_NAME} was cut off and is dropped")
+    if cut_line is not None:
+        reasons.append(f"{CSV_NAME} line {cut_line}, the last, was cut off and is dropped")
     if attrs["status"] is None:
         reasons.append(f"{METADATA_NAME} has no summary: the process ended before the run did")
     elif attrs["status"] != "finished":

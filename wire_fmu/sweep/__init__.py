@@ -24,11 +24,12 @@ See ``docs/sweeps.md``.
 """
 
 from .cases import Case, apply_case, expand
-from .runner import SweepResult, run_sweep
+from .runner import SweepResult, load_sweep, run_sweep
 from .spec import SweepError, SweepSpec, SweepSpecError, load_sweep_spec, parse_sweep_spec
 
 __all__ = [
     "run_sweep",
+    "load_sweep",
     "SweepResult",
     "SweepSpec",
     "SweepSpecError",

@@ -25,6 +25,7 @@ __all__ = [
     "TARGET_ROOTS",
     "GRID_KEYS",
     "MAX_AXIS_VALUES",
+    "well_formed_targets",
 ]
 
 DISTRIBUTIONS: Mapping[str, tuple[str, str]] = MappingProxyType(
@@ -335,6 +336,20 @@ def _parse_axes(data: Any, problems: list[str]) -> list[Axis]:
     for target in sorted({t for t in targets if targets.count(t) > 1}):
         problems.append(f"target {target!r} is swept by more than one axis")
     return [a for a in axes if a is not None]
+
+
+def well_formed_targets(data: Any) -> list[str]:
+    """The targets of the ``[[axes]]`` tables that are well formed, whatever else is amiss.
+
+    Parameters
+    ----------
+    data : Any
+        The spec's ``axes``, as read.
+    """
+    if not isinstance(data, list):
+        return []
+    specs = [spec for spec in data if isinstance(spec, Mapping)]
+    return [spec["target"] for spec in specs if _check_target(spec.get("target"), "", problems=[])]
 
 
 def _parse_sampling(data: Any, axes: list[Axis], problems: list[str]) -> Sampling | None:

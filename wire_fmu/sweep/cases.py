@@ -17,7 +17,7 @@ import hashlib
 import itertools
 import json
 import logging
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -38,7 +38,15 @@ from wire_fmu.master.validate import Structure
 from .figures import Figure
 from .spec import SweepSpec, SweepSpecError
 
-__all__ = ["Case", "case_id", "expand", "check_targets", "apply_case", "with_figures_recorded"]
+__all__ = [
+    "Case",
+    "case_id",
+    "expand",
+    "check_targets",
+    "target_problems",
+    "apply_case",
+    "with_figures_recorded",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -282,10 +290,45 @@ def check_targets(spec: SweepSpec, scene: Scene, structure: Structure | None = N
     list of str
         One sentence per problem; empty when everything exists.
     """
-    problems = [p for a in spec.axes if (p := _target_problem(scene, a.target))]
-    if structure is not None and not problems:
-        problems += [p for a in spec.axes if (p := _parameter_exists(scene, structure, a.target))]
-    problems += [p for f in spec.figures if (p := _column_problem(scene, structure, f))]
+    return target_problems([a.target for a in spec.axes], spec.figures, scene, structure)
+
+
+def target_problems(
+    targets: Sequence[str],
+    figures: Sequence[Figure],
+    scene: Scene,
+    structure: Structure | None = None,
+) -> list[str]:
+    """Every one of ``targets`` and of the ``figures``' columns that ``scene`` lacks.
+
+    Each target and column is checked on its own, so that one's problem hides no
+    other's (a spec with format problems is checked so too, see
+    :class:`~wire_fmu.sweep.spec.SweepSpecError`).
+
+    Parameters
+    ----------
+    targets : sequence of str
+        Well-formed axis targets (``units.<unit>.parameters.<name>`` ...).
+    figures : sequence of Figure
+        Key figures.
+    scene : Scene
+        The scene swept.
+    structure : Structure, optional
+        The units' model descriptions, as for :func:`check_targets`.
+
+    Returns
+    -------
+    list of str
+        One sentence per problem; empty when everything exists.
+    """
+    problems = []
+    for target in targets:
+        problem = _target_problem(scene, target)
+        if problem is None and structure is not None:
+            problem = _parameter_exists(scene, structure, target)
+        if problem:
+            problems.append(problem)
+    problems += [p for f in figures if (p := _column_problem(scene, structure, f))]
     return problems
 
 

@@ -19,14 +19,61 @@ from .worker import CaseTask, _dask_case, _describe, _worker_core
 
 logger = logging.getLogger(__name__)
 
+SCHEDULER_EXAMPLE = "tcp://10.0.0.5:8786"
+"""A Dask scheduler address, as messages show one."""
+_HOST_PORT_PROTOCOLS = frozenset({"tcp", "tls", "ws", "wss", "ucx"})
+
+
+def scheduler_problem(address: str) -> str | None:
+    """Why ``address`` is not the address of a Dask scheduler, or None if it is one.
+
+    Only its form is checked (a known protocol, and a host and a port where the
+    protocol needs them); whether a scheduler answers there is not.
+
+    Parameters
+    ----------
+    address : str
+        As given, e.g. ``"tcp://10.0.0.5:8786"`` (``tcp://`` may be left out).
+    """
+    from distributed.comm import registry
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    expected = f"expected PROTOCOL://HOST:PORT, e.g. {SCHEDULER_EXAMPLE}, got {address!r}"
+    try:
+        protocol, location = parse_address(address)
+    except (TypeError, ValueError) as err:
+        return f"{expected} ({err})"
+    if protocol not in registry.backends:
+        known = ", ".join(sorted(registry.backends))
+        return f"{expected} (unknown protocol {protocol!r}; known: {known})"
+    if protocol in _HOST_PORT_PROTOCOLS:
+        try:
+            parse_host_port(location)
+        except ValueError as err:
+            return f"{expected} ({err})"
+    return None
+
 
 @contextmanager
 def _client(workers: int, scheduler: str | None) -> Iterator[Any]:
-    """A Dask client: to ``scheduler``, or to a new local cluster of ``workers`` processes."""
+    """A Dask client: to ``scheduler``, or to a new local cluster of ``workers`` processes.
+
+    Raises
+    ------
+    SweepError
+        When no scheduler answers at ``scheduler``.
+    """
     from distributed import Client, LocalCluster
 
     if scheduler:
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler)
+        except OSError as err:
+            raise SweepError(
+                f"no Dask scheduler answers at {scheduler!r} ({err}); start one there "
+                "(dask scheduler), or leave --scheduler out to run on a local cluster"
+            ) from None
+        with client:
             yield client
         return
     if workers < 1:

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FUNCTIONS", "RESERVED_COLUMNS", "Figure"]
+__all__ = ["FUNCTIONS", "RESERVED_COLUMNS", "Figure", "well_formed_figures"]
 
 
 def _peak(time: np.ndarray, values: np.ndarray) -> float:
@@ -137,6 +137,25 @@ def _parse_figure(name: str, text: Any, problems: list[str]) -> Figure | None:
         problems.append(f"{where}: the column must be 'unit.variable', got {column!r}")
         return None
     return Figure(name, function, column)
+
+
+def well_formed_figures(data: Any) -> list[Figure]:
+    """The ``[figures]`` entries that read ``function(unit.variable)``, whatever else is
+    amiss (an unknown function, a reserved name): their columns can still be checked.
+
+    Parameters
+    ----------
+    data : Any
+        The spec's ``figures``, as read.
+    """
+    if not isinstance(data, Mapping):
+        return []
+    figures = []
+    for name, text in data.items():
+        match = _FIGURE_RE.match(text) if isinstance(text, str) else None
+        if match is not None and "." in match.group(3):
+            figures.append(Figure(str(name), match.group(1), match.group(3)))
+    return figures
 
 
 def _parse_figures(data: Any, problems: list[str]) -> list[Figure]:

@@ -44,6 +44,7 @@ import pyarrow.parquet as pq
 
 from wire_fmu.master.plot_units import DisplayUnit, display_unit
 from wire_fmu.master.plots import read_results
+from wire_fmu.master.results_frame import ResultsError
 
 from .axes import Axis
 from .cases import Case
@@ -307,7 +308,11 @@ class ResultStore:
         missing = [f for f in self.spec.figures if f.name not in record]
         csv = self.case_dir(case.case_id) / TIMESERIES_FILE
         if missing and record["status"] in ("finished", "stopped") and csv.exists():
-            columns = read_results(csv)
+            try:
+                columns = read_results(csv)
+            except ResultsError as err:  # the other cases' figures stand without this one's
+                logger.warning("case %s: key figures left out: %s", case.case_id, err)
+                columns = {}
             row |= {f.name: f.evaluate(columns) for f in missing}
         if list(record) != self.schema.names or record["index"] != case.index:
             self._write_record(row)

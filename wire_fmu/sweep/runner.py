@@ -63,14 +63,15 @@ from wire_fmu.master.run import find_scene
 from wire_fmu.master.scene import Scene, load_scene
 from wire_fmu.master.validate import Structure, check_structure, resolve_units
 
-from .cases import Case, apply_case, check_targets, expand, with_figures_recorded
-from .cluster import _check_workers, _client, _run_on_dask
+from .cases import Case, apply_case, expand, target_problems, with_figures_recorded
+from .cluster import _check_workers, _client, _run_on_dask, scheduler_problem
+from .figures import Figure
 from .results import DONE_STATUSES, CaseOutcome, ResultStore, plot_summary
-from .spec import SweepSpec, SweepSpecError, load_sweep_spec
+from .spec import SweepError, SweepSpec, SweepSpecError, load_sweep_spec
 from .units import case_metadata, sweep_units
 from .worker import CaseTask, _describe, _execute_here
 
-__all__ = ["run_sweep", "SweepResult", "ProgressWriter", "scene_key"]
+__all__ = ["run_sweep", "load_sweep", "SweepResult", "ProgressWriter", "scene_key"]
 
 logger = logging.getLogger(__name__)
 
@@ -195,12 +196,60 @@ def scene_key(scene: Scene) -> str:
     return hashlib.sha256(repr(normal).encode("utf-8")).hexdigest()[:16]
 
 
-def _load(scene: str | Path | Scene, spec: str | Path | SweepSpec) -> tuple[Scene, SweepSpec]:
+def _load(
+    scene: str | Path | Scene, spec: str | Path | SweepSpec, fmu_dir: Path
+) -> tuple[Scene, SweepSpec]:
     if not isinstance(scene, Scene):
         scene = load_scene(find_scene(scene))
     if not isinstance(spec, SweepSpec):
-        spec = load_sweep_spec(Path(spec))
+        spec = load_sweep(scene, Path(spec), fmu_dir)
     return scene, spec
+
+
+def load_sweep(scene: Scene, path: Path, fmu_dir: Path = DEFAULT_FMU_DIR) -> SweepSpec:
+    """Read the sweep spec at ``path``; if it has problems, say those of sweeping ``scene`` too.
+
+    A spec with problems of its own (a bad value list, an unknown function) is
+    also checked against the scene, as far as it can be: its well-formed targets
+    and its key figures (:func:`~wire_fmu.sweep.cases.target_problems`), and the
+    scene's units. Every problem is then said at once.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene to sweep.
+    path : Path
+        The spec file.
+    fmu_dir : Path
+        Where our FMUs are built and cached.
+
+    Raises
+    ------
+    SweepSpecError
+        Every problem of the spec and, if it has any, of sweeping ``scene`` with it.
+    """
+    try:
+        return load_sweep_spec(path)
+    except SweepSpecError as err:
+        if not (err.targets or err.figures):  # unreadable, or nothing to check
+            raise
+        _, more = _scene_problems(scene, err.targets, err.figures, fmu_dir)
+        if not more:
+            raise
+        raise SweepSpecError(
+            f"{err.where} for scene {scene.name!r}", [*err.problems, *more]
+        ) from None
+
+
+def _scene_problems(
+    scene: Scene, targets: Sequence[str], figures: Sequence[Figure], fmu_dir: Path
+) -> tuple[Structure, list[str]]:
+    """The scene's units built and checked, and the targets and figure columns it lacks."""
+    structure, problems = resolve_units(scene, fmu_dir)
+    if not problems:
+        problems += check_structure(scene, structure) + _stale_fmus(structure)
+    problems += target_problems(targets, figures, scene, structure if not problems else None)
+    return structure, problems
 
 
 def _prepare(scene: Scene, spec: SweepSpec, fmu_dir: Path) -> Scene:
@@ -211,10 +260,8 @@ def _prepare(scene: Scene, spec: SweepSpec, fmu_dir: Path) -> Scene:
     SweepSpecError
         Every problem of the scene's structure and of the spec's targets.
     """
-    structure, problems = resolve_units(scene, fmu_dir)
-    if not problems:
-        problems += check_structure(scene, structure) + _stale_fmus(structure)
-    problems += check_targets(spec, scene, structure if not problems else None)
+    targets = [a.target for a in spec.axes]
+    structure, problems = _scene_problems(scene, targets, spec.figures, fmu_dir)
     if problems:
         raise SweepSpecError(f"sweep {spec.name!r} of scene {scene.name!r}", problems)
     units = {
@@ -338,11 +385,14 @@ def run_sweep(
     SweepSpecError
         The spec's targets or figures do not fit the scene (every problem).
     SweepError
-        The output folder holds another scene's sweep; workers that cannot
-        run this version of wire_fmu.
+        A count of workers below 0 or a scheduler address of the wrong form
+        (said before anything runs); the output folder holds another scene's
+        sweep; no scheduler answers; workers that cannot run this version of
+        wire_fmu.
     """
     wall = time.perf_counter()
-    scene, spec = _load(scene, spec)
+    _check_options(workers, scheduler)
+    scene, spec = _load(scene, spec, fmu_dir)
     cases = expand(spec)
     base = _prepare(scene, spec, fmu_dir)
     store = ResultStore(out_dir, spec, cases)
@@ -395,6 +445,26 @@ def run_sweep(
     )
     logger.info("sweep %r: %s in %.3g s", spec.name, result.counts, result.wall_time)
     return result
+
+
+def _check_options(workers: Any, scheduler: str | None) -> None:
+    """Refuse a count of workers or a scheduler address that cannot be, before any work.
+
+    Raises
+    ------
+    SweepError
+        Naming each option at fault and what it takes.
+    """
+    problems = []
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        problems.append(
+            f"workers = {workers!r}: expected a whole number >= 1, or 0 to run the cases "
+            "in this process"
+        )
+    if scheduler is not None and (problem := scheduler_problem(scheduler)):
+        problems.append(f"scheduler: {problem}")
+    if problems:
+        raise SweepError("; ".join(problems))
 
 
 def _units(spec: SweepSpec, store: ResultStore, rows: list[dict[str, Any]]) -> dict[str, str]:

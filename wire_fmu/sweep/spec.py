@@ -4,7 +4,8 @@ A sweep spec is a TOML file (data only, nothing is executed).
 :func:`load_sweep_spec` reads it and :func:`parse_sweep_spec` checks the
 data, listing every problem at once (:class:`SweepSpecError`). Whether the
 targets exist in a given scene is checked by
-:func:`wire_fmu.sweep.cases.check_targets`.
+:func:`wire_fmu.sweep.cases.check_targets`; :func:`wire_fmu.sweep.runner.load_sweep`
+reads a spec for a scene and says the problems of both at once.
 
 Format::
 
@@ -70,7 +71,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -79,8 +80,8 @@ from wire_fmu.core.errors import ConfigurationError, WireFmuError
 from wire_fmu.master.files import UnreadableFileError, read_regular
 from wire_fmu.master.scene import MAX_SCENE_BYTES, is_plain_name
 
-from .axes import Axis, Sampling, _parse_axes, _parse_sampling
-from .figures import Figure, _parse_figures
+from .axes import Axis, Sampling, _parse_axes, _parse_sampling, well_formed_targets
+from .figures import Figure, _parse_figures, well_formed_figures
 
 __all__ = [
     "SweepSpec",
@@ -93,7 +94,35 @@ __all__ = [
 
 
 class SweepSpecError(ConfigurationError):
-    """A sweep spec with problems; ``problems`` lists every one."""
+    """A sweep spec with problems; ``problems`` lists every one.
+
+    Parameters
+    ----------
+    where : str
+        The spec (or the sweep) the problems belong to.
+    problems : iterable of str
+        One sentence per problem.
+    targets : iterable of str, optional
+        The spec's axis targets that are well formed, also those of axes with
+        other problems, and
+    figures : iterable of Figure, optional
+        its key figures that read ``function(unit.variable)``, also those with
+        other problems: what can still be checked against a scene
+        (:func:`wire_fmu.sweep.runner.load_sweep` does), so that a spec's
+        problems are all said at once.
+    """
+
+    def __init__(
+        self,
+        where: str,
+        problems: Iterable[str],
+        *,
+        targets: Iterable[str] = (),
+        figures: Iterable[Figure] = (),
+    ) -> None:
+        super().__init__(where, problems)
+        self.targets = tuple(targets)
+        self.figures = tuple(figures)
 
 
 class SweepError(WireFmuError, RuntimeError):
@@ -191,8 +220,10 @@ def parse_sweep_spec(data: Mapping[str, Any], *, source: Path | None = None) -> 
     for key in data:
         if key not in _TOP_KEYS:
             problems.append(f"unknown top-level key {key!r}; known: {', '.join(sorted(_TOP_KEYS))}")
+    before = len(problems)
     axes = _parse_axes(data.get("axes"), problems)
     sampling = _parse_sampling(data.get("sampling"), axes, problems)
+    cases_known = len(problems) == before  # every axis, and the sampling, as given
     figures = _parse_figures(data.get("figures", {}), problems)
     name = data.get("name", source.stem if source else "sweep")
     if not (isinstance(name, str) and is_plain_name(name)):
@@ -201,10 +232,16 @@ def parse_sweep_spec(data: Mapping[str, Any], *, source: Path | None = None) -> 
             "'-', '.', no '..'), since it names the sweep's results folder"
         )
         name = "sweep"
-    if not problems:
-        _check_case_count(data.get("max_cases", MAX_CASES), axes, sampling, problems)
+    limit = _max_cases(data.get("max_cases", MAX_CASES), problems)
+    if limit is not None and cases_known:
+        _check_case_count(limit, axes, sampling, problems)
     if problems:
-        raise SweepSpecError(f"sweep spec {name!r}", problems)
+        raise SweepSpecError(
+            f"sweep spec {name!r}",
+            problems,
+            targets=well_formed_targets(data.get("axes")),
+            figures=well_formed_figures(data.get("figures", {})),
+        )
     return SweepSpec(
         tuple(axes),
         tuple(figures),
@@ -216,11 +253,16 @@ def parse_sweep_spec(data: Mapping[str, Any], *, source: Path | None = None) -> 
     )
 
 
-def _check_case_count(limit: Any, axes: list, sampling: Any, problems: list[str]) -> None:
-    """Refuse a sweep of more cases than ``max_cases``, saying how many and how to allow it."""
+def _max_cases(limit: Any, problems: list[str]) -> int | None:
+    """``max_cases`` as given, or None (and a problem) if it is not a whole number >= 1."""
     if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
         problems.append(f"'max_cases' must be a whole number >= 1, got {limit!r}")
-        return
+        return None
+    return limit
+
+
+def _check_case_count(limit: int, axes: list, sampling: Any, problems: list[str]) -> None:
+    """Refuse a sweep of more cases than ``max_cases``, saying how many and how to allow it."""
     count = math.prod(len(a.values) for a in axes if a.values)
     count *= sampling.samples if sampling else 1
     if count > limit:

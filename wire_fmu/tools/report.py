@@ -28,7 +28,7 @@ from wire_fmu.master.results_frame import CSV_NAME, METADATA_NAME, ResultsError
 
 from .report_html import Raw, details, esc, image, page, table
 
-__all__ = ["REPORT_NAME", "write_report"]
+__all__ = ["REPORT_NAME", "ReportError", "write_report"]
 
 logger = logging.getLogger(__name__)
 
@@ -46,6 +46,10 @@ _RUN_UNITS = {
 """Units of the run settings that have one (the others are pure numbers, names or flags)."""
 
 
+class ReportError(WireFmuError, ValueError):
+    """The report cannot be written where asked; the message names the file and why."""
+
+
 def write_report(
     folder: str | Path, output: str | Path | None = None, *, plots: list[Path] | None = None
 ) -> Path:
@@ -56,7 +60,8 @@ def write_report(
     folder : str or Path
         A results folder as a run writes it.
     output : str or Path, optional
-        The HTML file (default ``<folder>/report.html``).
+        The HTML file, or an existing folder to write ``report.html`` into
+        (default ``<folder>/report.html``).
     plots : list of Path, optional
         The run's plot files; default those of the folder, drawn again if
         missing.
@@ -69,7 +74,11 @@ def write_report(
     Raises
     ------
     ResultsError
-        When the folder has no readable ``metadata.json``.
+        When the folder has no readable ``metadata.json``, or its
+        ``timeseries.csv`` cannot be read as a table (see
+        :func:`~wire_fmu.master.plots.read_results`).
+    ReportError
+        When the report cannot be written where ``output`` says.
     """
     folder = Path(folder)
     meta = read_metadata(folder)
@@ -78,14 +87,43 @@ def write_report(
             f"{folder / METADATA_NAME}: missing or unreadable; expected a results folder "
             f"as a run writes it ({METADATA_NAME} and {CSV_NAME})"
         )
+    target = _target(folder, output)
     data = read_results(folder / CSV_NAME) if (folder / CSV_NAME).is_file() else {}
     notes: list[str] = []
     figures = _plots(folder, meta, data, plots, notes)
     drawings = _drawings(folder, meta, notes)
-    target = Path(output) if output else folder / REPORT_NAME
-    target.write_text(_page(folder, meta, data, figures, drawings, notes), encoding="utf-8")
+    page = _page(folder, meta, data, figures, drawings, notes)
+    try:
+        target.write_text(page, encoding="utf-8")
+    except OSError as err:
+        raise ReportError(f"{target}: the report cannot be written: {_reason(err)}") from None
     logger.info("report: %s", target)
     return target
+
+
+def _target(folder: Path, output: str | Path | None) -> Path:
+    """The report's file: ``output``, or :data:`REPORT_NAME` in it if it is a folder.
+
+    Raises
+    ------
+    ReportError
+        When the file's folder does not exist (said before anything is drawn).
+    """
+    if output is None:
+        return folder / REPORT_NAME
+    target = Path(output)
+    if target.is_dir():
+        return target / REPORT_NAME
+    if not target.parent.is_dir():
+        raise ReportError(
+            f"{target}: the report cannot be written: no folder {target.parent}; expected "
+            "an HTML file in an existing folder, or an existing folder for report.html"
+        )
+    return target
+
+
+def _reason(err: OSError) -> str:
+    return err.strerror or type(err).__name__
 
 
 # ----------------------------------------------------------------------------- images
@@ -96,7 +134,7 @@ def _plots(folder: Path, meta, data, given: list[Path] | None, notes: list[str])
         given = [folder / f"{name}.png" for name, _ in requests]
         if data and not all(p.is_file() for p in given):
             try:
-                given = plot_results(folder)
+                given = plot_results(folder, data=data)
             except Exception as exc:  # noqa: BLE001 - the report stands without its plots
                 notes.append(f"the plots could not be drawn: {exc}")
                 given = [p for p in given if p.is_file()]
