@@ -333,6 +333,21 @@ def test_a_start_too_large_for_the_drive_is_named_without_numpy_warnings(values,
     assert all(name in text for name in named)
 
 
+def test_a_torque_too_large_mid_run_refuses_the_step_without_numpy_warnings():
+    """A finite input the drive cannot integrate (1e308 N m) makes the state overflow: the
+    step is refused, naming the unit and the non-finite state, and numpy's own warnings
+    stay out of the host's terminal."""
+    unit = make_drive({}, "", **{"motor.torque": 100.0})
+    run(unit, 0.02, 0.01)
+    unit.values["motor.torque"] = 1e308
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a numpy RuntimeWarning would fail here
+        result = unit.advance(0.02, 0.01)
+    assert not result.success
+    assert "MultiMassDrive 'drive'" in result.message and "non-finite" in result.message
+    assert unit.time == pytest.approx(0.02)  # the refused step left the state where it was
+
+
 def test_declarations_and_feedthrough():
     assert DriveUnit.check_declarations() == []
     unit = make_drive({"motor_slope": 25.6}, "motor_characteristic", **{"motor.torque": 10.0})

@@ -30,6 +30,8 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, ClassVar
 
+import numpy as np
+
 from wire_fmu.core.errors import ModelError
 from wire_fmu.core.framework.data_fields import DataField
 from wire_fmu.core.framework.hybrid import IntegrationError
@@ -270,7 +272,10 @@ class Unit(ABC):
         saved = self._snapshot()
         changes = self.values.get(MODE_CHANGES)
         try:
-            events = self._advance(time, step)
+            # numpy's floating-point warnings stay out of the host's terminal while the model
+            # is integrated: a state that is not finite is refused, naming the unit and step
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                events = self._advance(time, step)
             self.time = time + step
             self._update_outputs()
             if MODE_CHANGE_TIME in self.values and self.values.get(MODE_CHANGES) != changes:

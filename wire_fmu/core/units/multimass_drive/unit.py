@@ -344,10 +344,11 @@ class DriveUnit(Unit):
         if keep == 0 or keep == tree.n:
             return tree
         if not tree.is_chain() or keep < 2:
-            what = "a branched drive" if not tree.is_chain() else f"{keep} masses"
+            what = "a branched drive" if not tree.is_chain() else f"masses_kept = {keep}"
             problems.append(
                 f"parameter 'masses_kept': delta-star reduction keeps 2..{tree.n} "
-                f"masses of a chain (motor first, load last); got {what}"
+                f"masses of a chain (motor first, load last), or 0 for the full drive; "
+                f"got {what}"
             )
             return tree
         if tree.motors != (0,) or tree.load_index != tree.n - 1:
