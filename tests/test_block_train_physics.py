@@ -298,6 +298,20 @@ class TestBadInput:
         assert "starting tension 356000 N" in text and "'axial_stiffness' 1e+30 N" in text
         assert "3.56e-25, is below what the span lengths resolve" in text
 
+    @pytest.mark.parametrize("equilibrium", [True, False])
+    def test_a_start_at_or_above_the_breaking_load_is_refused(self, equilibrium):
+        """A span breaks when its tension rises through the breaking load; one that starts
+        above it never would: 1000 kg hanging on one line pulls m g = 9810 N (g = 9.81 m/s^2)."""
+        reeving = single_fall(axial_stiffness=1.3e8)
+        reeving["rope"]["breaking_load"] = 5000.0
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(reeving, initial_equilibrium=equilibrium, pretension=9810.0)
+        text = str(info.value)
+        assert "starting tension 9810 N is at or above the rope's 'breaking_load' 5000 N" in text
+        reeving["rope"]["breaking_load"] = 9900.0  # above the start: it starts, unbroken
+        unit = make_unit(reeving, initial_equilibrium=equilibrium, pretension=9810.0)
+        assert unit.values["line_a.tension"] == pytest.approx(9810.0, rel=1e-9)
+
     @pytest.mark.parametrize("pretension", [1e-3, 1.0, 3.56e5])
     def test_a_small_pretension_on_a_real_rope_starts_at_it(self, pretension):
         unit = make_unit(

@@ -71,6 +71,7 @@ class StartingState:
         flow = np.concatenate((self.q, held.line_positions))
         self.offsets = big_l * ea / (ea + tension) - self.flow_matrix @ flow
         self._check_start_tension(big_l, flow, tension)
+        self._check_breaking_load(tension)
         self.taut_mask = np.full(len(self.spans), tension > 0.0)
         self.contact_mask = np.array(
             [b.floor is not None and b.position < b.floor.position for b in self.blocks], dtype=bool
@@ -104,6 +105,28 @@ class StartingState:
                     "give the rope a stiffness it has (steel wire rope: about 1e7 to 1e9 N) or "
                     "the start a larger tension (the pretension, or with initial_equilibrium the "
                     "blocks' weight)"
+                ],
+            )
+
+    def _check_breaking_load(self, tension: float) -> None:
+        """Refuse a start at or above the rope's breaking load: a span breaks when its
+        tension rises through the breaking load, which a span that starts above it never
+        does, so such a rope would carry any load unbroken.
+
+        Parameters
+        ----------
+        tension : float
+            The starting tension of every span, N.
+        """
+        breaking = self.rope.breaking_load
+        if tension >= breaking:
+            raise ConfigurationError(
+                "block train",
+                [
+                    f"starting tension {tension:.6g} N is at or above the rope's "
+                    f"'breaking_load' {breaking:.6g} N: the rope would break at the start; give "
+                    "it a breaking load above the starting tension (the pretension, or with "
+                    "initial_equilibrium the blocks' weight per line) or start with less"
                 ],
             )
 
