@@ -13,7 +13,13 @@ import pytest
 
 from wire_fmu.core.components.rope import snap_load
 from wire_fmu.core.errors import ConfigurationError
-from wire_fmu.core.units.block_train.reevings import drilling_block_train, single_fall
+from wire_fmu.core.units.block_train.reeving_parse import parse_reeving
+from wire_fmu.core.units.block_train.reevings import (
+    drilling_block_train,
+    heave_compensated_block_train,
+    riser_tensioner,
+    single_fall,
+)
 
 from .block_train_helpers import make_unit, run
 
@@ -328,6 +334,82 @@ class TestBadInput:
             make_unit(reeving)
         assert "crown_0" in str(info.value) and "crown_1" in str(info.value)
 
+    def test_a_name_given_to_a_sheave_and_an_anchor_is_refused(self):
+        reeving = riser_tensioner()
+        reeving["anchors"]["fixed_1"] = reeving["anchors"].pop("dead_end")
+        reeving["path"][0] = {"anchor": "fixed_1"}
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(reeving)
+        assert info.value.problems == [
+            "parameter 'reeving': sheave 'fixed_1' and anchor 'fixed_1': the same name for two "
+            "nodes; every sheave and anchor needs a name of its own"
+        ]
+
+    def test_a_sheave_passed_twice_is_refused_naming_both_places(self):
+        """The model gives each passage of the path its own groove, rim and bearing: a sheave
+        met twice would turn twice over, with its inertia and friction counted twice."""
+        reeving = riser_tensioner()
+        path = reeving["path"]
+        reeving["path"] = path[:3] + path[1:3] + path[3:]  # ..., moving_1, fixed_1, moving_1, ...
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(reeving)
+        text = str(info.value)
+        assert "path nodes 1 and 3: sheave 'moving_1' is passed twice" in text
+        assert "path nodes 2 and 4: sheave 'fixed_1' is passed twice" in text
+        assert "one sheave per groove" in text
+        assert len(info.value.problems) == 2
+
+    def test_a_list_or_table_given_for_a_name_is_named_not_raised(self):
+        """Names are looked up in tables: a list or a table given for one is named as a
+        problem (it raised TypeError: unhashable type)."""
+        reeving = riser_tensioner()
+        reeving["path"][0] = {"anchor": {"name": "dead_end"}}
+        reeving["path"][1] = {"sheave": ["moving_1"], "wrap": ["cw"]}
+        reeving["bodies"]["rod"]["port"] = ["mover_a"]
+        reeving["bodies"]["riser"]["on"] = ["rod"]
+        reeving["sheaves"]["guide"]["body"] = ["ground"]
+        with pytest.raises(ConfigurationError) as info:
+            parse_reeving(reeving)
+        text = str(info.value)
+        for needle in (
+            "anchor {'name': 'dead_end'} is not defined",
+            "sheave ['moving_1'] is not defined",
+            "'wrap' must be 'ccw' or 'cw', got ['cw']",
+            "'port' of a driven body must be one of ('mover_a', 'mover_b'), got ['mover_a']",
+            "'on' names ['rod'], which is not a body",
+            "sheave 'guide': 'body' ['ground'] is not a body",
+        ):
+            assert needle in text
+
+    def test_coincident_sheaves_in_one_plane_are_refused(self):
+        reeving = riser_tensioner()
+        reeving["sheaves"]["fixed_2"]["centre"] = list(reeving["sheaves"]["fixed_1"]["centre"])
+        with pytest.raises(ConfigurationError) as info:
+            make_unit(reeving)
+        assert "sheaves 'fixed_1' and 'fixed_2': discs coincide in the same plane" in str(
+            info.value
+        )
+
+    @pytest.mark.parametrize("rope", [{"damping": 2.0e5}, {}])
+    def test_a_rope_without_stiffness_names_both_ways_to_give_it(self, rope):
+        reeving = riser_tensioner()
+        reeving["rope"] = rope
+        with pytest.raises(ConfigurationError) as info:
+            parse_reeving(reeving)
+        assert info.value.problems == [
+            "rope: its stiffness is required: give 'axial_stiffness' (EA, N), or "
+            "'metallic_area' (m2) and 'modulus' (Pa)"
+        ]
+
+    def test_half_a_metallic_area_and_modulus_pair_names_the_other_way(self):
+        reeving = riser_tensioner()
+        reeving["rope"] = {"metallic_area": 1.2e-3}
+        with pytest.raises(ConfigurationError) as info:
+            parse_reeving(reeving)
+        assert info.value.problems == [
+            "rope: 'modulus' is required with 'metallic_area' (or give 'axial_stiffness' instead)"
+        ]
+
     def test_effect_that_needs_another(self):
         with pytest.raises(ConfigurationError, match="needs effect 'sheave_inertia'"):
             make_unit(drilling_block_train(4), "bearing_friction")
@@ -431,3 +513,37 @@ def test_blocks_cannot_ride_on_bodies():
     reeving["bodies"]["travelling_block"]["on"] = "ground"
     with pytest.raises(ConfigurationError, match="cannot ride"):
         make_unit(reeving)
+
+
+class TestWrapWarning:
+    """A rope wrapping a sheave by more than 200 deg crosses itself in the sheave's plane:
+    legal (a capstan, its rope leaving the plane) but most often a wrap direction given the
+    wrong way round, so a warning naming the unit, the sheave, the angle and the other wrap."""
+
+    def test_a_flipped_wrap_is_warned_of(self, caplog):
+        reeving = riser_tensioner()
+        reeving["path"][2]["wrap"] = "cw"  # fixed_1: the rope goes round it the long way
+        with caplog.at_level("WARNING", logger="wire_fmu"):
+            make_unit(reeving)
+        warnings = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+        assert len(warnings) == 1, warnings
+        assert warnings[0].startswith(
+            "BlockTrain 'test': parameter 'reeving': sheave 'fixed_1' (path node 2): the rope "
+            "wraps it by 221.1 deg, more than 200 deg, so in the sheave's plane the rope "
+            "leaving it crosses the rope coming in; wrap = 'cw' may be the wrong way round: "
+            "with wrap = 'ccw' the rope goes round the other side"
+        )
+        # by hand: the spans from the moving sheaves at (0.75, 4) and (3.75, 4) m reach
+        # fixed_1 at (2.25, 0) m (all r = 0.75 m) on its far sides, each crossing the centre
+        # line: theta = 180 deg + 2 asin(2 r / d), d = |(1.5, 4)| m
+        theta = 180.0 + 2.0 * math.degrees(math.asin(1.5 / math.hypot(1.5, 4.0)))
+        assert theta == pytest.approx(221.1, abs=0.05)
+
+    @pytest.mark.parametrize(
+        "reeving",
+        [riser_tensioner, drilling_block_train, heave_compensated_block_train],
+    )
+    def test_the_shipped_reevings_are_not_warned_of(self, reeving, caplog):
+        with caplog.at_level("WARNING", logger="wire_fmu"):
+            make_unit(reeving())
+        assert [r.getMessage() for r in caplog.records if r.levelname == "WARNING"] == []

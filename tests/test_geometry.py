@@ -354,6 +354,35 @@ def test_overlap_of_sheaves_that_are_not_neighbours():
     )
 
 
+def test_coincident_sheaves_in_one_plane_are_refused():
+    """Two sheaves with the same centre and radius in one plane are one disc: refused like
+    overlapping ones (the exemption is only for the same sheave met again)."""
+    nodes = [
+        point("anchor", -1, -10),
+        sheave("A", 0, 0, 1.0, -1),
+        sheave("B", 5, -10, 1.0, +1),
+        sheave("C", 0, 0, 1.0, -1),
+        point("end", 1, -10),
+    ]
+    msg = only_problem(nodes)
+    assert msg == (
+        "sheaves 'A' and 'C': discs coincide in the same plane: same centre (0, 0, 0) m "
+        "and radius 1.000 m"
+    )
+
+
+def test_sheaves_side_by_side_on_one_shaft_are_not_an_overlap():
+    """Same centre line and radius, offset along the axis: two grooves on one shaft."""
+    nodes = [
+        point("anchor", -1, -10),
+        sheave("A", 0, 0, 1.0, -1),
+        sheave("B", 5, -10, 1.0, +1),
+        sheave("C", 0, 0, 1.0, -1, z=0.3),
+        point("end", 1, -10, 0.3),
+    ]
+    assert check_path(nodes) == []
+
+
 def test_zero_length_segment():
     msg = only_problem([point("a", 1, 2), point("b", 1, 2)])
     assert "'a'" in msg and "'b'" in msg and "same place" in msg

@@ -191,8 +191,17 @@ def _overlap_problem(p: Circle, q: Circle) -> str | None:
     if abs(_dot(d, p.axis)) > _POS_TOL:
         return None
     dist = _norm(d)
-    same = dist <= _POS_TOL and abs(p.radius - q.radius) <= _POS_TOL
-    if same or dist >= p.radius + q.radius:
+    if dist <= _POS_TOL and abs(p.radius - q.radius) <= _POS_TOL:
+        # One disc: the same sheave met again along the path (the pairs compare every two
+        # nodes, so a node is no overlap of itself), else two sheaves in one place. Sheaves
+        # side by side on one shaft are offset along the axis, so never get here.
+        if p == q:
+            return None
+        return (
+            f"{_pair(p, q)}: discs coincide in the same plane: same centre {_fmt(p.centre)} m "
+            f"and radius {p.radius:.3f} m"
+        )
+    if dist >= p.radius + q.radius:
         return None
     return (
         f"{_pair(p, q)}: discs overlap in the same plane: centre distance {dist:.3f} m "

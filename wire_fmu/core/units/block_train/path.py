@@ -22,7 +22,20 @@ from wire_fmu.core.components.sheave_geometry.path import path_geometry
 from wire_fmu.core.components.sheave_geometry.planar_path import planar_frame, planar_path_lengths
 from wire_fmu.core.errors import ConfigurationError
 
-__all__ = ["ReevedPath"]
+__all__ = ["ReevedPath", "LARGE_WRAP"]
+
+LARGE_WRAP = math.radians(200.0)
+"""Wrap angle above which a sheave's wrap is warned of, rad.
+
+In one plane a rope turning round a sheave by theta > 180 deg crosses itself: the span
+leaving it meets the span coming in r |tan(theta / 2)| from where that one touches the
+sheave (5.7 r at 200 deg, 2.7 r at the 221 deg of a riser tensioner's fixed sheave given
+``wrap = "cw"`` instead of "ccw", r at 270 deg), far closer than the spans of a block train
+are long. A sheave of a plain reeving turns the rope by at most 180 deg (a U-turn between
+two blocks); 200 deg leaves room for round-off and small fleet angles. A wrap direction
+given the wrong way round sends the rope round the other side, 360 deg less the turn
+meant. A capstan, whose rope leaves the plane groove by groove, may wrap further on
+purpose, so this is a warning, not a problem."""
 
 
 @dataclass(frozen=True)
@@ -134,6 +147,7 @@ class ReevedPath:
             self._require_planar(geo)
         self.wrap_angles = np.zeros(self.n_nodes)
         self.wrap_angles[1:-1] = geo.wrap_angles
+        self.wrap_warnings = self._large_wraps()
         self.segment_length0 = lengths
         n_dof = len(self.body_dof)
         jac = np.zeros((self.n_segments, n_dof))
@@ -161,6 +175,30 @@ class ReevedPath:
             if idx != self.rim_index[k]:
                 s = self.reeving.sheaves[self.nodes[k].name]
                 self.masses[idx] = self.rope.linear_mass * s.radius * self.wrap_angles[k]
+
+    def _large_wraps(self) -> list[str]:
+        """A warning for each sheave the rope wraps by more than :data:`LARGE_WRAP`.
+
+        Returns
+        -------
+        list of str
+            One sentence per such sheave: its name and path node, the wrap angle (deg),
+            and the other wrap direction to try.
+        """
+        warnings = []
+        for k, node in enumerate(self.nodes):
+            if node.kind != "sheave" or not self.wrap_angles[k] > LARGE_WRAP:
+                continue
+            given, other = ("ccw", "cw") if node.sense > 0 else ("cw", "ccw")
+            warnings.append(
+                f"sheave {node.name!r} (path node {k}): the rope wraps it by "
+                f"{math.degrees(self.wrap_angles[k]):.1f} deg, more than "
+                f"{math.degrees(LARGE_WRAP):.0f} deg, so in the sheave's plane the rope "
+                f"leaving it crosses the rope coming in; wrap = {given!r} may be the wrong way "
+                f"round: with wrap = {other!r} the rope goes round the other side (a capstan, "
+                "its rope leaving the plane, may wrap this far on purpose)"
+            )
+        return warnings
 
     def _choose_span_geometry(self) -> None:
         """Choose the span geometry the effects call for, once."""

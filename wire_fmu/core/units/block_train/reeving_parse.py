@@ -187,6 +187,20 @@ class _Problems:
         return vec
 
 
+def _known(name: Any, names: Mapping[str, Any]) -> bool:
+    """Whether ``name`` is text and one of ``names`` (a list or table given for a name is not,
+    rather than an error of its own).
+
+    Parameters
+    ----------
+    name : Any
+        The name as given.
+    names : mapping
+        The names defined, as keys.
+    """
+    return isinstance(name, str) and name in names
+
+
 def parse_reeving(data: Mapping[str, Any]) -> Reeving:
     """Validate a reeving description and build a :class:`Reeving`.
 
@@ -224,6 +238,7 @@ def parse_reeving(data: Mapping[str, Any]) -> Reeving:
     bodies = _parse_bodies(data.get("bodies", {}), p)
     sheaves = _parse_sheaves(data.get("sheaves", {}), bodies, p)
     anchors = _parse_anchors(data.get("anchors", {}), bodies, p)
+    _check_names(sheaves, anchors, p)
     path = _parse_path(data.get("path", []), sheaves, anchors, bodies, p)
     fleet = p.declared(data, "max_fleet_angle_deg", "reeving")
     _check_ports(bodies, path, p)
@@ -241,14 +256,50 @@ def _parse_rope(data: Mapping, p: _Problems) -> RopeProperties:
         ea = p.declared(data, "rope.axial_stiffness", where)
         damping = p.declared(data, "rope.damping", where)
     else:
-        area = p.declared(data, "rope.metallic_area", where)
-        modulus = p.declared(data, "rope.modulus", where)
-        fill = p.declared(data, "rope.fill_factor", where)
-        viscosity = p.declared(data, "rope.viscosity", where)
-        ea, damping = area * fill * modulus, area * fill * viscosity
+        ea, damping = _section_stiffness(data, where, p)
     breaking = p.declared(data, "rope.breaking_load", where)
     linear_mass = p.declared(data, "rope.linear_mass", where)
     return RopeProperties(ea, damping, breaking, linear_mass)
+
+
+def _section_stiffness(data: Mapping, where: str, p: _Problems) -> tuple[float, float]:
+    """EA (N) and the damping coefficient (N s) from metallic area, modulus, fill and viscosity.
+
+    Without ``axial_stiffness`` the rope needs both ``metallic_area`` and ``modulus``; a
+    problem naming both ways to give the stiffness is recorded when either is missing.
+
+    Parameters
+    ----------
+    data : mapping
+        The rope's table (no ``axial_stiffness``).
+    where : str
+        The rope, for the problems' text.
+    p : _Problems
+        Where problems are recorded.
+
+    Returns
+    -------
+    tuple of float
+        EA (N) and damping coefficient (N s); NaN when the stiffness is not given.
+    """
+    given = [key for key in ("metallic_area", "modulus") if key in data]
+    if not given:
+        p.add(
+            where,
+            "its stiffness is required: give 'axial_stiffness' (EA, N), or "
+            "'metallic_area' (m2) and 'modulus' (Pa)",
+        )
+    elif len(given) == 1:
+        (have,) = given
+        missing = "modulus" if have == "metallic_area" else "metallic_area"
+        p.add(where, f"'{missing}' is required with '{have}' (or give 'axial_stiffness' instead)")
+    values = {key: p.declared(data, f"rope.{key}", where) for key in given}
+    fill = p.declared(data, "rope.fill_factor", where)
+    viscosity = p.declared(data, "rope.viscosity", where)
+    if len(values) < 2:
+        return math.nan, math.nan
+    area, modulus = values["metallic_area"], values["modulus"]
+    return area * fill * modulus, area * fill * viscosity
 
 
 def _parse_bodies(data: Mapping, p: _Problems) -> dict[str, Body]:
@@ -288,7 +339,7 @@ def _check_carriers(bodies: dict[str, Body], data: Mapping, p: _Problems) -> Non
         if body.on == "ground":
             continue
         where = f"body {name!r}"
-        carrier = bodies.get(body.on)
+        carrier = bodies.get(body.on) if _known(body.on, bodies) else None
         if carrier is None:
             p.add(where, f"'on' names {body.on!r}, which is not a body")
         elif carrier.kind != "driven":
@@ -298,7 +349,7 @@ def _check_carriers(bodies: dict[str, Body], data: Mapping, p: _Problems) -> Non
                 f"{body.on!r} is a {carrier.kind}",
             )
         seen, current = {name}, body.on
-        while current in bodies and current != "ground":
+        while _known(current, bodies) and current != "ground":
             if current in seen:
                 p.add(where, "bodies ride on each other in a circle")
                 break
@@ -341,7 +392,7 @@ def _parse_on_bodies(
             p.add(where, "must be a mapping")
             continue
         body = spec.get("body", "ground")
-        if body not in bodies:
+        if not _known(body, bodies):
             p.add(where, f"'body' {body!r} is not a body; bodies: {', '.join(bodies)}")
         parts[name] = build(name, body, spec, where)
     return parts
@@ -397,11 +448,34 @@ def _parse_anchors(data: Mapping, bodies: dict[str, Body], p: _Problems) -> dict
     return _parse_on_bodies(data, "anchor", bodies, p, anchor)
 
 
+def _check_names(sheaves: Mapping, anchors: Mapping, p: _Problems) -> None:
+    """A name given to a sheave and to an anchor: refused, naming both.
+
+    The path says which kind each node is, but drawings, messages and the geometry name
+    nodes by their names alone, so a name must point at one node. Bodies are a namespace
+    of their own (only ``body`` and ``on`` name them); line ends are named by their port.
+
+    Parameters
+    ----------
+    sheaves, anchors : mapping
+        The parsed sheaves and anchors, by name.
+    p : _Problems
+        Where problems are recorded.
+    """
+    for name in anchors:
+        if name in sheaves:
+            p.add(
+                f"sheave {name!r} and anchor {name!r}",
+                "the same name for two nodes; every sheave and anchor needs a name of its own",
+            )
+
+
 def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[PathElement, ...]:
     if not isinstance(data, list | tuple) or len(data) < 2:
         p.add("path", "must be a list of at least two nodes (two rope ends)")
         return ()
     out = []
+    first_pass: dict[str, int] = {}  # sheave -> the path node that passes it first
     last = len(data) - 1
     for i, node in enumerate(data):
         where = f"path node {i}"
@@ -411,14 +485,26 @@ def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[Path
         if "sheave" in node:
             name = node["sheave"]
             wrap = node.get("wrap")
-            if name not in sheaves:
+            if not _known(name, sheaves):
                 p.add(where, f"sheave {name!r} is not defined; sheaves: {', '.join(sheaves)}")
-            if wrap not in _WRAPS:
+            if not _known(wrap, _WRAPS):
                 p.add(where, f"sheave {name!r}: 'wrap' must be 'ccw' or 'cw', got {wrap!r}")
-            out.append(PathElement("sheave", str(name), _WRAPS.get(wrap, 1)))
+            if _known(name, sheaves) and name in first_pass:
+                p.add(
+                    f"path nodes {first_pass[name]} and {i}",
+                    f"sheave {name!r} is passed twice; the rope may pass a sheave once (the "
+                    "model gives each pass a groove, rim and bearing of its own); for a sheave "
+                    "with several grooves give one sheave per groove, centres offset along "
+                    "the axis",
+                )
+            elif _known(name, sheaves):
+                first_pass[name] = i
+            out.append(
+                PathElement("sheave", str(name), _WRAPS[wrap] if _known(wrap, _WRAPS) else 1)
+            )
         elif "anchor" in node:
             name = node["anchor"]
-            if name not in anchors:
+            if not _known(name, anchors):
                 p.add(where, f"anchor {name!r} is not defined; anchors: {', '.join(anchors)}")
             if 0 < i < last:
                 p.add(where, f"anchor {name!r} must be at an end of the path")
@@ -430,7 +516,7 @@ def _parse_path(data: Any, sheaves, anchors, bodies, p: _Problems) -> tuple[Path
                 p.add(where, f"'line_end' must be one of {LINE_PORTS}, got {port!r}")
             if 0 < i < last:
                 p.add(where, f"line end {port!r} must be at an end of the path")
-            if body not in bodies:
+            if not _known(body, bodies):
                 p.add(where, f"'body' {body!r} is not a body")
             point = p.declared(node, "path[i].point", where)
             out.append(PathElement("line_end", str(port), 0, point, body))
@@ -447,6 +533,8 @@ def _check_ports(bodies: dict[str, Body], path, p: _Problems) -> None:
     owners = [(b.port, f"body {b.name!r}") for b in bodies.values() if b.port]
     owners += [(e.name, f"path line end {e.name!r}") for e in path if e.kind == "line_end"]
     for port, owner in owners:
+        if not isinstance(port, str):  # a problem of its own already
+            continue
         if port in used:
             p.add("ports", f"port {port!r} is used by both {used[port]} and {owner}")
         used[port] = owner

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import logging
 import math
 import operator
 from collections.abc import Mapping
@@ -63,6 +64,8 @@ from wire_fmu.core.units.block_train.reeving_parse import parse_reeving
 from wire_fmu.core.units.block_train.reevings import drilling_block_train
 
 __all__ = ["BlockTrainUnit"]
+
+logger = logging.getLogger(__name__)
 
 _INTERFACE_PORTS = LINE_PORTS + MOVER_PORTS
 """The ports that can publish an interface model."""
@@ -320,6 +323,8 @@ class BlockTrainUnit(Unit):
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", err.problems) from None
         if problems:
             raise ConfigurationError(f"{self.NAME} {self.instance_name!r}", problems)
+        for warning in self.model.wrap_warnings:  # legal, but most likely a mistake
+            logger.warning("%s %r: parameter 'reeving': %s", self.NAME, self.instance_name, warning)
 
     def initialize(self, start_time: float) -> None:
         """Rope stretched for equilibrium (or pretension); outputs filled.
