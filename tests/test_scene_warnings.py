@@ -173,3 +173,49 @@ def test_an_input_its_units_parameters_leave_without_influence_is_named(tmp_path
     (start,) = [w for w in warnings if "'initial_handle_speed'" in w]
     assert start.startswith("unit 'lift': parameter 'initial_handle_speed'")
     assert len(warnings) == 2
+
+
+SPEED_SETTERS = {
+    "event": ("", "event 'brake released, drive lowers at 5 m/s fast-line speed'"),
+    "driver": (
+        """
+        [[drivers]]
+        target = "winch.drum.speed_command"
+        kind = "ramp"
+        points = [[0.0, 0.0], [1.0, 2.0]]
+        label = "speed ramp"
+        """,
+        "driver 'speed ramp'",
+    ),
+    "connection": (
+        """
+        [[connections]]
+        from = "winch.motor.speed"
+        to = "winch.drum.speed_command"
+        """,
+        "connection from winch.motor.speed",
+    ),
+}
+
+
+@pytest.mark.parametrize("setter", sorted(SPEED_SETTERS))
+def test_an_input_its_units_effects_silence_is_named_with_what_sets_it(tmp_path, capsys, setter):
+    """The drawworks with an event, a driver or a connection on the drum's speed command,
+    which acts only without drum_inertia (the scene's winch has it): the unit, the input,
+    what sets it and the effect are named, by check (audit case
+    w_speed_command_with_inertia: the event)."""
+    text = shipped_scenes()["drawworks"].read_text(encoding="utf-8")
+    if setter == "event":
+        text = text.replace('"winch.motor.command" = 257.0e3', '"winch.drum.speed_command" = 5.0')
+    table, who = SPEED_SETTERS[setter]
+    path = tmp_path / "drawworks.toml"
+    path.write_text(text + textwrap.dedent(table), encoding="utf-8")
+    said = (
+        f"unit 'winch': input 'drum.speed_command' (set by {who}) has no influence with its "
+        "effects (band_brake, drum_inertia, motor_characteristic): it acts only without "
+        "effect 'drum_inertia'; change the effects or leave it out"
+    )
+    assert inactive_settings(load_scene_file(path)) == [said]
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "no problems" in out and f"warning: {said}" in out.splitlines()

@@ -192,6 +192,30 @@ def test_bad_parameters_give_one_error_listing_every_problem():
     assert len(err.value.problems) == 6
 
 
+def test_a_band_friction_or_wrap_beyond_any_real_band_brake_is_refused_with_its_range():
+    """A friction of 12 (a slip for 0.12) over 300 deg gave e^(mu alpha) of about 2e27, silently;
+    linings lie below about 0.65 and a band wraps at most one turn. Both bounds are
+    declared, so the reference shows them."""
+    unit = WinchUnit("mu")
+    unit.values.update(
+        {"effects": "drum_inertia,band_brake", "brake_friction": 12.0, "brake_wrap_angle": 7.0}
+    )
+    with pytest.raises(ConfigurationError) as err:
+        unit.configure()
+    assert err.value.problems == [
+        "parameter 'brake_friction' must be in (0, 1] (brake linings: 0.3-0.65), got 12.0",
+        "parameter 'brake_wrap_angle' must be in (0, 2 pi] rad (a band wraps at most one turn), "
+        "got 7.0",
+    ]
+    declared = {v.name: v for v in WinchUnit.VARIABLES}
+    assert declared["brake_friction"].max == 1.0
+    assert declared["brake_wrap_angle"].max == pytest.approx(2.0 * np.pi)
+    for edge in ({"brake_friction": 1.0}, {"brake_wrap_angle": 2.0 * np.pi}):
+        unit = WinchUnit("edge")
+        unit.values.update({"effects": "drum_inertia,band_brake", **edge})
+        unit.configure()
+
+
 def test_energy_solver_needs_a_rigid_machine_and_other_solvers_are_listed():
     for effects, params, needle in (
         ("drum_inertia,elastic_drive_train", {"solver": "energy"}, "rigid one-degree"),

@@ -15,10 +15,30 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["BandBrake", "BRAKE_FREE", "BRAKE_SLIPPING", "BRAKE_HOLDING"]
+__all__ = [
+    "BandBrake",
+    "BRAKE_FREE",
+    "BRAKE_SLIPPING",
+    "BRAKE_HOLDING",
+    "BRAKE_FRICTION_MAX",
+    "BRAKE_WRAP_ANGLE_MAX",
+]
 
 BRAKE_FREE, BRAKE_SLIPPING, BRAKE_HOLDING = 0, 1, 2
 _BRAKE_WORDS = ("released", "slipping", "holding")  # indexed by brake state
+
+BRAKE_FRICTION_MAX = 1.0
+"""Largest band friction coefficient taken. Dry brake linings on steel or cast iron lie
+between about 0.3 and 0.65 (moulded, woven and sintered linings; leather and cork up to
+about 0.6; e.g. Shigley's Mechanical Engineering Design, friction materials for brakes
+and clutches), so 1 leaves half as much again above the grippiest lining; beyond it the
+value is a typing slip (12 for 0.12), and the self-energising factor e^(mu alpha) of
+300 deg of wrap would be about 2e27 at mu = 12."""
+
+BRAKE_WRAP_ANGLE_MAX = 2.0 * math.pi
+"""Largest band wrap angle taken, rad: a band brake's band, its dead end anchored and its
+live end on the lever, both leaving the rim, wraps at most one turn (270-330 deg in
+drawworks)."""
 
 
 @dataclass(frozen=True)
@@ -73,8 +93,18 @@ class BandBrake:
             ("brake_rim_radius", self.rim_radius, self.rim_radius > 0, "> 0 m"),
             ("brake_lever_ratio", self.lever_ratio, self.lever_ratio > 0, "> 0"),
             ("brake_efficiency", self.efficiency, 0 < self.efficiency <= 1, "in (0, 1]"),
-            ("brake_friction", self.friction, self.friction > 0, "> 0"),
-            ("brake_wrap_angle", self.wrap_angle, self.wrap_angle > 0, "> 0 rad"),
+            (
+                "brake_friction",
+                self.friction,
+                0 < self.friction <= BRAKE_FRICTION_MAX,
+                f"in (0, {BRAKE_FRICTION_MAX:g}] (brake linings: 0.3-0.65)",
+            ),
+            (
+                "brake_wrap_angle",
+                self.wrap_angle,
+                0 < self.wrap_angle <= BRAKE_WRAP_ANGLE_MAX,
+                "in (0, 2 pi] rad (a band wraps at most one turn)",
+            ),
         )
         return [
             f"parameter {name!r} must be {bound}, got {value}"

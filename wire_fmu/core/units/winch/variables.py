@@ -12,6 +12,7 @@ from wire_fmu.core.framework.energy_solver import ENERGY_SOLVERS
 from wire_fmu.core.framework.interface_model import interface_input_names, interface_inputs
 from wire_fmu.core.framework.solver_options import solver_parameters
 from wire_fmu.core.framework.unit import input_, mode_change_time_output, output, parameter
+from wire_fmu.core.units.winch.brake import BRAKE_FRICTION_MAX, BRAKE_WRAP_ANGLE_MAX
 from wire_fmu.core.units.winch.model import WINCH_EFFECTS
 
 __all__ = ["winch_parameters", "winch_inputs", "winch_outputs"]
@@ -151,8 +152,10 @@ def winch_parameters():
             "brake_friction",
             0.4,
             "1",
-            "Band friction coefficient mu (moulded lining on steel, 0.35-0.45)",
+            "Band friction coefficient mu (moulded lining on steel, 0.35-0.45; at most 1: "
+            "brake linings lie below about 0.65)",
             min=0.0,
+            max=BRAKE_FRICTION_MAX,
             min_exclusive=True,
             acts_with=_BRAKE,
         ),
@@ -160,8 +163,10 @@ def winch_parameters():
             "brake_wrap_angle",
             5.24,
             "rad",
-            "Band wrap angle alpha (about 300 deg)",
+            "Band wrap angle alpha (about 300 deg; at most one turn, 2 pi: both band ends "
+            "leave the drum)",
             min=0.0,
+            max=BRAKE_WRAP_ANGLE_MAX,
             min_exclusive=True,
             acts_with=_BRAKE,
         ),
