@@ -116,6 +116,27 @@ def _cli(args: list[str], fmu_dir: Path, expected: int) -> str:
     return _checked(run, expected)
 
 
+FMPY_ONE_AFTER_ANOTHER = """
+import sys
+from pathlib import Path
+from fmpy import simulate_fmu
+for name in ("Winch", "Hydraulics", "BlockTrain", "Winch"):
+    result = simulate_fmu(str(Path(sys.argv[3]) / f"{name}.fmu"), stop_time=0.02,
+                          output_interval=0.01)
+    print(name, "rows", len(result))
+"""
+
+
+def test_fmus_run_one_after_another_by_fmpy_in_one_process(tmp_path, fmu_dir):
+    """The runner ``fmpy.simulate_fmu`` removes each FMU's extraction folder when done, and the
+    first FMU's ``wire_fmu`` serves every later one: a later FMU imports what the first
+    never did from its own identical copy (``guard.follow_bundled_copy``), where it had
+    failed with ``No module named 'wire_fmu.core.units.hydraulics'``."""
+    said = _python(FMPY_ONE_AFTER_ANOTHER, RISER, tmp_path, fmu_dir, 0)
+    for name in ("Winch", "Hydraulics", "BlockTrain"):
+        assert f"{name} rows 3" in said, said[-2000:]
+
+
 @pytest.mark.parametrize("attempt", range(5))
 def test_python_api_runs_and_checks_exit_cleanly(tmp_path, fmu_dir, failing_scene, attempt):
     assert "status finished" in _python(API_RUN, RISER, tmp_path / "ok", fmu_dir, 0)

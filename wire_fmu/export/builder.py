@@ -11,6 +11,7 @@ build record for the core-version guard, builds with pythonfmu's
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import importlib.util
 import inspect
@@ -49,6 +50,45 @@ logger = logging.getLogger(__name__)
 
 class BuildError(ConfigurationError):
     """A facade script cannot be built into an FMU (lists every problem)."""
+
+
+FACADE_PREAMBLE = """\
+# Put here by wire_fmu's builder. If this process imported wire_fmu from an FMU whose
+# folder is gone since, import the rest of it from this FMU's identical copy
+# (wire_fmu.export.guard.follow_bundled_copy); the first FMU in a process has nothing to do.
+import os as _os
+import sys as _sys
+
+if "wire_fmu.export.guard" in _sys.modules:
+    _sys.modules["wire_fmu.export.guard"].follow_bundled_copy(
+        _os.path.dirname(_os.path.abspath(__file__))
+    )
+
+"""
+"""Lines the builder puts before an FMU's facade script (see
+:func:`~wire_fmu.export.guard.follow_bundled_copy`)."""
+
+
+def _with_preamble(text: str) -> str:
+    """The facade script ``text`` with :data:`FACADE_PREAMBLE` before its first statement
+    after its docstring and ``from __future__`` imports (which must come first); a script
+    Python cannot parse is left as it is, for its import to say why."""
+    try:
+        body = ast.parse(text).body
+    except SyntaxError:
+        return text
+    first = next(
+        (
+            node
+            for k, node in enumerate(body)
+            if not (k == 0 and isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant))
+            and not (isinstance(node, ast.ImportFrom) and node.module == "__future__")
+        ),
+        None,
+    )
+    lines = text.splitlines(keepends=True)
+    at = len(lines) if first is None else first.lineno - 1
+    return "".join(lines[:at]) + FACADE_PREAMBLE + "".join(lines[at:])
 
 
 def unique_module_name(script: Path, core_fingerprint: str) -> str:
@@ -177,7 +217,7 @@ def _stage(script: Path, folder: Path, extra_modules: Sequence[Path]) -> _Stagin
     core_print = _bundle_core(core)
     staged = folder / "script" / f"{unique_module_name(script, core_print)}.py"
     staged.parent.mkdir()
-    shutil.copy2(script, staged)
+    staged.write_text(_with_preamble(script.read_text(encoding="utf-8")), encoding="utf-8")
     extras = tuple(staged.parent / extra.name for extra in extra_modules)
     for source, target in zip(extra_modules, extras, strict=True):
         shutil.copy2(source, target)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import functools
 import json
+import os
+import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -18,7 +20,14 @@ import wire_fmu
 from wire_fmu._fingerprint import fingerprint
 from wire_fmu.core.errors import WireFmuError
 
-__all__ = ["BUILD_INFO_FILE", "BuildInfo", "CoreVersionError", "check_core", "imported_core"]
+__all__ = [
+    "BUILD_INFO_FILE",
+    "BuildInfo",
+    "CoreVersionError",
+    "check_core",
+    "follow_bundled_copy",
+    "imported_core",
+]
 
 BUILD_INFO_FILE = "wire_fmu_build.json"
 """Name of the build record in an FMU's ``resources`` folder."""
@@ -129,3 +138,40 @@ def check_core(resources: str | Path, fmu: str, instance: str) -> None:
     version, print_, _ = imported_core()
     if (info.version, info.fingerprint) != (version, print_):
         raise CoreVersionError(_mismatch_message(info, instance, resources))
+
+
+def follow_bundled_copy(resources: str | Path) -> None:
+    """Let the ``wire_fmu`` imported here import what it has not yet from ``resources``'
+    copy, where the folder it was imported from is gone.
+
+    The first FMU's copy serves every later FMU (see the module docstring), but a master
+    may delete that FMU's folder once it is done with it: fmpy's ``simulate_fmu`` removes
+    its extraction folder, so a second FMU run in the same process could not import a
+    module the first never did (``No module named 'wire_fmu.core.units.hydraulics'``).
+    When ``resources`` holds the same ``wire_fmu`` (the version and fingerprint of
+    :func:`check_core`), every imported package whose folder is gone is pointed at the
+    same package in ``resources``; anything else is left for :func:`check_core` to refuse.
+    The builder puts a call of this at the top of every FMU's facade script, before it
+    imports its unit.
+
+    Parameters
+    ----------
+    resources : str or Path
+        The folder of the FMU being loaded (its facade script's folder).
+    """
+    resources = Path(resources)
+    record = resources / BUILD_INFO_FILE
+    if not record.is_file():
+        return
+    info = BuildInfo.read(record)
+    version, print_, _ = imported_core()
+    if (info.version, info.fingerprint) != (version, print_):
+        return
+    bundled = resources / "wire_fmu"
+    for name, module in list(sys.modules.items()):
+        if name != "wire_fmu" and not name.startswith("wire_fmu."):
+            continue
+        path = getattr(module, "__path__", None)
+        if path is None or any(os.path.isdir(folder) for folder in path):
+            continue
+        module.__path__ = [str(bundled.joinpath(*name.split(".")[1:]))]
