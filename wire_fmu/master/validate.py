@@ -492,8 +492,8 @@ def _left_out(refused: Mapping[str, str]) -> str:
     if not refused:
         return ""
     names = ", ".join(repr(k) for k in refused)
-    values = "value" if len(refused) == 1 else "values"
-    return f" (found with {names} left out: the unit cannot take the {values} given)"
+    them = "it" if len(refused) == 1 else "them"
+    return f" (found with {names} left out: the unit cannot take {them} as given)"
 
 
 def unit_messages(name: str, slave, exc: Exception) -> list[str]:
