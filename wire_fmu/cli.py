@@ -40,7 +40,7 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from wire_fmu.cli_cache import add_cache_parser
@@ -66,27 +66,26 @@ __all__ = ["main"]
 logger = logging.getLogger("wire_fmu")
 
 
-def _positive_int(text: str) -> int:
-    """A whole number >= 1 from the command line (argparse names the option on error)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
-    return value
+def _whole_number(minimum: int, expected: str) -> Callable[[str], int]:
+    """A parser of a whole number ``>= minimum`` from the command line, saying ``expected``
+    when the text is not one (argparse names the option)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{expected}, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{expected}, got {value}")
+        return value
+
+    return parse
 
 
-def _worker_count(text: str) -> int:
-    """Worker processes of a sweep's local cluster from the command line: 0 runs serially."""
-    expected = "expected a whole number >= 1, or 0 to run the cases serially in this process"
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{expected}, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{expected}, got {value}")
-    return value
+_positive_int = _whole_number(1, "expected a whole number >= 1")
+_worker_count = _whole_number(  # worker processes of a sweep's local cluster: 0 runs serially
+    0, "expected a whole number >= 1, or 0 to run the cases serially in this process"
+)
 
 
 def _scheduler_address(text: str) -> str:
